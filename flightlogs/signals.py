@@ -1,0 +1,115 @@
+"""The canonical signal vocabulary shared by every layer.
+
+All signals after ingest are named and scaled as in ``DESIGN.md``: SI units,
+radians, FRD body axes and NED earth axes (PX4 conventions). Mixer inputs,
+motor commands and the excitation keep the unit they were logged in, and the
+unit is recorded with them.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+__all__ = [
+    "SignalSpec",
+    "CANONICAL_SIGNALS",
+    "LOGGED_SIGNALS",
+    "ESTIMATOR_SIGNALS",
+    "is_canonical",
+    "describe",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class SignalSpec:
+    """Meaning and SI unit of one canonical signal.
+
+    Parameters
+    ----------
+    name : str
+        Canonical name, e.g. ``"q"``.
+    meaning : str
+        Plain-language description.
+    unit : str
+        SI unit, or ``"as logged"`` when the autopilot's own unit is kept.
+    """
+
+    name: str
+    meaning: str
+    unit: str
+
+
+_SPECS = (
+    SignalSpec("p", "body roll rate", "rad/s"),
+    SignalSpec("q", "body pitch rate", "rad/s"),
+    SignalSpec("r", "body yaw rate", "rad/s"),
+    SignalSpec("phi", "roll angle", "rad"),
+    SignalSpec("theta", "pitch angle", "rad"),
+    SignalSpec("psi", "yaw angle (heading)", "rad"),
+    SignalSpec("vn", "north velocity", "m/s"),
+    SignalSpec("ve", "east velocity", "m/s"),
+    SignalSpec("vd", "down velocity", "m/s"),
+    SignalSpec("u", "body-x air-relative velocity (eq. 3.1)", "m/s"),
+    SignalSpec("v", "body-y air-relative velocity (eq. 3.1)", "m/s"),
+    SignalSpec("w", "body-z air-relative velocity (eq. 3.1)", "m/s"),
+    SignalSpec("ax", "body-x specific force", "m/s^2"),
+    SignalSpec("ay", "body-y specific force", "m/s^2"),
+    SignalSpec("az", "body-z specific force", "m/s^2"),
+    SignalSpec("delta_lat", "roll mixer input", "as logged"),
+    SignalSpec("delta_lon", "pitch mixer input", "as logged"),
+    SignalSpec("delta_yaw", "yaw mixer input", "as logged"),
+    SignalSpec("delta_thr", "thrust mixer input", "as logged"),
+    SignalSpec("wind_n", "north wind at the vehicle (blowing towards)", "m/s"),
+    SignalSpec("wind_e", "east wind at the vehicle (blowing towards)", "m/s"),
+    SignalSpec("wind_lon", "wind along body x", "m/s"),
+    SignalSpec("wind_lat", "wind along body y", "m/s"),
+    SignalSpec("height_agl", "height above ground", "m"),
+    SignalSpec("battery_v", "battery voltage", "V"),
+    SignalSpec("excitation", "injected excitation signal", "as logged"),
+    SignalSpec("est_wind_n", "autopilot's own north wind estimate", "m/s"),
+    SignalSpec("est_wind_e", "autopilot's own east wind estimate", "m/s"),
+)
+
+#: Every canonical signal with a fixed name, by name.
+CANONICAL_SIGNALS: dict[str, SignalSpec] = {spec.name: spec for spec in _SPECS}
+
+#: Signals a reader is expected to find in a flight log (``motor_1..n`` aside).
+#: The ones it cannot find are reported as missing, by name.
+LOGGED_SIGNALS: tuple[str, ...] = (
+    "p", "q", "r", "phi", "theta", "psi", "vn", "ve", "vd", "ax", "ay", "az",
+    "delta_lat", "delta_lon", "delta_yaw", "delta_thr", "height_agl", "battery_v",
+)
+
+#: Optional signals a reader adds when the autopilot logs them.
+ESTIMATOR_SIGNALS: tuple[str, ...] = ("excitation", "est_wind_n", "est_wind_e")
+
+_MOTOR = re.compile(r"motor_([1-9][0-9]?)")
+
+
+def is_canonical(name: str) -> bool:
+    """Return True if `name` is a canonical signal name (``motor_N`` included)."""
+    return name in CANONICAL_SIGNALS or _MOTOR.fullmatch(name) is not None
+
+
+def describe(name: str) -> SignalSpec:
+    """Return the :class:`SignalSpec` of a canonical name.
+
+    Raises
+    ------
+    KeyError
+        If `name` is not canonical.
+
+    Examples
+    --------
+    >>> describe("q").unit
+    'rad/s'
+    >>> describe("motor_3").meaning
+    'motor 3 command'
+    """
+    if name in CANONICAL_SIGNALS:
+        return CANONICAL_SIGNALS[name]
+    match = _MOTOR.fullmatch(name)
+    if match is None:
+        raise KeyError(f"{name!r} is not a canonical signal name")
+    return SignalSpec(name, f"motor {match.group(1)} command", "as logged")

@@ -1,0 +1,26 @@
+"""Shared fixtures: where the real logs live, and a CLI runner."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+
+
+def _real_data_dir() -> Path:
+    override = os.environ.get("SYSID_REAL_DATA")
+    return Path(override) if override else REPO_ROOT.parent / "shared" / "data" / "real"
+
+
+REAL_DATA = _real_data_dir()
+
+
+@pytest.fixture(scope="session")
+def real_data() -> Path:
+    """Folder of real logs recorded by others (``../shared/data/real``); never copied here."""
+    if not REAL_DATA.is_dir():
+        pytest.fail(f"real flight data not found at {REAL_DATA} (set SYSID_REAL_DATA)")
+    return REAL_DATA
