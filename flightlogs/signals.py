@@ -88,12 +88,23 @@ _MOTOR = re.compile(r"motor_([1-9][0-9]?)")
 
 
 def is_canonical(name: str) -> bool:
-    """Return True if `name` is a canonical signal name (``motor_N`` included)."""
+    """Return True if `name` is a canonical signal name (``motor_N`` included).
+
+    Parameters
+    ----------
+    name : str
+        Name to check.
+    """
     return name in CANONICAL_SIGNALS or _MOTOR.fullmatch(name) is not None
 
 
 def describe(name: str) -> SignalSpec:
     """Return the :class:`SignalSpec` of a canonical name.
+
+    Parameters
+    ----------
+    name : str
+        Canonical name, ``motor_N`` included.
 
     Raises
     ------

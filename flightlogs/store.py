@@ -1,0 +1,254 @@
+"""The HDF5 dataset store: ingested logs and wind measurements, with provenance.
+
+Layout (schema version 1)::
+
+    /                               attrs: schema, schema_version, software, created_utc
+    /logs/<key>/                    attrs: path, sha256, log_format, autopilot, vehicle,
+                                           utc_offset_s (NaN when unknown), warnings (JSON)
+    /logs/<key>/parameters          compound dataset (name, value)
+    /logs/<key>/signals/<name>/     attrs: unit, source
+    /logs/<key>/signals/<name>/time_s   float64 (n_samples,), s, log clock
+    /logs/<key>/signals/<name>/values   float64 (n_samples,), in `unit`
+    /wind/<key>/                    attrs: path, sha256, and the measurement's scalar
+                                           fields; JSON for mappings and tuples
+    /wind/<key>/<array field>       float64 (n_samples,) (``utc_s`` in UNIX s, winds m/s)
+
+``<key>`` is the file's stem, made unique with a numeric suffix. Later steps
+add groups of their own beside these (aligned records, segments); a reader
+ignores groups it does not know.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from .atomic import atomic_output
+from .errors import LogFormatError
+from .flightlog import FlightLog, Signal
+
+__all__ = ["Dataset", "write_dataset", "read_dataset", "file_sha256", "SCHEMA_VERSION"]
+
+SCHEMA = "flight-sysid dataset"
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True, slots=True)
+class Dataset:
+    """What a dataset file holds.
+
+    Parameters
+    ----------
+    logs : tuple of FlightLog
+        Ingested flight logs, in the order they were written.
+    winds : tuple
+        Wind measurements (:class:`flightlogs.anemometer.WindMeasurement`).
+    sha256 : dict
+        Hash of each source file as it was at ingest, by path string.
+    schema_version : int
+        Layout version of the file read.
+    """
+
+    logs: tuple[FlightLog, ...]
+    winds: tuple[Any, ...] = ()
+    sha256: dict[str, str] = dataclasses.field(default_factory=dict)
+    schema_version: int = SCHEMA_VERSION
+
+
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 hex digest of a file's bytes (provenance of ingested inputs).
+
+    Parameters
+    ----------
+    path : str or Path
+        File to hash.
+    """
+    digest = hashlib.sha256()
+    with Path(path).open("rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def write_dataset(path: str | Path, logs: Sequence[FlightLog], winds: Sequence[Any] = ()) -> None:
+    """Write logs and wind measurements to an HDF5 dataset, atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination ``.h5``; replaced only once the whole file is written.
+    logs : sequence of FlightLog
+        Logs to store.
+    winds : sequence of WindMeasurement, optional
+        Anemometer measurements to store.
+    """
+    with atomic_output(path) as tmp, h5py.File(tmp, "w") as h5:
+        h5.attrs["schema"] = SCHEMA
+        h5.attrs["schema_version"] = SCHEMA_VERSION
+        h5.attrs["software"] = f"flight-sysid {_version()}"
+        h5.attrs["created_utc"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        log_group = h5.create_group("logs")
+        for log in logs:
+            _write_log(log_group.create_group(_unique_key(log_group, log.path)), log)
+        wind_group = h5.create_group("wind")
+        for wind in winds:
+            _write_dataclass(wind_group.create_group(_unique_key(wind_group, wind.path)), wind)
+
+
+def read_dataset(path: str | Path) -> Dataset:
+    """Read a dataset written by :func:`write_dataset`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.h5`` file.
+
+    Raises
+    ------
+    LogFormatError
+        If the file is not an HDF5 dataset of this schema, or of a newer version.
+    """
+    path = Path(path)
+    try:
+        h5 = h5py.File(path, "r")
+    except (OSError, ValueError) as err:
+        raise LogFormatError(f"{path}: not an HDF5 dataset ({err}).") from err
+    with h5:
+        if h5.attrs.get("schema") != SCHEMA:
+            raise LogFormatError(f"{path}: HDF5 file is not a flight-sysid dataset.")
+        version = int(h5.attrs["schema_version"])
+        if version > SCHEMA_VERSION:
+            raise LogFormatError(
+                f"{path}: dataset schema version {version} is newer than this "
+                f"software reads ({SCHEMA_VERSION}); upgrade flight-sysid."
+            )
+        logs = tuple(_read_log(group) for group in h5["logs"].values())
+        sha = {g.attrs["path"]: g.attrs["sha256"] for g in h5["logs"].values()}
+        winds = tuple(_read_wind(group) for group in h5.get("wind", {}).values())
+        sha.update({g.attrs["path"]: g.attrs["sha256"] for g in h5.get("wind", {}).values()})
+    return Dataset(logs=logs, winds=winds, sha256=sha, schema_version=version)
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("flight-sysid")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def _unique_key(group: h5py.Group, path: Path) -> str:
+    stem = Path(path).stem.replace("/", "_") or "log"
+    key, n = stem, 1
+    while key in group:
+        n += 1
+        key = f"{stem}_{n}"
+    return key
+
+
+def _source_hash(path: Path) -> str:
+    return file_sha256(path) if Path(path).is_file() else ""
+
+
+def _write_log(group: h5py.Group, log: FlightLog) -> None:
+    group.attrs["path"] = str(log.path)
+    group.attrs["sha256"] = _source_hash(log.path)
+    group.attrs["log_format"] = log.log_format
+    group.attrs["autopilot"] = log.autopilot
+    group.attrs["vehicle"] = log.vehicle
+    group.attrs["utc_offset_s"] = np.nan if log.utc_offset_s is None else log.utc_offset_s
+    group.attrs["warnings"] = json.dumps(list(log.warnings))
+    names = sorted(log.parameters)
+    table = np.array(
+        [(name, float(log.parameters[name])) for name in names],
+        dtype=[("name", h5py.string_dtype()), ("value", "f8")],
+    )
+    group.create_dataset("parameters", data=table)
+    signals = group.create_group("signals")
+    for name, signal in log.signals.items():
+        sub = signals.create_group(name)
+        sub.attrs["unit"] = signal.unit
+        sub.attrs["source"] = signal.source
+        sub.create_dataset("time_s", data=signal.time_s, compression="gzip", shuffle=True)
+        sub.create_dataset("values", data=signal.values, compression="gzip", shuffle=True)
+
+
+def _read_log(group: h5py.Group) -> FlightLog:
+    signals = {
+        name: Signal(
+            name, sub["time_s"][()], sub["values"][()], str(sub.attrs["unit"]), str(sub.attrs["source"])
+        )
+        for name, sub in group["signals"].items()
+    }
+    table = group["parameters"][()]
+    parameters = {
+        (row["name"].decode() if isinstance(row["name"], bytes) else str(row["name"])): float(row["value"])
+        for row in table
+    }
+    offset = float(group.attrs["utc_offset_s"])
+    return FlightLog(
+        path=Path(group.attrs["path"]),
+        log_format=str(group.attrs["log_format"]),  # type: ignore[arg-type]
+        autopilot=str(group.attrs["autopilot"]),  # type: ignore[arg-type]
+        signals=signals,
+        vehicle=str(group.attrs["vehicle"]),
+        parameters=parameters,
+        utc_offset_s=None if np.isnan(offset) else offset,
+        warnings=tuple(json.loads(group.attrs["warnings"])),
+    )
+
+
+def _write_dataclass(group: h5py.Group, item: Any) -> None:
+    """Store a frozen dataclass: arrays as datasets, the rest as attributes."""
+    group.attrs["sha256"] = _source_hash(item.path)
+    for field in dataclasses.fields(item):
+        value = getattr(item, field.name)
+        if isinstance(value, np.ndarray):
+            group.create_dataset(field.name, data=value, compression="gzip", shuffle=True)
+        elif isinstance(value, Path):
+            group.attrs[field.name] = str(value)
+        elif value is None:
+            group.attrs[field.name] = "null"
+            group.attrs[f"{field.name}.json"] = True
+        elif isinstance(value, (str, int, float, bool, np.floating, np.integer)):
+            group.attrs[field.name] = value
+        else:
+            group.attrs[field.name] = json.dumps(_jsonable(value))
+            group.attrs[f"{field.name}.json"] = True
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, dict) or hasattr(value, "items"):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (tuple, list)):
+        return [_jsonable(v) for v in value]
+    return value
+
+
+def _read_wind(group: h5py.Group) -> Any:
+    from .anemometer import WindMeasurement
+
+    kwargs: dict[str, Any] = {}
+    for field in dataclasses.fields(WindMeasurement):
+        if field.name in group:
+            kwargs[field.name] = group[field.name][()]
+        elif field.name in group.attrs:
+            raw = group.attrs[field.name]
+            if group.attrs.get(f"{field.name}.json", False):
+                raw = json.loads(raw)
+                raw = tuple(raw) if isinstance(raw, list) else raw
+            kwargs[field.name] = raw
+    kwargs["path"] = Path(kwargs["path"])
+    return WindMeasurement(**kwargs)

@@ -1,0 +1,68 @@
+"""The ``sysid`` command group: options shared by all commands, and error mapping."""
+
+from __future__ import annotations
+
+import logging
+import sys
+
+import click
+
+from flightlogs.errors import SysidError
+
+__all__ = ["cli"]
+
+_EPILOG = """\b
+Examples:
+  sysid demo
+  sysid ingest flight.ulg --wind anemometer.csv -o flight.h5 --json -
+"""
+
+
+class _SysidGroup(click.Group):
+    """Turn project errors into one sentence and exit code 1 (traceback only with --debug)."""
+
+    def invoke(self, ctx: click.Context) -> object:
+        try:
+            return super().invoke(ctx)
+        except (click.exceptions.Exit, click.ClickException, click.Abort):
+            raise
+        except SysidError as err:
+            if ctx.meta.get("sysid.debug"):
+                raise
+            click.secho(f"error: {err}", fg="red", err=True)
+            ctx.exit(1)
+        except (KeyboardInterrupt, BrokenPipeError):
+            raise
+        except Exception as err:  # a bug or an unwrapped library failure
+            if ctx.meta.get("sysid.debug"):
+                raise
+            click.secho(
+                f"error: unexpected {type(err).__name__}: {err} (run with --debug for the traceback)",
+                fg="red",
+                err=True,
+            )
+            ctx.exit(1)
+
+
+@click.group(cls=_SysidGroup, epilog=_EPILOG, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="flight-sysid", prog_name="sysid")
+@click.option("--debug", is_flag=True, help="Show full tracebacks and debug logging.")
+@click.pass_context
+def cli(ctx: click.Context, debug: bool) -> None:
+    """flight-sysid: turn multirotor flight logs into validated dynamic models."""
+    ctx.meta["sysid.debug"] = debug
+    logging.basicConfig(
+        level=logging.DEBUG if debug else logging.WARNING,
+        format="%(levelname)s %(name)s: %(message)s",
+        stream=sys.stderr,
+    )
+
+
+def _register() -> None:
+    from . import demo, ingest
+
+    cli.add_command(ingest.ingest)
+    cli.add_command(demo.demo)
+
+
+_register()

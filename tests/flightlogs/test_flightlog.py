@@ -1,0 +1,68 @@
+"""Signal and FlightLog containers: shapes, immutability, missing signals."""
+
+from __future__ import annotations
+
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from flightlogs.errors import MissingSignalError
+from flightlogs.flightlog import FlightLog, Signal
+from flightlogs.signals import LOGGED_SIGNALS, describe, is_canonical
+
+
+def _signal(name: str, n: int = 101, rate: float = 100.0) -> Signal:
+    t = np.arange(n) / rate
+    return Signal(name, t, np.sin(t), describe(name).unit, f"test.{name}")
+
+
+def test_signal_rate_and_duration() -> None:
+    signal = _signal("q", n=201, rate=200.0)
+    assert signal.samples == 201
+    assert signal.duration_s == pytest.approx(1.0)
+    assert signal.rate_hz == pytest.approx(200.0)
+
+
+def test_signal_arrays_are_read_only() -> None:
+    signal = _signal("p")
+    with pytest.raises(ValueError):
+        signal.values[0] = 1.0
+
+
+@pytest.mark.parametrize(
+    ("name", "time_s", "values"),
+    [("q", np.zeros(3), np.zeros(4)), ("q", np.zeros((3, 2)), np.zeros((3, 2))), ("pitch", np.zeros(3), np.zeros(3))],
+)
+def test_signal_rejects_bad_shapes_and_names(name: str, time_s: np.ndarray, values: np.ndarray) -> None:
+    with pytest.raises(ValueError):
+        Signal(name, time_s, values, "rad/s", "test")
+
+
+def test_canonical_names() -> None:
+    assert is_canonical("motor_8") and is_canonical("delta_thr")
+    assert not is_canonical("motor_0") and not is_canonical("roll")
+
+
+def test_flightlog_reports_missing_and_utc() -> None:
+    signals = {name: _signal(name) for name in ("p", "q", "r", "motor_1")}
+    log = FlightLog(Path("x.ulg"), "ulog", "px4", signals, utc_offset_s=1_700_000_000.0)
+    assert "p" not in log.missing and "phi" in log.missing
+    assert "motor_1..n" not in log.missing
+    assert set(log.missing) == set(LOGGED_SIGNALS) - {"p", "q", "r"}
+    assert log.utc_start == datetime.fromtimestamp(1_700_000_000.0, tz=timezone.utc)
+    assert log.duration_s == pytest.approx(1.0)
+
+
+def test_flightlog_getitem_names_the_missing_signal() -> None:
+    log = FlightLog(Path("flight.bin"), "dataflash", "ardupilot", {"p": _signal("p")})
+    with pytest.raises(MissingSignalError, match=r"flight.bin: no signal 'theta'"):
+        log["theta"]
+    assert log["p"].name == "p"
+
+
+def test_flightlog_signals_are_immutable() -> None:
+    log = FlightLog(Path("a.ulg"), "ulog", "px4", {"p": _signal("p")})
+    with pytest.raises(TypeError):
+        log.signals["q"] = _signal("q")  # type: ignore[index]
