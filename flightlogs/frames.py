@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["quaternion_to_euler"]
+__all__ = ["quaternion_to_euler", "earth_to_body", "air_velocity_body", "wind_to_body_axes"]
 
 
 def quaternion_to_euler(quaternion: np.ndarray) -> np.ndarray:
@@ -37,3 +37,107 @@ def quaternion_to_euler(quaternion: np.ndarray) -> np.ndarray:
     theta = np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
     psi = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
     return np.column_stack([phi, theta, psi])
+
+
+def _earth_to_body_matrices(phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> np.ndarray:
+    """Rotation matrices R_i^b (NED → FRD) of 3-2-1 Euler angles, shape (n_samples, 3, 3)."""
+    cf, sf = np.cos(phi), np.sin(phi)
+    ct, st = np.cos(theta), np.sin(theta)
+    cp, sp = np.cos(psi), np.sin(psi)
+    return np.stack(
+        [
+            np.stack([ct * cp, ct * sp, -st], axis=-1),
+            np.stack([sf * st * cp - cf * sp, sf * st * sp + cf * cp, sf * ct], axis=-1),
+            np.stack([cf * st * cp + sf * sp, cf * st * sp - sf * cp, cf * ct], axis=-1),
+        ],
+        axis=-2,
+    )
+
+
+def earth_to_body(vectors_ned: np.ndarray, phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> np.ndarray:
+    """Rotate NED vectors into FRD body axes.
+
+    Parameters
+    ----------
+    vectors_ned : ndarray, shape (n_samples, 3)
+        Vectors in earth axes (north, east, down).
+    phi, theta, psi : ndarray, shape (n_samples,)
+        Roll, pitch and yaw, rad (3-2-1 sequence).
+
+    Returns
+    -------
+    ndarray, shape (n_samples, 3)
+        The same vectors in body axes (forward, right, down).
+
+    Examples
+    --------
+    >>> north = np.array([[1.0, 0.0, 0.0]])
+    >>> np.round(earth_to_body(north, np.zeros(1), np.zeros(1), np.array([np.pi / 2])), 12)
+    array([[ 0., -1.,  0.]])
+    """
+    vectors_ned = np.asarray(vectors_ned, dtype=np.float64)
+    if vectors_ned.ndim != 2 or vectors_ned.shape[1] != 3:
+        raise ValueError(f"vectors_ned must have shape (n_samples, 3), got {vectors_ned.shape}")
+    matrices = _earth_to_body_matrices(np.asarray(phi), np.asarray(theta), np.asarray(psi))
+    return np.einsum("nij,nj->ni", matrices, vectors_ned)
+
+
+def air_velocity_body(
+    velocity_ned: np.ndarray, wind_ne: np.ndarray, phi: np.ndarray, theta: np.ndarray, psi: np.ndarray
+) -> np.ndarray:
+    """Body-axis velocity relative to the air, eq. 3.1: V_b = R_i^b (V_i - V_wind).
+
+    Parameters
+    ----------
+    velocity_ned : ndarray, shape (n_samples, 3)
+        Ground velocity ``vn, ve, vd``, m/s.
+    wind_ne : ndarray, shape (n_samples, 2)
+        Horizontal wind ``wind_n, wind_e`` (velocity of the air), m/s; the
+        vertical wind is taken as zero, as in the dissertation.
+    phi, theta, psi : ndarray, shape (n_samples,)
+        Euler angles, rad.
+
+    Returns
+    -------
+    ndarray, shape (n_samples, 3)
+        ``u, v, w``, m/s.
+
+    Examples
+    --------
+    A vehicle hovering in a 3 m/s wind blowing towards the north, nose north,
+    sees the air coming at it: u = -3 m/s.
+
+    >>> air_velocity_body(np.zeros((1, 3)), np.array([[3.0, 0.0]]), *np.zeros((3, 1)))
+    array([[-3.,  0.,  0.]])
+    """
+    wind_ne = np.asarray(wind_ne, dtype=np.float64)
+    relative = np.asarray(velocity_ned, dtype=np.float64).copy()
+    relative[:, :2] -= wind_ne
+    return earth_to_body(relative, phi, theta, psi)
+
+
+def wind_to_body_axes(wind_ne: np.ndarray, psi: np.ndarray) -> np.ndarray:
+    """Horizontal wind in heading-aligned body axes (the inputs of G_w, eq. 3.6).
+
+    Parameters
+    ----------
+    wind_ne : ndarray, shape (n_samples, 2)
+        ``wind_n, wind_e``, m/s (velocity of the air).
+    psi : ndarray, shape (n_samples,)
+        Heading, rad.
+
+    Returns
+    -------
+    ndarray, shape (n_samples, 2)
+        ``wind_lon`` (along the nose) and ``wind_lat`` (to the right), m/s.
+
+    Examples
+    --------
+    >>> np.round(wind_to_body_axes(np.array([[0.0, 2.0]]), np.array([np.pi / 2])), 12)
+    array([[2., 0.]])
+    """
+    wind_ne = np.asarray(wind_ne, dtype=np.float64)
+    cos_psi, sin_psi = np.cos(psi), np.sin(psi)
+    wind_lon = wind_ne[:, 0] * cos_psi + wind_ne[:, 1] * sin_psi
+    wind_lat = -wind_ne[:, 0] * sin_psi + wind_ne[:, 1] * cos_psi
+    return np.column_stack([wind_lon, wind_lat])
