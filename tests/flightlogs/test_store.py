@@ -90,3 +90,19 @@ def test_foreign_hdf5_and_newer_schema_are_refused(tmp_path: Path) -> None:
         h5.attrs["schema_version"] = SCHEMA_VERSION + 1
     with pytest.raises(LogFormatError, match="newer than this software"):
         read_dataset(newer)
+
+
+def test_wind_measurements_round_trip(tmp_path: Path) -> None:
+    from flightlogs.anemometer import read_anemometer_csv
+
+    csv = Path(__file__).resolve().parents[1] / "data" / "anemometer" / "iso_utc_speed_dir.csv"
+    wind = read_anemometer_csv(csv)
+    out = tmp_path / "w.h5"
+    write_dataset(out, [], [wind])
+    back = read_dataset(out).winds[0]
+    for name in ("utc_s", "wind_n", "wind_e", "speed_m_s", "direction_from_rad"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(wind, name))
+    assert (back.path, dict(back.columns), back.unit, back.layout, back.warnings) == (
+        wind.path, dict(wind.columns), wind.unit, wind.layout, wind.warnings
+    )
+    assert read_dataset(out).sha256[str(csv)] == hashlib.sha256(csv.read_bytes()).hexdigest()
