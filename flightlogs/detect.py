@@ -46,7 +46,7 @@ def detect_format(path: Path) -> LogFormat:
         raise LogFormatError(f"{path}: the file is empty.")
     if head.startswith(_ULOG_MAGIC):
         return "ulog"
-    if head.startswith(_DATAFLASH_HEADER + b"\x80"):
+    if head.startswith(_DATAFLASH_HEADER + b"\x80") or _dataflash_after_garbage(head):
         return "dataflash"
     if _looks_like_tlog(head):
         return "tlog"
@@ -54,6 +54,11 @@ def detect_format(path: Path) -> LogFormat:
         f"{path}: not a PX4 ULog, ArduPilot DataFlash or MAVLink telemetry log "
         f"(first bytes {head[:8].hex(' ')})."
     )
+
+
+def _dataflash_after_garbage(head: bytes) -> bool:
+    """A FMT-of-FMT message (A3 95 80 80 59) somewhere in the head: damaged start, readable rest."""
+    return b"\xa3\x95\x80\x80\x59" in head
 
 
 def _looks_like_tlog(head: bytes) -> bool:

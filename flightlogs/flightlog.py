@@ -153,6 +153,6 @@ class FlightLog:
     @property
     def utc_start(self) -> datetime | None:
         """UTC of the first sample, or None without GPS time."""
-        if self.utc_offset_s is None:
+        if self.utc_offset_s is None or not self.signals:
             return None
         return datetime.fromtimestamp(self.time_range_s[0] + self.utc_offset_s, tz=timezone.utc)

@@ -54,3 +54,9 @@ def test_unknown_content_names_the_file(tmp_path: Path, content: bytes, fragment
 def test_a_missing_file_is_a_log_format_error(tmp_path: Path) -> None:
     with pytest.raises(LogFormatError, match="cannot be read"):
         detect_format(tmp_path / "absent.bin")
+
+
+def test_dataflash_with_a_damaged_start_is_still_dataflash(real_data: Path, tmp_path: Path) -> None:
+    damaged = tmp_path / "damaged.bin"
+    damaged.write_bytes(b"\x00\xff" * 37 + (real_data / "dronekit-la-testdata/log171.bin").read_bytes())
+    assert detect_format(damaged) == "dataflash"
