@@ -18,6 +18,7 @@ from types import MappingProxyType
 import numpy as np
 from pymavlink.DFReader import FORMAT_TO_STRUCT
 
+from .atomic import atomic_output
 from .dataflash import message_dtype
 
 __all__ = [
@@ -301,9 +302,8 @@ def write_dataflash(
     """
     path = Path(path)
     payload = encode_dataflash(blocks, parameters=parameters, firmware=firmware, type_ids=type_ids)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(payload)
-    tmp.replace(path)
+    with atomic_output(path) as tmp:
+        tmp.write_bytes(payload)
     return path
 
 
