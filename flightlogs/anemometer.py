@@ -34,10 +34,6 @@ Two layouts are recognised:
 
 from __future__ import annotations
 
-import calendar
-import csv
-import io
-import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -48,6 +44,8 @@ from types import MappingProxyType
 
 import numpy as np
 
+from ._anemometer_text import Table, check_increasing, load_rows, parse_time_columns, parse_times
+from ._responseone import is_responseone, read_readings
 from .errors import DataError, LogFormatError
 
 __all__ = ["WindMeasurement", "read_anemometer_csv", "COLUMN_SYNONYMS", "SPEED_UNITS"]
@@ -79,12 +77,6 @@ _UNIT_ALIASES = {
 _BRACKET_UNIT = re.compile(r"^(.*?)\s*[\(\[\{]\s*([^\)\]\}]*?)\s*[\)\]\}]\s*$")
 _SUFFIX_UNIT = re.compile(r"^(.*?)[\s_\-]+(" + "|".join(
     re.escape(a) for a in sorted(_UNIT_ALIASES, key=len, reverse=True)) + r")$", re.IGNORECASE)
-_ISO = re.compile(r"^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2})(?::(\d{2})(?:[.,](\d+))?)?"
-                  r"\s*(Z|[+-]\d{2}(?::?\d{2})?)?$", re.IGNORECASE)
-_TIME_OF_DAY = re.compile(r"^\d{1,2}:\d{2}")
-_RESPONSEONE = re.compile(r"^\s*([0-9A-Za-z])\s+(\d+(?:\.\d*)?)\s+(\d+(?:\.\d*)?)"
-                          r"((?:\s+[-+]?\d+(?:\.\d*)?)*)\s+([0-9A-Fa-f]{2})\*([0-9A-Fa-f]{2})\s*$")
-_MISSING = {"", "nan", "na", "n/a", "null", "none", "-", "--"}
 _KEYS = ("time", "date", "speed", "direction", "u", "v", "w")
 
 
@@ -230,97 +222,16 @@ def read_anemometer_csv(
         if unknown:
             raise ValueError(f"columns has unknown keys {unknown}; use {list(_KEYS)}")
     default_unit = _speed_unit_name(speed_unit) if speed_unit is not None else None
-    rows, line_numbers = _load_rows(path)
-    if columns is None and _is_responseone(rows):
+    rows, line_numbers = load_rows(path)
+    if columns is None and is_responseone(rows):
         return _read_responseone(path, rows, line_numbers, utc_offset_hours, default_unit)
     header, data, lines = rows[0], rows[1:], line_numbers[1:]
     if not data:
         raise LogFormatError(f"{path}: no data rows below the header (line {line_numbers[0]})")
     used = _resolve_columns(path, header, columns or {})
-    table = _Table(path, header, data, lines)
-    utc_s = _parse_time_columns(table, used, utc_offset_hours)
+    table = Table(path, header, data, lines)
+    utc_s = parse_time_columns(table, used, utc_offset_hours)
     return _wind_from_columns(table, used, utc_s, default_unit)
-
-
-# --------------------------------------------------------------------------- reading text
-
-
-def _load_rows(path: Path) -> tuple[list[list[str]], list[int]]:
-    """Non-blank, non-comment CSV rows with their 1-based line numbers."""
-    raw = path.read_bytes()
-    if not raw.strip():
-        raise LogFormatError(f"{path}: the file is empty")
-    if b"\x00" in raw[:4096]:
-        raise LogFormatError(f"{path}: binary content (NUL bytes), not a CSV file")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        text = raw.decode("cp1252", errors="replace")
-    lines = enumerate(text.splitlines(), 1)
-    number, first = next(((n, line) for n, line in lines
-                          if line.strip() and not line.lstrip().startswith("#")), (1, ""))
-    delimiter = max(",;\t", key=first.count)
-    if _RESPONSEONE.match(first):
-        raise LogFormatError(f"{path}, line {number}: a ResponseONE reading without a timestamp; "
-                             "the sensor has no clock, so log lines as '<time>,<reading>'")
-    if first.count(delimiter) == 0:
-        raise LogFormatError(f"{path}, line {number}: no comma, semicolon or tab; not a CSV file")
-    reader = csv.reader(io.StringIO(text), delimiter=delimiter, skipinitialspace=True)
-    rows: list[list[str]] = []
-    numbers: list[int] = []
-    try:
-        for row in reader:
-            if not row or not "".join(row).strip() or row[0].lstrip().startswith("#"):
-                continue
-            rows.append([cell.strip() for cell in row])
-            numbers.append(reader.line_num)
-    except csv.Error as err:
-        raise LogFormatError(f"{path}, line {reader.line_num}: not valid CSV ({err})") from err
-    return rows, numbers
-
-
-@dataclass(frozen=True, slots=True)
-class _Table:
-    """Header, data rows and their line numbers, with typed column access."""
-
-    path: Path
-    header: list[str]
-    rows: list[list[str]]
-    lines: list[int]
-
-    def cells(self, column: str) -> list[str]:
-        """Text of `column` in every row ('' where a short row ends early)."""
-        index = self.header.index(column)
-        width = len(self.header)
-        out = []
-        for row, line in zip(self.rows, self.lines):
-            if len(row) > width and any(row[width:]):
-                raise LogFormatError(f"{self.path}, line {line}: {len(row)} fields but the "
-                                     f"header has {width}")
-            out.append(row[index] if index < len(row) else "")
-        return out
-
-    def numbers(self, column: str) -> np.ndarray:
-        """Finite float values of `column`; DataError naming the line otherwise."""
-        values = np.empty(len(self.rows))
-        for i, (text, line) in enumerate(zip(self.cells(column), self.lines)):
-            values[i] = _number(text, f"{self.path}, line {line}: column {column!r}")
-        return values
-
-
-def _number(text: str, where: str) -> float:
-    if text.lower() in _MISSING:
-        raise DataError(f"{where} has no value ({text!r})")
-    try:
-        value = float(text)
-    except ValueError:
-        try:
-            value = float(text.replace(",", "."))  # decimal comma
-        except ValueError:
-            raise DataError(f"{where} is not a number ({text!r})") from None
-    if not math.isfinite(value):
-        raise DataError(f"{where} has no finite value ({text!r})")
-    return value
 
 
 # --------------------------------------------------------------------------- columns
@@ -400,107 +311,10 @@ def _speed_unit_name(unit: str) -> str:
     return alias
 
 
-# --------------------------------------------------------------------------- time
-
-
-def _parse_time_columns(table: _Table, used: dict[str, str], utc_offset_hours: float) -> np.ndarray:
-    """UNIX seconds UTC of every row, from the time column (and date column)."""
-    column = used["time"]
-    texts = table.cells(column)
-    label = repr(column)
-    if "date" in used:
-        if texts and _TIME_OF_DAY.match(texts[0]):
-            dates = table.cells(used["date"])
-            texts = [f"{d}T{t}" if d and t else "" for d, t in zip(dates, texts)]
-            label = f"{used['date']!r} + {column!r}"
-        else:
-            del used["date"]  # the time column holds whole timestamps
-    utc_s = _parse_times(table.path, texts, table.lines, label, utc_offset_hours)
-    _check_increasing(table.path, utc_s, texts, table.lines)
-    return utc_s
-
-
-def _parse_times(path: Path, texts: list[str], lines: list[int], label: str,
-                 utc_offset_hours: float) -> np.ndarray:
-    """ISO-8601 or epoch (s or ms) texts to UNIX seconds UTC."""
-    offset_s = utc_offset_hours * 3600.0
-    out = np.empty(len(texts))
-    epoch_scale = _epoch_scale(texts[0]) if texts else None
-    for i, (text, line) in enumerate(zip(texts, lines)):
-        where = f"{path}, line {line}: time column {label}"
-        if text.lower() in _MISSING:
-            raise DataError(f"{where} is empty")
-        value = None
-        if epoch_scale is not None:
-            if _epoch_scale(text) == epoch_scale:
-                value = float(text) * epoch_scale
-        else:
-            value = _iso_to_unix(text, offset_s)
-        if value is None:
-            kind = ("UNIX time in " + ("s" if epoch_scale == 1.0 else "ms")
-                    if epoch_scale is not None else "ISO-8601 (date and time)")
-            if epoch_scale is None and re.fullmatch(r"[-+]?\d+(\.\d*)?", text):
-                kind = "ISO-8601 nor UNIX time (s or ms since 1970, from 1973 on)"
-            hint = "; add a date column" if _TIME_OF_DAY.match(text) else ""
-            raise LogFormatError(f"{where} holds {text!r}, which is not {kind}{hint}")
-        out[i] = value
-    return out
-
-
-def _epoch_scale(text: str) -> float | None:
-    """1.0 for UNIX seconds, 1e-3 for milliseconds, None if `text` is neither."""
-    try:
-        value = float(text)
-    except ValueError:
-        return None
-    if 1e8 <= value < 1e11:  # 1973 .. 5138 in seconds
-        return 1.0
-    if 1e11 <= value < 1e14:  # the same span in milliseconds
-        return 1e-3
-    return None
-
-
-def _iso_to_unix(text: str, naive_offset_s: float) -> float | None:
-    """UNIX seconds of an ISO-8601 date-time; zone-less times are shifted by `naive_offset_s`."""
-    match = _ISO.match(text)
-    if match:
-        year, month, day, hour, minute, second, fraction, zone = match.groups()
-        try:
-            stamp = datetime(int(year), int(month), int(day), int(hour), int(minute),
-                             int(second or 0), tzinfo=timezone.utc)
-        except ValueError:
-            return None
-        seconds = calendar.timegm(stamp.timetuple()) + (float("0." + fraction) if fraction else 0.0)
-        if zone is None:
-            return seconds - naive_offset_s
-        if zone.upper() == "Z":
-            return seconds
-        sign = -1.0 if zone[0] == "-" else 1.0
-        digits = zone[1:].replace(":", "")
-        return seconds - sign * (int(digits[:2]) * 3600 + int(digits[2:] or 0) * 60)
-    try:
-        stamp = datetime.fromisoformat(text)
-    except ValueError:
-        return None
-    if stamp.tzinfo is None:
-        return stamp.replace(tzinfo=timezone.utc).timestamp() - naive_offset_s
-    return stamp.timestamp()
-
-
-def _check_increasing(path: Path, utc_s: np.ndarray, texts: list[str], lines: list[int]) -> None:
-    steps = np.diff(utc_s)
-    bad = np.flatnonzero(steps <= 0)
-    if bad.size:
-        i = int(bad[0]) + 1
-        kind = "repeats" if steps[i - 1] == 0 else "goes backwards from"
-        raise DataError(f"{path}, line {lines[i]}: time {texts[i]!r} {kind} the time on line "
-                        f"{lines[i - 1]} ({texts[i - 1]!r}); timestamps must increase")
-
-
 # --------------------------------------------------------------------------- wind
 
 
-def _wind_from_columns(table: _Table, used: dict[str, str], utc_s: np.ndarray,
+def _wind_from_columns(table: Table, used: dict[str, str], utc_s: np.ndarray,
                        default_unit: str | None) -> WindMeasurement:
     warnings: list[str] = []
     path, kind = table.path, ("speed" if "speed" in used else "u")
@@ -569,53 +383,18 @@ def _checked_polar(path: Path, speed: np.ndarray, direction: np.ndarray, directi
 # --------------------------------------------------------------------------- ResponseONE
 
 
-def _is_responseone(rows: list[list[str]]) -> bool:
-    """True if the first or second row ends with a ResponseONE ASCII polar reading."""
-    return any(len(row) >= 2 and _RESPONSEONE.match(row[-1]) for row in rows[:2])
-
-
-def _checksum(text: str) -> int:
-    value = 0
-    for char in text:
-        value ^= ord(char)
-    return value
-
-
 def _read_responseone(path: Path, rows: list[list[str]], numbers: list[int],
                       utc_offset_hours: float, default_unit: str | None) -> WindMeasurement:
     """Parse ``<time>,<ResponseONE polar line>`` rows (module docstring)."""
-    has_header = not (len(rows[0]) >= 2 and _RESPONSEONE.match(rows[0][-1]))
-    times, speeds, directions, lines = [], [], [], []
-    failed_sum, flagged = [], []
-    for row, line in zip(rows[has_header:], numbers[has_header:]):
-        match = _RESPONSEONE.match(row[-1]) if len(row) >= 2 else None
-        if match is None:
-            raise LogFormatError(f"{path}, line {line}: not a timestamped ResponseONE reading "
-                                 "('<time>,a www.ww ddd.d ... ss*cc')")
-        sensor = row[-1].strip()
-        if _checksum(sensor[: sensor.index("*")]) != int(match.group(6), 16):
-            failed_sum.append(line)
-        elif int(match.group(5), 16) != 0:
-            flagged.append(line)
-        else:
-            times.append(row[0])
-            speeds.append(float(match.group(2)))
-            directions.append(float(match.group(3)))
-            lines.append(line)
-    warnings = [f"dropped {len(bad)} ResponseONE lines {why} (first: line {bad[0]})"
-                for bad, why in ((failed_sum, "failing the checksum"),
-                                 (flagged, "with a non-zero status code")) if bad]
-    if not times:
-        raise DataError(f"{path}: no valid ResponseONE reading ({len(failed_sum)} failed the "
-                        f"checksum, {len(flagged)} had a non-zero status)")
-    utc_s = _parse_times(path, times, lines, "1", utc_offset_hours)
-    _check_increasing(path, utc_s, times, lines)
-    speed, direction = _checked_polar(path, np.array(speeds), np.array(directions), "deg",
-                                      lines, {})
+    found = read_readings(path, rows, numbers)
+    utc_s = parse_times(path, found.times, found.lines, "1", utc_offset_hours)
+    check_increasing(path, utc_s, found.times, found.lines)
+    speed, direction = _checked_polar(path, found.speeds, found.directions_deg, "deg", found.lines, {})
+    warnings = list(found.warnings)
     if default_unit is None:
         warnings.append("ResponseONE readings carry no unit; m/s assumed (pass speed_unit=)")
     unit = default_unit or "m/s"
-    columns = {"time": rows[0][0] if has_header else "field 1",
+    columns = {"time": found.time_column,
                "speed": "ResponseONE field 2 (wind speed)",
                "direction": "ResponseONE field 3 (wind direction, from)"}
     return _from_polar(path, utc_s, speed * SPEED_UNITS[unit], direction, None, columns=columns,

@@ -19,8 +19,9 @@ canonical                     DataFlash source
 ============================  ================================================
 
 Times are ``TimeUS`` / 1e6 or, in logs before Copter 3.4, ``TimeMS`` / 1e3.
-The System ID maneuvers (SIDS messages) are not signals; read them with
-:func:`system_id_runs` on :func:`~flightlogs.dataflash.read_messages` output.
+The System ID maneuvers (SIDS messages) are not signals; they are in
+:attr:`FlightLog.system_id_runs <flightlogs.flightlog.FlightLog>`, built by
+:func:`system_id_runs`.
 """
 
 from __future__ import annotations
@@ -28,14 +29,13 @@ from __future__ import annotations
 import calendar
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ._series import make_signal
 from .dataflash import DataFlashMessages, MessageTable, read_messages
-from .flightlog import FlightLog, Signal
+from .flightlog import FlightLog, Signal, SystemIdRun
 
 __all__ = ["read_dataflash", "flightlog_from_messages", "SystemIdRun", "system_id_runs", "gps_leap_seconds"]
 
@@ -70,7 +70,8 @@ def read_dataflash(path: str | Path, *, progress: Callable[[int, int], None] | N
     FlightLog
         Signals in SI units and radians (mixer inputs and motors as logged,
         with their unit), parameters (first value of each PARM), the vehicle
-        (firmware and frame), the UTC offset from GPS time, and warnings.
+        (firmware and frame), the UTC offset from GPS time, the System ID
+        runs (:func:`system_id_runs`), and warnings.
 
     Raises
     ------
@@ -117,9 +118,10 @@ def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
     n_motors = _map_motors(messages, parameters, add)
     _map_battery_height(messages, add)
     _map_estimator(messages, parameters, add, warnings)
-    _map_excitation(messages, add)
+    runs = system_id_runs(messages)
+    _map_excitation(messages, runs, add)
     return FlightLog(messages.path, "dataflash", "ardupilot", signals, _vehicle(messages, parameters, n_motors),
-                     parameters, _utc_offset(messages), tuple(warnings))
+                     parameters, _utc_offset(messages), tuple(warnings), runs)
 
 
 _Add = Callable[..., None]
@@ -254,52 +256,18 @@ def _map_estimator(messages: DataFlashMessages, parameters: dict[str, float], ad
         return
 
 
-def _map_excitation(messages: DataFlashMessages, add: _Add) -> None:
+def _map_excitation(messages: DataFlashMessages, runs: tuple[SystemIdRun, ...], add: _Add) -> None:
     sidd = messages.get("SIDD")
     if sidd is None or "Targ" not in sidd:
         return
-    axes = sorted({run.axis for run in system_id_runs(messages)})
+    axes = sorted({run.axis for run in runs})
     named = ", ".join(f"{a} ({_SYSID_AXES.get(a, 'other')})" for a in axes)
     unit = f"as logged (SID_AXIS {named})" if axes else "as logged"
     add("excitation", sidd, "Targ", unit, "SIDD.Targ")
 
 
-@dataclass(frozen=True, slots=True)
-class SystemIdRun:
-    """One System ID maneuver, from a SIDS message and the SIDD that follow it.
-
-    Parameters
-    ----------
-    start_s, end_s : float
-        Log time of the SIDS message and of the last SIDD before the next
-        SIDS (NaN without SIDD), s.
-    axis : int
-        ``SID_AXIS`` (1-3 input angle, 7-9 rate, 10-13 mixer...).
-    axis_name : str
-        Its meaning, e.g. ``"rate roll"``.
-    magnitude : float
-        ``SID_MAGNITUDE``, in the unit of the axis.
-    f_start_hz, f_stop_hz : float
-        Chirp start and stop frequency, Hz.
-    fade_in_s, const_s, record_s, fade_out_s : float
-        Fade-in, constant-frequency, total record and fade-out times, s.
-    """
-
-    start_s: float
-    end_s: float
-    axis: int
-    axis_name: str
-    magnitude: float
-    f_start_hz: float
-    f_stop_hz: float
-    fade_in_s: float
-    const_s: float
-    record_s: float
-    fade_out_s: float
-
-
 def system_id_runs(messages: DataFlashMessages) -> tuple[SystemIdRun, ...]:
-    """The System ID maneuvers of a log, for segmentation.
+    """The System ID maneuvers of a log, for segmentation (:attr:`FlightLog.system_id_runs`).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Containers for what a reader produces: time series and the flight log."""
+"""Containers for what a reader produces: time series, logged maneuvers and the flight log."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import numpy as np
 
 from .signals import LOGGED_SIGNALS, is_canonical
 
-__all__ = ["Signal", "FlightLog", "Autopilot", "LogFormat"]
+__all__ = ["Signal", "SystemIdRun", "FlightLog", "Autopilot", "LogFormat"]
 
 Autopilot = Literal["px4", "ardupilot"]
 LogFormat = Literal["ulog", "dataflash", "tlog"]
@@ -78,6 +78,50 @@ class Signal:
 
 
 @dataclass(frozen=True, slots=True)
+class SystemIdRun:
+    """One ArduPilot System ID maneuver, from a SIDS message and the SIDD that follow it.
+
+    Parameters
+    ----------
+    start_s : float
+        Log time of the SIDS message, written on entering the mode, s.
+    end_s : float
+        Log time of the last SIDD sample before the next SIDS, s; the run
+        ends there at the latest. NaN when unknown (no SIDD logged).
+    axis : int
+        ``SID_AXIS`` (1-3 input angle, 4-6 recovery, 7-9 rate, 10-13 mixer...).
+    axis_name : str
+        Its meaning, e.g. ``"rate roll"``.
+    magnitude : float
+        ``SID_MAGNITUDE`` (``Mag``), in the unit of the axis: deg, deg/s, or
+        0-1 for mixer axes.
+    f_start_hz, f_stop_hz : float
+        Chirp start and stop frequency (``FSt``, ``FSp``), Hz.
+    fade_in_s, const_s, record_s, fade_out_s : float
+        Fade-in (``TFin``), dwell at the start frequency (``TC``), total
+        record (``TR``) and fade-out (``TFout``) times, s.
+
+    Notes
+    -----
+    Per ArduCopter's ``mode_systemid.cpp`` the chirp starts
+    ``SYSTEM_ID_DELAY`` (1 s) after the SIDS message, and the fade-in, the
+    dwell and the fade-out all lie inside ``TR`` (``AP_Math/chirp.cpp``).
+    """
+
+    start_s: float
+    end_s: float
+    axis: int
+    axis_name: str
+    magnitude: float
+    f_start_hz: float
+    f_stop_hz: float
+    fade_in_s: float
+    const_s: float
+    record_s: float
+    fade_out_s: float
+
+
+@dataclass(frozen=True, slots=True)
 class FlightLog:
     """Canonical signals read from one log file, with its metadata.
 
@@ -100,6 +144,9 @@ class FlightLog:
         holds no GPS time.
     warnings : tuple of str
         Problems that were recovered from (skipped bytes, dropped samples).
+    system_id_runs : tuple of SystemIdRun
+        ArduPilot System ID maneuvers logged (SIDS messages), in time order;
+        empty when the log holds none (and for other autopilots).
     """
 
     path: Path
@@ -110,6 +157,7 @@ class FlightLog:
     parameters: Mapping[str, float] = field(default_factory=dict)
     utc_offset_s: float | None = None
     warnings: tuple[str, ...] = ()
+    system_id_runs: tuple[SystemIdRun, ...] = ()
 
     def __post_init__(self) -> None:
         for name, signal in self.signals.items():
@@ -118,6 +166,7 @@ class FlightLog:
         object.__setattr__(self, "signals", MappingProxyType(dict(self.signals)))
         object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
         object.__setattr__(self, "warnings", tuple(self.warnings))
+        object.__setattr__(self, "system_id_runs", tuple(self.system_id_runs))
 
     def __getitem__(self, name: str) -> Signal:
         from .errors import MissingSignalError

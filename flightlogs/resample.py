@@ -21,9 +21,19 @@ from dataclasses import dataclass
 from typing import Literal, Union
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PchipInterpolator
-from scipy.signal import fftconvolve, firwin, kaiserord
 
+from ._resampling import (
+    TIME_TOL_S,
+    check_time_base,
+    check_times,
+    complement,
+    interpolate,
+    intersect,
+    lowpass,
+    nominal_interval,
+    piece_bounds,
+    snap,
+)
 from .errors import DataError
 from .flightlog import Signal
 
@@ -45,10 +55,6 @@ Method = Literal["spline", "pchip", "linear"]
 #: A signal as accepted here: a :class:`Signal`, or a ``(time_s, values)`` pair of arrays.
 SeriesLike = Union[Signal, tuple[np.ndarray, np.ndarray]]
 
-_TIME_TOL_S = 1e-7  # below the 1 µs resolution of log timestamps
-_STOPBAND_DB = 60.0  # anti-alias attenuation from 0.6 × the target rate
-_PASS_EDGE = 0.4  # anti-alias pass-band edge, × target rate
-_STOP_EDGE = 0.6  # anti-alias stop-band edge, × target rate
 _DOWNSAMPLE_MARGIN = 1.02  # filter only when the source is > 2 % faster than the target
 
 
@@ -123,7 +129,7 @@ class ContiguousSpans:
         first, last = self.spans[0][0], self.spans[-1][1]
         out = []
         for gap in self.gaps:
-            inside = gap.start_s >= first - _TIME_TOL_S and gap.end_s <= last + _TIME_TOL_S
+            inside = gap.start_s >= first - TIME_TOL_S and gap.end_s <= last + TIME_TOL_S
             out.append(f"{gap.describe()}; record {'split' if inside else 'trimmed'}")
         return tuple(out)
 
@@ -158,8 +164,8 @@ def find_gaps(time_s: np.ndarray, *, max_gap_samples: float = 5, name: str = "")
     >>> find_gaps(t, name="q")[0].describe()
     'q: 0.84 s gap at 12.30 s'
     """
-    time_s = _check_times(time_s, name or "time_s")
-    bounds = _piece_bounds(time_s, _nominal_interval(time_s), max_gap_samples)
+    time_s = check_times(time_s, name or "time_s")
+    bounds = piece_bounds(time_s, nominal_interval(time_s), max_gap_samples)
     return tuple(
         Gap(name, float(time_s[prev_end - 1]), float(time_s[start]))
         for (_, prev_end), (start, _) in zip(bounds[:-1], bounds[1:])
@@ -228,7 +234,7 @@ def uniform_time_base(
             f"{latest[0]} starts at {latest[1][0]:.2f} s" if start_s is None and end_s is None
             else f"end_s={end} must be after start_s={start}"
         )
-    k = np.arange(np.ceil((start - _TIME_TOL_S) * rate_hz), np.floor((end + _TIME_TOL_S) * rate_hz) + 1)
+    k = np.arange(np.ceil((start - TIME_TOL_S) * rate_hz), np.floor((end + TIME_TOL_S) * rate_hz) + 1)
     if k.size < 2:
         raise DataError(f"the span {start:.3f}-{end:.3f} s holds fewer than 2 samples at {rate_hz} Hz")
     return k / rate_hz
@@ -302,25 +308,25 @@ def resample_signal(
     True
     """
     name, t, v = _as_series(signal)
-    tb, dt_target = _check_time_base(time_base)
+    tb, dt_target = check_time_base(time_base)
     if outside not in ("nan", "raise"):
         raise DataError(f"{outside=} must be 'nan' or 'raise'")
     if method not in ("spline", "pchip", "linear"):
         raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
-    dt_src = _nominal_interval(t)
+    dt_src = nominal_interval(t)
     out = np.full(tb.shape, np.nan)
     filter_needed = anti_alias and dt_target > _DOWNSAMPLE_MARGIN * dt_src
-    for i0, i1 in _piece_bounds(t, dt_src, max_gap_samples):
+    for i0, i1 in piece_bounds(t, dt_src, max_gap_samples):
         pt, pv = t[i0:i1], v[i0:i1]
-        inside = (tb >= pt[0] - _TIME_TOL_S) & (tb <= pt[-1] + _TIME_TOL_S)
+        inside = (tb >= pt[0] - TIME_TOL_S) & (tb <= pt[-1] + TIME_TOL_S)
         if not inside.any():
             continue
         if pt.size == 1:
             out[inside] = pv[0]
             continue
         if filter_needed:
-            pt, pv = _lowpass(pt, pv, dt_src, 1.0 / dt_target)
-        out[inside] = _interpolate(pt, pv, np.clip(tb[inside], pt[0], pt[-1]), method)
+            pt, pv = lowpass(pt, pv, dt_src, 1.0 / dt_target)
+        out[inside] = interpolate(pt, pv, np.clip(tb[inside], pt[0], pt[-1]), method)
     if outside == "raise" and np.isnan(out).any():
         first = float(tb[np.isnan(out)][0])
         raise DataError(
@@ -421,20 +427,20 @@ def contiguous_spans(
     if isinstance(span, tuple):
         lo, hi = float(span[0]), float(span[1])
     else:
-        grid, _ = _check_time_base(span)
+        grid, _ = check_time_base(span)
         lo, hi = float(grid[0]), float(grid[-1])
     if not hi > lo:
         raise DataError(f"the span {lo}-{hi} s is empty")
     covered = [(lo, hi)]
     gaps: list[Gap] = []
     for name, t, _ in _series_list(signals):
-        pieces = [(float(t[a]), float(t[b - 1])) for a, b in _piece_bounds(t, _nominal_interval(t), max_gap_samples)]
-        holes = _complement(pieces, lo, hi)
+        pieces = [(float(t[a]), float(t[b - 1])) for a, b in piece_bounds(t, nominal_interval(t), max_gap_samples)]
+        holes = complement(pieces, lo, hi)
         gaps.extend(Gap(name, a, b) for a, b in holes)
-        covered = _intersect(covered, pieces)
+        covered = intersect(covered, pieces)
     if grid is not None:
-        covered = _snap(covered, grid)
-    kept = tuple((a, b) for a, b in covered if b - a >= min_duration_s - _TIME_TOL_S)
+        covered = snap(covered, grid)
+    kept = tuple((a, b) for a, b in covered if b - a >= min_duration_s - TIME_TOL_S)
     return ContiguousSpans(kept, tuple(gaps))
 
 
@@ -460,124 +466,10 @@ def _as_series(signal: SeriesLike, default_name: str = "signal") -> tuple[str, n
         except (TypeError, ValueError) as err:
             raise DataError(f"{default_name}: expected a Signal or a (time_s, values) pair") from err
         name = default_name
-    t = _check_times(t, name)
+    t = check_times(t, name)
     v = np.asarray(v, dtype=np.float64)
     if v.shape != t.shape:
         raise DataError(f"{name}: {t.size} times but values of shape {v.shape}")
     if not np.isfinite(v).all():
         raise DataError(f"{name}: {int((~np.isfinite(v)).sum())} non-finite values; drop them before resampling")
     return name, t, v
-
-
-def _check_times(time_s: np.ndarray, name: str) -> np.ndarray:
-    """Return `time_s` as float64 after checking it is 1-D, finite and strictly increasing."""
-    t = np.asarray(time_s, dtype=np.float64)
-    if t.ndim != 1 or t.size == 0:
-        raise DataError(f"{name}: times must be a non-empty 1-D array, got shape {t.shape}")
-    if not np.isfinite(t).all():
-        raise DataError(f"{name}: times hold non-finite values")
-    steps = np.diff(t)
-    if (steps <= 0).any():
-        at = int(np.argmax(steps <= 0))
-        raise DataError(f"{name}: time does not increase at sample {at + 1} ({t[at]:.6f} → {t[at + 1]:.6f} s)")
-    return t
-
-
-def _check_time_base(time_base: np.ndarray) -> tuple[np.ndarray, float]:
-    """Validate a uniform time base; return it with its sample interval, s."""
-    tb = _check_times(time_base, "time_base")
-    if tb.size < 2:
-        raise DataError("time_base must hold at least 2 samples")
-    steps = np.diff(tb)
-    dt = float(np.median(steps))
-    if np.max(np.abs(steps - dt)) > 1e-3 * dt + _TIME_TOL_S:
-        raise DataError(f"time_base is not uniform (steps from {steps.min():.6g} to {steps.max():.6g} s)")
-    return tb, float((tb[-1] - tb[0]) / (tb.size - 1))
-
-
-def _nominal_interval(t: np.ndarray) -> float:
-    """Median sample interval, s (inf for a single sample)."""
-    return float(np.median(np.diff(t))) if t.size > 1 else np.inf
-
-
-def _piece_bounds(t: np.ndarray, dt: float, max_gap_samples: float) -> list[tuple[int, int]]:
-    """Index ranges [i0, i1) of the pieces between gaps longer than `max_gap_samples` × `dt`."""
-    if not (np.isfinite(max_gap_samples) and max_gap_samples >= 1):
-        raise DataError(f"{max_gap_samples=} must be a finite number ≥ 1")
-    cuts = np.flatnonzero(np.diff(t) > max_gap_samples * dt + _TIME_TOL_S) + 1
-    edges = np.r_[0, cuts, t.size]
-    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
-
-
-def _lowpass(t: np.ndarray, v: np.ndarray, dt_src: float, target_rate_hz: float) -> tuple[np.ndarray, np.ndarray]:
-    """Anti-alias one contiguous piece: uniform grid at the source rate, then a zero-phase FIR."""
-    n_fine = max(int(round((t[-1] - t[0]) / dt_src)) + 1, 2)
-    grid = np.linspace(t[0], t[-1], n_fine)
-    if grid.size == t.size and np.allclose(grid, t, rtol=0.0, atol=_TIME_TOL_S):
-        grid, values = t, v
-    else:
-        values = _interpolate(t, v, grid, "spline")
-    fs = (n_fine - 1) / (grid[-1] - grid[0])
-    taps = _kaiser_lowpass(fs, target_rate_hz)
-    half = taps.size // 2
-    padded = np.pad(values, half, mode="reflect", reflect_type="odd")
-    return grid, fftconvolve(padded, taps, mode="valid")
-
-
-def _kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
-    """Odd-length, unit-DC-gain Kaiser FIR: pass to 0.4, stop from 0.6 × the target rate."""
-    nyquist = fs_hz / 2.0
-    width = (_STOP_EDGE - _PASS_EDGE) * target_rate_hz / nyquist
-    numtaps, beta = kaiserord(_STOPBAND_DB, min(width, 1.0))
-    numtaps |= 1
-    cutoff = 0.5 * (_PASS_EDGE + _STOP_EDGE) * target_rate_hz
-    return firwin(numtaps, min(cutoff, 0.999 * nyquist), window=("kaiser", beta), fs=fs_hz)
-
-
-def _interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: Method) -> np.ndarray:
-    """Evaluate the chosen interpolant through (t, v) at times `at` inside [t[0], t[-1]]."""
-    if method == "linear" or t.size < 3:
-        return np.interp(at, t, v)
-    if method == "spline":
-        return CubicSpline(t, v, bc_type="not-a-knot")(at)
-    if method == "pchip":
-        with np.errstate(over="ignore"):  # SciPy divides by slopes that underflow for subnormal data
-            return PchipInterpolator(t, v)(at)
-    raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
-
-
-def _complement(pieces: list[tuple[float, float]], lo: float, hi: float) -> list[tuple[float, float]]:
-    """Parts of [lo, hi] not covered by the ordered, disjoint `pieces`."""
-    holes, cursor = [], lo
-    for a, b in pieces:
-        if a > cursor + _TIME_TOL_S and cursor < hi:
-            holes.append((cursor, min(a, hi)))
-        cursor = max(cursor, b)
-    if cursor < hi - _TIME_TOL_S:
-        holes.append((cursor, hi))
-    return holes
-
-
-def _intersect(left: list[tuple[float, float]], right: list[tuple[float, float]]) -> list[tuple[float, float]]:
-    """Intersection of two ordered lists of disjoint closed intervals."""
-    out, i, j = [], 0, 0
-    while i < len(left) and j < len(right):
-        a, b = max(left[i][0], right[j][0]), min(left[i][1], right[j][1])
-        if b >= a - _TIME_TOL_S:
-            out.append((a, max(a, b)))
-        if left[i][1] < right[j][1]:
-            i += 1
-        else:
-            j += 1
-    return out
-
-
-def _snap(intervals: list[tuple[float, float]], grid: np.ndarray) -> list[tuple[float, float]]:
-    """Shrink each interval to the grid samples inside it; drop those holding none."""
-    out = []
-    for a, b in intervals:
-        i0 = int(np.searchsorted(grid, a - _TIME_TOL_S, side="left"))
-        i1 = int(np.searchsorted(grid, b + _TIME_TOL_S, side="right")) - 1
-        if i1 >= i0:
-            out.append((float(grid[i0]), float(grid[i1])))
-    return out

@@ -1,9 +1,11 @@
 """Find the maneuvers in a flight: sweeps, doublets, 3211s, multisines and hover.
 
 Spectra must be taken on the right pieces of a flight. The pieces come from
-three places, in order of trust: ``"sids"``, the SIDS rows ArduPilot's System
-ID mode logs when it starts a sweep (:func:`segments_from_sid`); ``"user"``, a
-TOML or CSV file the engineer writes (:func:`read_segments_file`);
+three places, in order of trust: ``"sids"``, the runs ArduPilot's System ID
+mode logs when it starts a sweep (SIDS messages, in
+:attr:`FlightLog.system_id_runs <flightlogs.flightlog.FlightLog>`;
+:func:`segments_from_sid`); ``"user"``, a TOML or CSV file the engineer
+writes (:func:`read_segments_file`);
 ``"detected"``, found from the mixer inputs alone (:func:`detect_segments`).
 Axes are the mixer inputs: ``lat`` (delta_lat, roll), ``lon`` (delta_lon,
 pitch), ``yaw`` (delta_yaw) and ``thr`` (delta_thr).
@@ -15,20 +17,19 @@ import csv
 import re
 import tomllib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any, Literal, get_args
 
 import numpy as np
-from scipy.ndimage import binary_dilation, median_filter, uniform_filter1d
-from scipy.signal import fftconvolve
-from scipy.stats import spearmanr
 
+from ._maneuvers import find_maneuvers, hover_spans
 from .errors import DataError
+from .flightlog import SystemIdRun
 
 __all__ = [
     "Axis", "Kind", "SegmentSource", "AXES", "SID_AXES",
-    "Segment", "SidsRow", "detect_segments", "segments_from_sid", "read_segments_file",
+    "Segment", "detect_segments", "segments_from_sid", "read_segments_file",
 ]
 
 Axis = Literal["lat", "lon", "yaw", "thr"]
@@ -56,13 +57,6 @@ SID_AXES: dict[int, tuple[str, str]] = {
 _SID_FIELDS = {"Ax": "axis", "Mag": "magnitude", "FSt": "f_start_hz", "FSp": "f_stop_hz",
                "TFin": "fade_in_s", "TC": "const_s", "TR": "record_s", "TFout": "fade_out_s"}
 _USER_KEYS = ("start_s", "end_s", "axis", "kind", "f_min_hz", "f_max_hz")
-_SHORT_S = 0.2  # window of the short moving mean and RMS, s
-_GUARD_S, _BASELINE_S = 1.0, 10.0  # edge baseline: fitted from 11 s to 1 s before the burst
-_QUADRATIC_S = 3.0  # edge baseline: straight below this much quiet trace, quadratic above
-_LOOK_IN_S = 3.0  # edge baseline: trusted this far into a burst, s
-_CALM = 3.0  # edges: calm within 3 noise σ ...
-_RELATIVE_FLOOR = 0.015  # ... or within 1.5 % of the burst's peak, however clean the trace
-_EDGE_PASSES = 6  # edges: searched again from the last edge found until they settle
 
 
 @dataclass(frozen=True, slots=True)
@@ -120,51 +114,6 @@ class Segment:
     def duration_s(self) -> float:
         """Length of the segment, s."""
         return self.end_s - self.start_s
-
-
-@dataclass(frozen=True, slots=True)
-class SidsRow:
-    """One ArduPilot SIDS message: the settings of a System ID run.
-
-    Parameters
-    ----------
-    time_s : float
-        Log time the mode was entered, s (``TimeUS`` × 1e-6).
-    axis : int
-        ``SID_AXIS`` (``Ax``), see :data:`SID_AXES`.
-    magnitude : float
-        Sweep magnitude (``Mag``): deg, deg/s, or 0-1 for mixer axes.
-    f_start_hz, f_stop_hz : float
-        Start and stop frequency (``FSt``, ``FSp``), Hz.
-    fade_in_s, const_s, record_s, fade_out_s : float
-        Fade-in (``TFin``), dwell at the start frequency (``TC``), sweep
-        length (``TR``) and fade-out (``TFout``), s.
-    last_sidd_s : float or None, optional
-        Time of the run's last SIDD sample, s; the run ends there at the
-        latest. None (or NaN) when unknown.
-    """
-
-    time_s: float
-    axis: int
-    magnitude: float
-    f_start_hz: float
-    f_stop_hz: float
-    fade_in_s: float
-    const_s: float
-    record_s: float
-    fade_out_s: float
-    last_sidd_s: float | None = None
-
-    def __post_init__(self) -> None:
-        if self.last_sidd_s is not None and not np.isfinite(self.last_sidd_s):
-            object.__setattr__(self, "last_sidd_s", None)
-        for item in fields(self):
-            value = getattr(self, item.name)
-            if value is not None and not np.isfinite(value):
-                raise DataError(f"SIDS row at {self.time_s}: {item.name}={value} is not finite")
-        if int(self.axis) != self.axis:
-            raise DataError(f"SIDS row at {self.time_s:.2f} s: axis={self.axis} is not an integer")
-        object.__setattr__(self, "axis", int(self.axis))
 
 
 def detect_segments(
@@ -233,50 +182,39 @@ def detect_segments(
     """
     t, dt = _uniform(time_s)
     traces = _check_inputs(inputs, t.size)
-    acts = {axis: _activity(x, dt, threshold, trend_window_s) for axis, x in traces.items()}
-    bursts = [b for axis, act in acts.items() for b in _bursts(axis, act, dt, threshold, merge_gap_s, min_active_s)]
-    segments, busy = [], []
-    margin = int(round(_GUARD_S / dt))
-    for owner, reactions in _assign(bursts):
-        axis, i0, i1, _ = owner
-        others = [b for b in bursts if b is not owner and b not in reactions]
-        before = max((b[2] + margin for b in others if b[2] < i0), default=0)
-        after = min((b[1] - margin for b in others if b[1] > i1), default=t.size - 1)
-        lo, hi = _edges(acts[axis], i0, i1, dt, (min(before, i0), max(after, i1)), threshold)
-        busy += [(lo, hi)] + [(b[1], b[2]) for b in reactions]
-        found = _classify(acts[axis], t, lo, hi, threshold)
-        if found is not None:
-            segments.append(Segment(axis, found[0], t[lo], t[hi], "detected", found[1], found[2]))
-    segments.extend(_hover(t, busy, min_hover_s, hover_margin_s))
+    maneuvers, busy = find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s)
+    segments = [Segment(axis, kind, t[lo], t[hi], "detected", f_min, f_max)
+                for axis, kind, lo, hi, f_min, f_max in maneuvers]
+    segments += [Segment(None, "hover", a, b, "detected") for a, b in hover_spans(t, busy, min_hover_s, hover_margin_s)]
     return tuple(sorted(segments, key=lambda s: s.start_s))
 
 
 def segments_from_sid(
-    rows: Sequence[SidsRow] | Mapping[str, Any],
+    runs: Sequence[SystemIdRun] | Mapping[str, Any],
     *,
     sidd_time_s: np.ndarray | None = None,
     extent: Literal["excitation", "mode"] = "excitation",
     delay_s: float = 1.0,
 ) -> tuple[Segment, ...]:
-    """Turn ArduPilot SIDS rows into sweep segments.
+    """Turn ArduPilot System ID runs into sweep segments.
 
     Parameters
     ----------
-    rows : sequence of SidsRow, or Mapping of SIDS field name to array
-        The SIDS messages; a mapping holds ``TimeUS`` (µs) or ``time_s`` (s)
-        and ``Ax, Mag, FSt, FSp, TFin, TC, TR, TFout``. Objects with the
-        attributes of :class:`SidsRow` (``start_s`` for `time_s` and
-        ``end_s`` for `last_sidd_s` also do, as in
-        ``flightlogs.ardupilot.SystemIdRun``) are accepted too.
+    runs : sequence of SystemIdRun, or Mapping of SIDS field name to array
+        The runs, as in :attr:`FlightLog.system_id_runs
+        <flightlogs.flightlog.FlightLog>` (a run ends at its `end_s`, the
+        last SIDD sample, at the latest; NaN when unknown); or the SIDS
+        messages as columns, holding ``TimeUS`` (µs) or ``time_s`` (s) and
+        ``Ax, Mag, FSt, FSp, TFin, TC, TR, TFout``, with no end known.
     sidd_time_s : ndarray, shape (n_samples,), optional
         Times of the SIDD samples, s. A run ends at its last SIDD sample at
         the latest (the mode was left early, or stopped on a lean-angle
         limit); a run without any SIDD sample is dropped.
     extent : {"excitation", "mode"}, optional
-        ``"excitation"`` (default): from ``time_s + delay_s`` to
-        ``time_s + delay_s + TR``, where the chirp is non-zero; ``"mode"``:
-        from ``time_s`` to ``time_s + delay_s + TFin + TC + TR + TFout``, when
-        the mode reports "SystemID Finished".
+        ``"excitation"`` (default): from ``start_s + delay_s`` to
+        ``start_s + delay_s + TR``, where the chirp is non-zero; ``"mode"``:
+        from ``start_s`` to ``start_s + delay_s + TFin + TC + TR + TFout``,
+        when the mode reports "SystemID Finished".
     delay_s : float, optional
         Wait between entering the mode and starting the chirp, s
         (``SYSTEM_ID_DELAY``, 1 s in ArduCopter). Default 1.
@@ -290,7 +228,8 @@ def segments_from_sid(
     Raises
     ------
     DataError
-        If a field is missing or a row names an unknown ``SID_AXIS``.
+        If a field is missing or not finite, or a run names an unknown
+        ``SID_AXIS``.
 
     Notes
     -----
@@ -301,33 +240,33 @@ def segments_from_sid(
 
     Examples
     --------
-    >>> row = SidsRow(100.0, 11, 0.1, 0.1, 10.0, 2.0, 20.0, 34.0, 1.0)
-    >>> seg, = segments_from_sid([row])
+    >>> run = SystemIdRun(100.0, float("nan"), 11, "mixer pitch", 0.1, 0.1, 10.0, 2.0, 20.0, 34.0, 1.0)
+    >>> seg, = segments_from_sid([run])
     >>> seg.axis, seg.start_s, seg.end_s, seg.f_min_hz
     ('lon', 101.0, 135.0, 0.1)
     """
     if extent not in ("excitation", "mode"):
         raise DataError(f"{extent=} must be 'excitation' or 'mode'")
-    table = sorted(_sids_rows(rows), key=lambda r: r.time_s)
+    table = sorted(_sids_runs(runs), key=lambda r: r.start_s)
     sidd = None if sidd_time_s is None else np.sort(np.asarray(sidd_time_s, dtype=np.float64))
     out = []
-    for k, row in enumerate(table):
-        if row.axis not in SID_AXES:
-            raise DataError(f"SIDS row at {row.time_s:.2f} s: SID_AXIS={row.axis} is not a known axis (1-19)")
-        axis, name = SID_AXES[row.axis]
-        start, end = row.time_s + delay_s, row.time_s + delay_s + row.record_s
+    for k, run in enumerate(table):
+        if run.axis not in SID_AXES:
+            raise DataError(f"SIDS row at {run.start_s:.2f} s: SID_AXIS={run.axis} is not a known axis (1-19)")
+        axis, name = SID_AXES[run.axis]
+        start, end = run.start_s + delay_s, run.start_s + delay_s + run.record_s
         if extent == "mode":
-            start, end = row.time_s, end + row.fade_in_s + row.const_s + row.fade_out_s
-        if row.last_sidd_s is not None:
-            end = min(end, row.last_sidd_s)
+            start, end = run.start_s, end + run.fade_in_s + run.const_s + run.fade_out_s
+        if np.isfinite(run.end_s):
+            end = min(end, run.end_s)
         if sidd is not None:
-            next_start = table[k + 1].time_s if k + 1 < len(table) else np.inf
-            run = sidd[(sidd >= row.time_s) & (sidd < next_start)]
-            end = min(end, float(run[-1])) if run.size else -np.inf
+            next_start = table[k + 1].start_s if k + 1 < len(table) else np.inf
+            inside = sidd[(sidd >= run.start_s) & (sidd < next_start)]
+            end = min(end, float(inside[-1])) if inside.size else -np.inf
         if end <= start:
             continue
-        lo, hi = sorted((row.f_start_hz, row.f_stop_hz))
-        detail = f"SID_AXIS={row.axis} ({name}), magnitude {row.magnitude:g}"
+        lo, hi = sorted((run.f_start_hz, run.f_stop_hz))
+        detail = f"SID_AXIS={run.axis} ({name}), magnitude {run.magnitude:g}"
         out.append(Segment(axis, "sweep", start, end, "sids", lo, hi, detail))  # type: ignore[arg-type]
     return tuple(out)
 
@@ -385,24 +324,7 @@ def read_segments_file(path: str | Path) -> tuple[Segment, ...]:
     return tuple(sorted(segments, key=lambda s: s.start_s))
 
 
-# ------------------------------------------------------------------ detection
-
-
-@dataclass(frozen=True, slots=True)
-class _Activity:
-    """One axis: raw and detrended trace (n_samples,), normalised envelopes, noise σ of both."""
-
-    raw: np.ndarray
-    detrended: np.ndarray
-    mean_z: np.ndarray  # |0.2 s moving mean| / sigma_mean
-    rms_z: np.ndarray  # 0.2 s moving RMS / sigma
-    sigma: float
-    sigma_mean: float
-
-    def flipped(self) -> _Activity:
-        """The same axis with time reversed (to find an end as a start)."""
-        return _Activity(self.raw[::-1], self.detrended[::-1], self.mean_z[::-1], self.rms_z[::-1],
-                         self.sigma, self.sigma_mean)
+# ------------------------------------------------------------------ checks of detection inputs
 
 
 def _uniform(time_s: np.ndarray) -> tuple[np.ndarray, float]:
@@ -432,250 +354,42 @@ def _check_inputs(inputs: Mapping[str, np.ndarray], n: int) -> dict[str, np.ndar
     return traces
 
 
-def _activity(x: np.ndarray, dt: float, threshold: float, trend_window_s: float) -> _Activity:
-    """Detrend one axis and normalise its short envelopes by noise floors of quiet stretches."""
-    xd = x - _trend(x, max(3, int(round(trend_window_s / dt)) | 1))
-    width = max(1, int(round(_SHORT_S / dt)))
-    mean = np.abs(uniform_filter1d(xd, width, mode="nearest"))
-    rms = np.sqrt(uniform_filter1d(xd * xd, width, mode="nearest"))
-    tiny = 1e-12 * max(1.0, float(np.max(np.abs(xd))))
-    quiet = np.ones(xd.size, dtype=bool)
-    for quantile in (0.25, 0.5, 0.5, 0.5):  # the first pass may see more maneuver than quiet
-        sigma = max(_robust_std(xd[quiet], quantile), tiny)
-        sigma_mean = max(_robust_std(mean[quiet], quantile, centred=True), tiny)
-        calm = ~binary_dilation(np.maximum(mean / sigma_mean, rms / sigma) > threshold, iterations=int(1 / dt))
-        if calm.sum() < 10:
-            break
-        quiet = calm
-    return _Activity(x, xd, mean / sigma_mean, rms / sigma, sigma, sigma_mean)
+# ------------------------------------------------------------------ System ID runs and segment files
 
 
-def _trend(x: np.ndarray, width: int) -> np.ndarray:
-    """Robust moving quadratic (bisquare weights, from a moving median): trim and drift, not maneuvers.
-
-    A maneuver's lobes lose their weight, so the trend runs through the quiet
-    samples and the zero crossings and follows a curving drift without lag.
-    """
-    trend = median_filter(x, size=width, mode="reflect")
-    half = width // 2
-    kernels = [(-np.arange(-half, half + 1) / half) ** k for k in range(5)]
-    idx = np.arange(x.size)
-    for _ in range(3):
-        resid = x - trend
-        r = resid / (4.685 * max(_robust_std(resid, 0.25), 1e-12 * (1.0 + float(np.max(np.abs(x))))))
-        w = np.where(np.abs(r) < 1, (1 - r * r) ** 2, 0.0)
-        m = [fftconvolve(w, k, mode="same") for k in kernels]
-        b = np.stack([fftconvolve(w * x, k, mode="same") for k in kernels[:3]], axis=-1)
-        a = np.stack([np.stack(m[i : i + 3], axis=-1) for i in range(3)], axis=-2)
-        good = (m[0] > 0.2 * half) & (np.abs(np.linalg.det(a)) > 1e-6 * m[0] ** 3)
-        if good.sum() < 2:
-            break
-        trend = np.interp(idx, idx[good], np.linalg.solve(a[good], b[good][..., None])[:, 0, 0])
-    return trend
-
-
-def _robust_std(x: np.ndarray, quantile: float = 0.5, *, centred: bool = False) -> float:
-    """σ of the quietest part of `x` from a quantile of |x - median| (0.5: 1.4826 × MAD).
-
-    A lower quantile stays right when maneuvers fill more than half the
-    record; `centred` takes x as already |deviations|. Falls back to the
-    standard deviation for quantised traces.
-    """
-    dev = x if centred else np.abs(x - np.median(x))
-    spread = float(np.quantile(dev, quantile)) / {0.5: 0.6745, 0.25: 0.3186}[quantile]
-    return spread if spread > 0 else float(np.std(x))
-
-
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """Inclusive index ranges of the True runs of `mask`."""
-    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
-    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
-
-
-def _bursts(axis: str, act: _Activity, dt: float, threshold: float, merge_s: float, active_s: float) -> list[tuple]:
-    """(axis, first, last, score) of each burst: active runs merged over short pauses."""
-    active = np.maximum(act.mean_z, act.rms_z) > threshold
-    merged: list[list[int]] = []
-    for a, b in _runs(active):
-        if merged and (a - merged[-1][1]) * dt < merge_s:
-            merged[-1][1] = b
-        else:
-            merged.append([a, b])
-    score = np.maximum(act.mean_z, act.rms_z)
-    return [(axis, a, b, float(np.percentile(score[a : b + 1], 95)))
-            for a, b in merged if active[a : b + 1].sum() * dt >= active_s]
-
-
-def _assign(bursts: list[tuple]) -> list[tuple[tuple, list[tuple]]]:
-    """Greedy: the strongest burst owns a maneuver; weaker bursts overlapping it are its reactions."""
-    pending, owned = sorted(bursts, key=lambda b: -b[3]), []
-    while pending:
-        owner, rest = pending[0], pending[1:]
-        reactions = [b for b in rest if b[1] <= owner[2] and b[2] >= owner[1]]
-        pending = [b for b in rest if b not in reactions]
-        owned.append((owner, reactions))
-    return sorted(owned, key=lambda pair: pair[0][1])
-
-
-def _edges(act: _Activity, i0: int, i1: int, dt: float, limits: tuple[int, int], threshold: float) -> tuple[int, int]:
-    """First and last sample of the maneuver around burst [i0, i1], within `limits`.
-
-    The end is found as the start of the time-reversed trace. Each edge is
-    searched again from where it was found until it settles, so the baseline
-    ends up next to the edge even when noise misplaced the burst boundary.
-    """
-    peak, n, back = float(np.max(np.abs(act.detrended[i0 : i1 + 1]))), act.raw.size, act.flipped()
-    lo, hi = i0, n - 1 - i1
-    for _ in range(_EDGE_PASSES):
-        lo, before = _onset(act, lo, dt, (limits[0], i1), peak, threshold), lo
-        if lo == before:
-            break
-    for _ in range(_EDGE_PASSES):
-        hi, before = _onset(back, hi, dt, (n - 1 - limits[1], n - 1 - i0), peak, threshold), hi
-        if hi == before:
-            break
-    return lo, max(n - 1 - hi, lo + 1)
-
-
-def _onset(act: _Activity, core: int, dt: float, limits: tuple[int, int], peak: float, threshold: float) -> int:
-    """Last calm sample before the trace leaves its local baseline near `core`.
-
-    The baseline is a robust polynomial through up to `_BASELINE_S` of trace
-    ending `_GUARD_S` before `core`, extended `_LOOK_IN_S` past it: a fade-in
-    too weak to detect lies in the guard, not in the fit, and a curving drift
-    is followed.
-    """
-    guard, x = int(round(_GUARD_S / dt)), act.raw
-    lo = max(core - guard - int(round(_BASELINE_S / dt)), limits[0], 0)
-    hi = int(min(core + _LOOK_IN_S / dt, limits[1], x.size - 1))
-    fit_end = max(lo, core - guard)
-    t = (np.arange(lo, hi + 1) - core) * dt
-    n_fit = fit_end - lo + 1
-    if n_fit >= max(3, int(round(0.5 / dt))):
-        degree = 2 if n_fit * dt >= _QUADRATIC_S else 1
-        d = x[lo : hi + 1] - _robust_poly(t[:n_fit], x[lo : fit_end + 1], degree, t)
-    else:
-        d = act.detrended[lo : hi + 1]
-    width = max(1, int(round(_SHORT_S / dt)))
-    mean = np.abs(uniform_filter1d(d, width, mode="nearest"))
-    rms = np.sqrt(uniform_filter1d(d * d, width, mode="nearest"))
-    floor = _RELATIVE_FLOOR * peak
-    loud = (mean > max(threshold * act.sigma_mean, 2 * floor)) | (rms > max(threshold * act.sigma, 2 * floor))
-    calm = (mean < max(_CALM * act.sigma_mean, floor)) & (rms < max(_CALM * act.sigma, floor))
-    leaving = np.flatnonzero(loud[fit_end - lo :])
-    first = fit_end - lo + int(leaving[0]) if leaving.size else core - lo
-    quiet = np.flatnonzero(calm[:first])
-    return lo + int(quiet[-1]) if quiet.size else lo
-
-
-def _robust_poly(t: np.ndarray, x: np.ndarray, degree: int, at: np.ndarray) -> np.ndarray:
-    """Polynomial fit of x(t), re-weighted twice with bisquare weights, evaluated at `at`."""
-    w = np.ones_like(x)
-    for _ in range(3):
-        coef = np.polyfit(t, x, degree, w=np.sqrt(w))
-        resid = x - np.polyval(coef, t)
-        r = resid / (4.685 * max(_robust_std(resid), 1e-300))
-        w = np.where(np.abs(r) < 1, (1 - r * r) ** 2, 0.0)
-        if np.count_nonzero(w) <= degree + 1:
-            break
-    return np.polyval(coef, at)
-
-
-def _lobes(x: np.ndarray, t: np.ndarray, h: float) -> list[tuple[int, float, float, float]]:
-    """(sign, begin_s, end_s, area) of the half-waves of `x`, cut at zero crossings with hysteresis h.
-
-    A half-wave begins at the zero crossing before `x` passes ±h with the
-    other sign; the first begins at t[0], the last ends at t[-1].
-    """
-    state = np.where(x > h, 1, np.where(x < -h, -1, 0))
-    loud = np.flatnonzero(state)
-    if loud.size == 0:
-        return []
-    firsts = loud[np.r_[0, np.flatnonzero(np.diff(state[loud]) != 0) + 1]]
-    idx = np.arange(x.size)
-    last_nonpos = np.maximum.accumulate(np.where(x <= 0, idx, 0))
-    last_nonneg = np.maximum.accumulate(np.where(x >= 0, idx, 0))
-    bounds = [float(t[0])]
-    for a in firsts[1:]:
-        j = int(last_nonpos[a] if state[a] > 0 else last_nonneg[a])
-        bounds.append(float(t[j] + x[j] / (x[j] - x[j + 1]) * (t[j + 1] - t[j])))
-    bounds.append(float(t[-1]))
-    cum = np.r_[0.0, np.cumsum(0.5 * (x[1:] + x[:-1]) * np.diff(t))]
-    areas = np.diff(np.interp(bounds, t, cum))
-    return [(int(state[a]), b, e, float(s)) for a, b, e, s in zip(firsts, bounds[:-1], bounds[1:], areas)]
-
-
-def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float) -> tuple | None:
-    """(kind, f_min_hz, f_max_hz) of the maneuver on samples [lo, hi], or None for no known kind."""
-    lobes = _lobes(act.detrended[lo : hi + 1], t[lo : hi + 1], threshold * act.sigma)
-    if len(lobes) >= 8:
-        return _oscillation(lobes)
-    if not lobes:
-        return None
-    areas = np.array([abs(lobe[3]) for lobe in lobes])
-    durations = np.array([lobe[2] - lobe[1] for lobe in lobes])
-    big = np.flatnonzero(areas >= 0.25 * areas.max())
-    if big.size == 2 and big[1] == big[0] + 1:
-        area_ratio, time_ratio = areas[big[1]] / areas[big[0]], durations[big[1]] / durations[big[0]]
-        if 1 / 3 <= area_ratio <= 3 and 1 / 3 <= time_ratio <= 3:
-            return "doublet", None, None
-    if big.size == 4 and np.all(np.diff(big) == 1):
-        unit = durations[big].sum() / 7.0
-        if np.all(np.abs(durations[big] / unit - [3, 2, 1, 1]) <= [1.0, 0.7, 0.4, 0.4]):
-            return "3211", None, None
-    return None
-
-
-def _oscillation(lobes: list) -> tuple:
-    """Sweep (frequency trend, or one frequency) or multisine, from the half-wave durations."""
-    durations = np.array([lobe[2] - lobe[1] for lobe in lobes[:-1]])  # the last may be cut short
-    freq = 0.5 / durations
-    mid = np.array([0.5 * (lobe[1] + lobe[2]) for lobe in lobes[:-1]])
-    smooth = np.array([np.median(freq[max(0, i - 1) : i + 2]) for i in range(freq.size)])
-    f_min, f_max = float(min(freq[0], smooth.min())), float(smooth.max())
-    if (abs(spearmanr(mid, freq).statistic) > 0.6 and f_max > 2 * f_min) or f_max < 1.5 * f_min:
-        return "sweep", f_min, f_max
-    return "multisine", f_min, f_max
-
-
-def _hover(t: np.ndarray, busy: list, min_hover_s: float, margin_s: float) -> list[Segment]:
-    """Stretches at least `min_hover_s` long and `margin_s` away from any activity."""
-    quiet = np.ones(t.size, dtype=bool)
-    pad = int(round(margin_s / (t[1] - t[0])))
-    for lo, hi in busy:
-        quiet[max(0, lo - pad) : hi + pad + 1] = False
-    return [Segment(None, "hover", t[a], t[b], "detected") for a, b in _runs(quiet) if t[b] - t[a] >= min_hover_s]
-
-
-# ------------------------------------------------------------------ SIDS rows and segment files
-
-
-def _sids_rows(rows: Sequence[SidsRow] | Mapping[str, Any]) -> list[SidsRow]:
-    if not isinstance(rows, Mapping):
-        return [_sids_row(row) for row in rows]
-    if "time_s" in rows:
-        times = np.asarray(rows["time_s"], dtype=np.float64)
-    elif "TimeUS" in rows:
-        times = np.asarray(rows["TimeUS"], dtype=np.float64) * 1e-6
+def _sids_runs(runs: Sequence[SystemIdRun] | Mapping[str, Any]) -> list[SystemIdRun]:
+    """Checked runs, from runs or from SIDS columns (whose runs have no known end)."""
+    if not isinstance(runs, Mapping):
+        return [_checked_run(run) for run in runs]
+    if "time_s" in runs:
+        times = np.asarray(runs["time_s"], dtype=np.float64)
+    elif "TimeUS" in runs:
+        times = np.asarray(runs["TimeUS"], dtype=np.float64) * 1e-6
     else:
         raise DataError("SIDS rows need a TimeUS (µs) or time_s (s) column")
-    missing = [name for name in _SID_FIELDS if name not in rows]
+    missing = [name for name in _SID_FIELDS if name not in runs]
     if missing:
         raise DataError(f"SIDS rows lack the field(s) {', '.join(missing)}")
-    columns = {ours: np.asarray(rows[name], dtype=np.float64) for name, ours in _SID_FIELDS.items()}
-    return [SidsRow(float(t), **{k: float(v[i]) for k, v in columns.items()}) for i, t in enumerate(times)]
+    columns = {ours: np.asarray(runs[name], dtype=np.float64) for name, ours in _SID_FIELDS.items()}
+    rows = [SystemIdRun(float(t), float("nan"), axis_name="", **{k: float(v[i]) for k, v in columns.items()})
+            for i, t in enumerate(times)]
+    return [replace(run, axis_name=_axis_name(run.axis)) for run in map(_checked_run, rows)]
 
 
-def _sids_row(row: Any) -> SidsRow:
-    """A SidsRow from a SidsRow, a tuple of its fields, or an object with its attributes."""
-    if isinstance(row, SidsRow):
-        return row
-    if not hasattr(row, "f_start_hz"):
-        return SidsRow(*row)
-    names = [item.name for item in fields(SidsRow)][2:-1]
-    time_s = getattr(row, "time_s", None)
-    last = getattr(row, "last_sidd_s", None) if time_s is not None else getattr(row, "end_s", None)
-    return SidsRow(row.start_s if time_s is None else time_s, row.axis, *(getattr(row, n) for n in names), last)
+def _axis_name(axis: int) -> str:
+    """ArduPilot's name of a ``SID_AXIS`` in lower case (``"rate roll"``), ``"other"`` if unknown."""
+    return SID_AXES[axis][1].lower() if axis in SID_AXES else "other"
+
+
+def _checked_run(run: SystemIdRun) -> SystemIdRun:
+    """`run` with an integer axis, after checking its settings are finite (a non-finite end is unknown)."""
+    for item in fields(SystemIdRun):
+        value = getattr(run, item.name)
+        if item.name not in ("end_s", "axis_name") and not np.isfinite(value):
+            raise DataError(f"SIDS row at {run.start_s}: {item.name}={value} is not finite")
+    if int(run.axis) != run.axis:
+        raise DataError(f"SIDS row at {run.start_s:.2f} s: axis={run.axis} is not an integer")
+    return replace(run, axis=int(run.axis))
 
 
 def _toml_entries(path: Path, text: str) -> list[tuple[int, dict]]:

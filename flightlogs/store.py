@@ -12,6 +12,10 @@ Layout (schema version 1)::
     /wind/<key>/                    attrs: path, sha256, and the measurement's scalar
                                            fields; JSON for mappings and tuples
     /wind/<key>/<array field>       float64 (n_samples,) (``utc_s`` in UNIX s, winds m/s)
+    /conditioned/<key>/             attrs: source, rate_hz, warnings (JSON), wind_alignment (JSON or "null")
+    /conditioned/<key>/segments     compound (axis, kind, start_s, end_s, source, f_min_hz, f_max_hz, detail)
+    /conditioned/<key>/records/<i>/ attrs: label, units (JSON), trim (JSON)
+    /conditioned/<key>/records/<i>/time_s, /<signal>   float64 (n_samples,), trim removed
 
 ``<key>`` is the file's stem, made unique with a numeric suffix. Later steps
 add groups of their own beside these (aligned records, segments); a reader
@@ -52,6 +56,8 @@ class Dataset:
         Ingested flight logs, in the order they were written.
     winds : tuple
         Wind measurements (:class:`flightlogs.anemometer.WindMeasurement`).
+    conditioned : tuple
+        Conditioned flights (:class:`flightlogs.condition.ConditionedFlight`).
     sha256 : dict
         Hash of each source file as it was at ingest, by path string.
     schema_version : int
@@ -60,6 +66,7 @@ class Dataset:
 
     logs: tuple[FlightLog, ...]
     winds: tuple[Any, ...] = ()
+    conditioned: tuple[Any, ...] = ()
     sha256: dict[str, str] = dataclasses.field(default_factory=dict)
     schema_version: int = SCHEMA_VERSION
 
@@ -79,8 +86,10 @@ def file_sha256(path: str | Path) -> str:
     return digest.hexdigest()
 
 
-def write_dataset(path: str | Path, logs: Sequence[FlightLog], winds: Sequence[Any] = ()) -> None:
-    """Write logs and wind measurements to an HDF5 dataset, atomically.
+def write_dataset(
+    path: str | Path, logs: Sequence[FlightLog], winds: Sequence[Any] = (), conditioned: Sequence[Any] = ()
+) -> None:
+    """Write logs, wind measurements and conditioned flights to an HDF5 dataset, atomically.
 
     Parameters
     ----------
@@ -90,6 +99,8 @@ def write_dataset(path: str | Path, logs: Sequence[FlightLog], winds: Sequence[A
         Logs to store.
     winds : sequence of WindMeasurement, optional
         Anemometer measurements to store.
+    conditioned : sequence of ConditionedFlight, optional
+        Aligned records, segments and alignment of each flight.
     """
     with atomic_output(path) as tmp, h5py.File(tmp, "w") as h5:
         h5.attrs["schema"] = SCHEMA
@@ -102,6 +113,9 @@ def write_dataset(path: str | Path, logs: Sequence[FlightLog], winds: Sequence[A
         wind_group = h5.create_group("wind")
         for wind in winds:
             _write_dataclass(wind_group.create_group(_unique_key(wind_group, wind.path)), wind)
+        flights = h5.create_group("conditioned")
+        for flight in conditioned:
+            _write_conditioned(flights.create_group(_unique_key(flights, flight.source)), flight)
 
 
 def read_dataset(path: str | Path) -> Dataset:
@@ -135,7 +149,8 @@ def read_dataset(path: str | Path) -> Dataset:
         sha = {g.attrs["path"]: g.attrs["sha256"] for g in h5["logs"].values()}
         winds = tuple(_read_wind(group) for group in h5.get("wind", {}).values())
         sha.update({g.attrs["path"]: g.attrs["sha256"] for g in h5.get("wind", {}).values()})
-    return Dataset(logs=logs, winds=winds, sha256=sha, schema_version=version)
+        conditioned = tuple(_read_conditioned(g) for g in h5.get("conditioned", {}).values())
+    return Dataset(logs=logs, winds=winds, conditioned=conditioned, sha256=sha, schema_version=version)
 
 
 def _version() -> str:
@@ -252,3 +267,74 @@ def _read_wind(group: h5py.Group) -> Any:
             kwargs[field.name] = raw
     kwargs["path"] = Path(kwargs["path"])
     return WindMeasurement(**kwargs)
+
+
+_SEGMENT_DTYPE = np.dtype([
+    ("axis", h5py.string_dtype()), ("kind", h5py.string_dtype()), ("start_s", "f8"), ("end_s", "f8"),
+    ("source", h5py.string_dtype()), ("f_min_hz", "f8"), ("f_max_hz", "f8"), ("detail", h5py.string_dtype()),
+])
+
+
+def _text(value: Any) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _write_conditioned(group: h5py.Group, flight: Any) -> None:
+    group.attrs["source"] = str(flight.source)
+    group.attrs["rate_hz"] = flight.rate_hz
+    group.attrs["warnings"] = json.dumps(list(flight.warnings))
+    group.attrs["wind_alignment"] = json.dumps(_jsonable(_asdict(flight.wind)))
+    rows = [
+        (s.axis or "", s.kind, s.start_s, s.end_s, s.source, np.nan if s.f_min_hz is None else s.f_min_hz,
+         np.nan if s.f_max_hz is None else s.f_max_hz, s.detail)
+        for s in flight.segments
+    ]
+    group.create_dataset("segments", data=np.array(rows, dtype=_SEGMENT_DTYPE))
+    records = group.create_group("records")
+    for k, record in enumerate(flight.records):
+        sub = records.create_group(str(k))
+        sub.attrs["label"] = record.label
+        sub.attrs["units"] = json.dumps(dict(record.units))
+        sub.attrs["trim"] = json.dumps(dict(record.trim))
+        sub.create_dataset("time_s", data=record.time_s)
+        for name in record.signals:
+            sub.create_dataset(name, data=record[name], compression="gzip", shuffle=True)
+
+
+def _asdict(item: Any) -> Any:
+    return None if item is None else dataclasses.asdict(item)
+
+
+def _read_conditioned(group: h5py.Group) -> Any:
+    import pandas as pd
+
+    from .align import WindAlignment
+    from .condition import ConditionedFlight
+    from .record import Record
+    from .segments import Segment
+    from .timing import LagEstimate, TransportDelay
+
+    segments = tuple(
+        Segment(
+            _text(row["axis"]) or None, _text(row["kind"]), float(row["start_s"]), float(row["end_s"]),
+            _text(row["source"]), None if np.isnan(row["f_min_hz"]) else float(row["f_min_hz"]),
+            None if np.isnan(row["f_max_hz"]) else float(row["f_max_hz"]), _text(row["detail"]),
+        )
+        for row in group["segments"][()]
+    )
+    source = Path(group.attrs["source"])
+    records = []
+    for key in sorted(group["records"], key=int):
+        sub = group["records"][key]
+        units = json.loads(sub.attrs["units"])
+        table = pd.DataFrame({name: sub[name][()] for name in units}, index=pd.Index(sub["time_s"][()], name="time_s"))
+        records.append(Record(table, units, json.loads(sub.attrs["trim"]), source, str(sub.attrs["label"])))
+    raw = json.loads(group.attrs["wind_alignment"])
+    wind = None
+    if raw is not None:
+        raw["wind_path"] = Path(raw["wind_path"])
+        raw["transport"] = TransportDelay(**raw["transport"])
+        raw["residual"] = None if raw["residual"] is None else LagEstimate(**raw["residual"])
+        wind = WindAlignment(**raw)
+    return ConditionedFlight(source, tuple(records), segments, float(group.attrs["rate_hz"]), wind,
+                             tuple(json.loads(group.attrs["warnings"])))

@@ -6,7 +6,7 @@ from typing import Any
 
 from .flightlog import FlightLog
 
-__all__ = ["log_summary", "wind_summary"]
+__all__ = ["log_summary", "wind_summary", "conditioned_summary"]
 
 
 def log_summary(log: FlightLog) -> dict[str, Any]:
@@ -70,4 +70,57 @@ def wind_summary(wind: Any) -> dict[str, Any]:
         "mean_speed_m_s": round(float(np.mean(wind.speed_m_s)), 4),
         "columns": dict(wind.columns),
         "warnings": list(wind.warnings),
+    }
+
+
+def conditioned_summary(flight: Any) -> dict[str, Any]:
+    """Summarise a conditioned flight as JSON-ready data.
+
+    Parameters
+    ----------
+    flight : ConditionedFlight
+        The conditioned flight.
+
+    Returns
+    -------
+    dict
+        ``rate_hz``, ``records[]`` (``start_s, end_s, samples, signals``),
+        ``segments[]`` (``axis, kind, start_s, end_s, source, f_min_hz,
+        f_max_hz``), ``wind_alignment`` (offsets and delays used, or None) and
+        ``warnings``.
+    """
+    alignment = None
+    if flight.wind is not None:
+        wind = flight.wind
+        transport = wind.transport
+        alignment = {
+            "wind_file": str(wind.wind_path),
+            "reference_clock": wind.reference,
+            "clock_offset_s": round(wind.clock_offset_s, 4),
+            "clock_offset_source": wind.clock_offset_source,
+            "transport_delay_s": round(transport.delay_s, 4),
+            "transport_delay_source": transport.source,
+            "distance_m": transport.distance_m,
+            "mean_speed_m_s": round(transport.mean_speed_m_s, 4),
+            "turbulence_ratio": round(transport.turbulence_ratio, 4),
+            "frozen_turbulence_holds": transport.frozen_turbulence_holds,
+            "overlap_s": round(wind.overlap_s, 3),
+            "residual_offset_s": None if wind.residual is None else round(wind.residual.lag_s, 4),
+            "residual_correlation": None if wind.residual is None else round(wind.residual.correlation, 4),
+            "residual_against": wind.residual_against,
+        }
+    return {
+        "rate_hz": round(flight.rate_hz, 6),
+        "records": [
+            {"label": r.label, "start_s": round(r.start_s, 4), "end_s": round(r.end_s, 4),
+             "samples": int(r.time_s.size), "signals": list(r.signals)}
+            for r in flight.records
+        ],
+        "segments": [
+            {"axis": s.axis, "kind": s.kind, "start_s": round(s.start_s, 3), "end_s": round(s.end_s, 3),
+             "source": s.source, "f_min_hz": s.f_min_hz, "f_max_hz": s.f_max_hz}
+            for s in flight.segments
+        ],
+        "wind_alignment": alignment,
+        "warnings": list(flight.warnings),
     }

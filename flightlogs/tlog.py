@@ -29,16 +29,15 @@ missing.
 
 from __future__ import annotations
 
-import struct
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from ._series import make_signal
+from ._tlog_scan import FIELDS, Key, Scan, message_table, scan_tlog
 from .errors import LogFormatError
 from .flightlog import FlightLog, Signal
 
@@ -53,29 +52,7 @@ _MAV_AUTOPILOT_INVALID = 8
 _FIRMWARE_PREFIXES = ("APM:", "ArduCopter", "ArduPlane", "ArduRover", "ArduSub", "Frame:")
 _U32_US_PERIOD_S = 2.0**32 * 1e-6  # SERVO_OUTPUT_RAW.time_usec is uint32 µs
 _REBOOT_DROP_S = 1.0  # a backward step of the boot clock larger than this is a reboot
-_PROGRESS_EVERY = 2000  # messages between progress callbacks
 
-#: Fields kept per message type; everything else in the stream is decoded and dropped.
-_FIELDS: dict[str, tuple[str, ...]] = {
-    "HEARTBEAT": ("type", "autopilot"),
-    "ATTITUDE": ("time_boot_ms", "roll", "pitch", "yaw", "rollspeed", "pitchspeed", "yawspeed"),
-    "HIGHRES_IMU": ("time_usec", "xacc", "yacc", "zacc"),
-    "SCALED_IMU": ("time_boot_ms", "xacc", "yacc", "zacc"),
-    "RAW_IMU": ("time_usec", "xacc", "yacc", "zacc"),
-    "SCALED_IMU2": ("time_boot_ms", "xacc", "yacc", "zacc"),
-    "SCALED_IMU3": ("time_boot_ms", "xacc", "yacc", "zacc"),
-    "LOCAL_POSITION_NED": ("time_boot_ms", "z", "vx", "vy", "vz"),
-    "GLOBAL_POSITION_INT": ("time_boot_ms", "relative_alt", "vx", "vy", "vz"),
-    "DISTANCE_SENSOR": ("time_boot_ms", "current_distance", "min_distance", "max_distance",
-                        "orientation"),
-    "SERVO_OUTPUT_RAW": ("time_usec", "port", *(f"servo{i}_raw" for i in range(1, 17))),
-    "SYS_STATUS": ("voltage_battery",),
-    "SYSTEM_TIME": ("time_unix_usec", "time_boot_ms"),
-    "GPS_RAW_INT": ("time_usec", "fix_type"),
-    "PARAM_VALUE": ("param_id", "param_value"),
-    "STATUSTEXT": ("text",),
-    "AUTOPILOT_VERSION": ("flight_sw_version",),
-}
 #: Messages whose time field is the autopilot's boot clock, and its scale to seconds.
 _BOOT_CLOCK = {
     "ATTITUDE": ("time_boot_ms", 1e-3), "HIGHRES_IMU": ("time_usec", 1e-6),
@@ -85,21 +62,8 @@ _BOOT_CLOCK = {
     "DISTANCE_SENSOR": ("time_boot_ms", 1e-3), "SYSTEM_TIME": ("time_boot_ms", 1e-3),
 }
 
-_Key = tuple[int, int]  # (system id, component id)
 _Tables = dict[str, dict[str, np.ndarray]]  # message type -> field -> column
 _Signals = dict[str, Signal]
-
-
-@dataclass(slots=True)
-class _Scan:
-    """What one pass over the file keeps: rows of wanted fields per source and type."""
-
-    rows: dict[_Key, dict[str, list[tuple]]] = field(default_factory=dict)
-    heartbeats: list[tuple[_Key, int, int]] = field(default_factory=list)  # key, type, autopilot
-    n_known: int = 0
-    known_bytes: int = 0
-    other_bytes: int = 0  # well-formed packets of message types this dialect does not know
-    stopped: str = ""  # why decoding stopped early, if it did
 
 
 def read_tlog(
@@ -167,7 +131,7 @@ def read_tlog(
     size = path.stat().st_size
     if size == 0:
         raise LogFormatError(f"{path}: the file is empty, not a MAVLink telemetry log")
-    scan = _scan(path, size, progress)
+    scan = scan_tlog(path, size, progress)
     if scan.n_known == 0:
         raise LogFormatError(f"{path}: no intact MAVLink message found; not a telemetry log")
     key, mav_type, autopilot = _vehicle(scan, path)
@@ -180,7 +144,7 @@ def read_tlog(
             f"({100.0 * skipped / size:.2g}%); read the {scan.n_known} intact messages"
             + (f" ({scan.stopped})" if scan.stopped else "")
         )
-    tables = {name: _table(name, rows.get(name, [])) for name in _FIELDS}
+    tables = {name: message_table(name, rows.get(name, [])) for name in FIELDS}
     clock = _BootClock.from_tables(tables)
     parameters = _parameters(rows.get("PARAM_VALUE", []))
     signals: dict[str, Signal] = {}
@@ -205,72 +169,10 @@ def read_tlog(
     )
 
 
-# --------------------------------------------------------------------------- decoding
+# --------------------------------------------------------------------------- vehicle and clock
 
 
-def _open(path: Path) -> Any:  # pymavlink.mavutil.mavlogfile
-    """Open `path` with pymavlink, with a MAVLink 2 parser that also reads MAVLink 1."""
-    from pymavlink import mavutil
-    from pymavlink.dialects.v20 import all as mavlink2
-
-    conn = mavutil.mavlogfile(str(path), robust_parsing=True)
-    conn.mav = mavlink2.MAVLink(conn, srcSystem=255, srcComponent=0)
-    conn.mav.robust_parsing = True
-    conn.first_byte = False  # keep mavutil from switching its global dialect
-    return conn
-
-
-def _scan(path: Path, size: int, progress: Callable[[int, int], None] | None) -> _Scan:
-    """Decode every packet once, keeping the wanted fields of the wanted types."""
-    from pymavlink.dialects.v20.all import MAVError
-
-    scan = _Scan()
-    if progress is not None:
-        progress(0, size)
-    conn = _open(path)
-    try:
-        count = 0
-        while True:
-            try:
-                msg = conn.recv_msg()
-            except (MAVError, struct.error, ValueError, IndexError, TypeError, RuntimeError) as err:
-                scan.stopped = f"decoding stopped at byte {conn.f.tell()}: {err}"
-                break
-            if msg is None:
-                break
-            count += 1
-            if progress is not None and count % _PROGRESS_EVERY == 0:
-                progress(min(conn.f.tell(), size), size)
-            _keep(scan, msg)
-    finally:
-        conn.close()
-    if progress is not None:
-        progress(size, size)
-    return scan
-
-
-def _keep(scan: _Scan, msg: Any) -> None:
-    """Account for one decoded packet and keep its fields if its type is wanted."""
-    msg_id = msg.get_msgId()
-    if msg_id == -1:  # BAD_DATA: counted as skipped
-        return
-    if msg_id < 0:  # UNKNOWN_n: a well-formed packet of another dialect
-        scan.other_bytes += 8 + len(msg.get_msgbuf())
-        return
-    scan.n_known += 1
-    scan.known_bytes += 8 + len(msg.get_msgbuf())
-    name = msg.get_type()
-    fields = _FIELDS.get(name)
-    if fields is None:
-        return
-    key = (msg.get_srcSystem(), msg.get_srcComponent())
-    row = (msg._timestamp, *(getattr(msg, f, 0) for f in fields))
-    scan.rows.setdefault(key, {}).setdefault(name, []).append(row)
-    if name == "HEARTBEAT":
-        scan.heartbeats.append((key, int(msg.type), int(msg.autopilot)))
-
-
-def _vehicle(scan: _Scan, path: Path) -> tuple[_Key, int, str]:
+def _vehicle(scan: Scan, path: Path) -> tuple[Key, int, str]:
     """Source key, MAV_TYPE and autopilot name of the vehicle's own heartbeats."""
     others: set[int] = set()
     for key, mav_type, autopilot in scan.heartbeats:
@@ -285,17 +187,6 @@ def _vehicle(scan: _Scan, path: Path) -> tuple[_Key, int, str]:
             "only ArduPilot (3) and PX4 (12) are supported"
         )
     raise LogFormatError(f"{path}: no HEARTBEAT from a vehicle, so the autopilot is unknown")
-
-
-def _table(name: str, rows: list[tuple]) -> dict[str, np.ndarray]:
-    """Columns of one message type as float arrays; ``"rx"`` is the tlog receive time, s."""
-    fields = _FIELDS[name]
-    if name in ("PARAM_VALUE", "STATUSTEXT"):
-        return {}
-    if not rows:
-        return {f: np.empty(0) for f in ("rx", *fields)}
-    data = np.asarray(rows, dtype=np.float64)
-    return {f: data[:, i] for i, f in enumerate(("rx", *fields))}
 
 
 @dataclass(frozen=True, slots=True)

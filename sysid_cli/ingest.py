@@ -1,8 +1,10 @@
-"""``sysid ingest``: read a flight log (and anemometer CSVs) into canonical signals."""
+"""``sysid ingest``: read flight logs and anemometer files into aligned, segmented records."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -13,8 +15,9 @@ __all__ = ["ingest", "parse_columns"]
 _EPILOG = """\b
 Examples:
   sysid ingest flight.ulg --json -
-  sysid ingest 00000042.BIN --wind mast.csv -o flight.h5
-  sysid ingest flight.ulg --wind mast.csv --columns time=UTC,speed=WS,direction=WD
+  sysid ingest 00000042.BIN --wind mast.csv --wind-distance 4.6 -o flight.h5
+  sysid ingest sweeps/*.bin --wind anemometer/ --wind-distance 4.6 -o campaign.h5
+  sysid ingest flight.ulg --wind mast.csv --columns time=UTC,speed=WS,direction=WD --transport-delay 0.8
 """
 
 
@@ -32,67 +35,102 @@ def parse_columns(_ctx: click.Context, _param: click.Parameter, value: str | Non
 
 
 @click.command(epilog=_EPILOG)
-@click.argument("log", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option(
-    "--wind", "wind_paths", multiple=True,
-    type=click.Path(exists=True, dir_okay=False, path_type=Path),
-    help="Anemometer CSV (repeatable).",
-)
-@click.option(
-    "--columns", callback=parse_columns,
-    help="Override anemometer column detection: time=,speed=,direction= or time=,u=,v=.",
-)
-@click.option(
-    "-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
-    help="Write the canonical signals to this HDF5 dataset.",
-)
+@click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--wind", "wind_paths", multiple=True, type=click.Path(exists=True, path_type=Path),
+              help="Anemometer CSV, or a folder of them (repeatable); each log takes the file overlapping it in UTC.")
+@click.option("--columns", callback=parse_columns,
+              help="Override anemometer column detection: time=,speed=,direction= or time=,u=,v=.")
+@click.option("--wind-distance", type=click.FloatRange(min=0, min_open=True), metavar="M",
+              help="Anemometer-to-vehicle distance, m (transport delay = distance / mean wind speed).")
+@click.option("--wind-bearing", type=float, metavar="DEG",
+              help="Direction from the anemometer to the vehicle, deg from north (default: straight upstream).")
+@click.option("--transport-delay", type=float, metavar="S", help="Use this transport delay, s, instead.")
+@click.option("--wind-offset", type=float, metavar="S",
+              help="Anemometer clock minus UTC, s (minus the log's clock when the log has no GPS time).")
+@click.option("--estimate-wind-offset", is_flag=True,
+              help="Correct the clock offset by cross-correlating the wind with the vehicle's response.")
+@click.option("--rate", "rate_hz", type=click.FloatRange(min=0, min_open=True), metavar="HZ",
+              help="Rate of the common time base (default: the fastest core signal's).")
+@click.option("--segments", "segments_file", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              help="TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
+@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+              help="Write signals, records and segments to this HDF5 dataset.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
-def ingest(
-    log: Path,
-    wind_paths: tuple[Path, ...],
-    columns: dict[str, str] | None,
-    out: Path | None,
-    json_path: str | None,
-    quiet: bool,
-) -> None:
-    """Read LOG (PX4 .ulg, ArduPilot .bin or MAVLink .tlog, detected from content)
-    and report every canonical signal found, with its rate, unit and source."""
-    from flightlogs.anemometer import read_anemometer_csv
-    from flightlogs.reader import read_log
+def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[str, str] | None,
+           wind_distance: float | None, wind_bearing: float | None, transport_delay: float | None,
+           wind_offset: float | None, estimate_wind_offset: bool, rate_hz: float | None,
+           segments_file: Path | None, out: Path | None, json_path: str | None, quiet: bool) -> None:
+    """Read LOGS (PX4 .ulg, ArduPilot .bin or MAVLink .tlog, detected from content), report every
+    canonical signal with its rate, unit and source, align the anemometer wind, and find the maneuvers."""
+    from flightlogs.campaign import ingest_campaign
+    from flightlogs.condition import ConditioningOptions
+    from flightlogs.segments import read_segments_file
     from flightlogs.store import write_dataset
-    from flightlogs.summary import log_summary, wind_summary
 
-    with progress_bar(f"reading {log.name}", quiet=quiet) as progress:
-        flight = read_log(log, progress=progress)
-    winds = [read_anemometer_csv(path, columns=columns) for path in wind_paths]
+    options = ConditioningOptions(
+        rate_hz=rate_hz, wind_offset_s=wind_offset, estimate_wind_offset=estimate_wind_offset,
+        wind_distance_m=wind_distance, wind_bearing_rad=None if wind_bearing is None else math.radians(wind_bearing),
+        transport_delay_s=transport_delay,
+        segments=read_segments_file(segments_file) if segments_file is not None else None,
+    )
+    with progress_bar("reading", quiet=quiet) as bar:
+        campaign = ingest_campaign(list(logs), list(wind_paths), columns=columns, options=options,
+                                   progress=lambda _name, done, total: bar(done, total))
     if out is not None:
-        write_dataset(out, [flight], winds)
-
-    summary = log_summary(flight)
-    summary["wind"] = [wind_summary(wind) for wind in winds]
-    summary["output"] = str(out) if out is not None else None
+        write_dataset(out, campaign.logs, campaign.winds, [c for c in campaign.conditioned if c is not None])
+    summary = _summary(campaign, out)
     if not quiet:
-        _print_table(summary, to_stderr=json_path == "-")
+        _print_summary(summary, to_stderr=json_path == "-")
     emit_json(summary, json_path)
 
 
-def _print_table(summary: dict, *, to_stderr: bool) -> None:
+def _summary(campaign: Any, out: Path | None) -> dict[str, Any]:
+    from flightlogs.summary import conditioned_summary, log_summary, wind_summary
+
+    entries = []
+    for log, flight, notes in zip(campaign.logs, campaign.conditioned, campaign.notes):
+        entry = log_summary(log)
+        if flight is not None:
+            entry.update({k: v for k, v in conditioned_summary(flight).items() if k != "warnings"})
+            entry["warnings"] += conditioned_summary(flight)["warnings"]
+        entry["warnings"] += list(notes)
+        entries.append(entry)
+    summary: dict[str, Any] = dict(entries[0]) if len(entries) == 1 else {}
+    summary["logs"] = entries
+    summary["wind"] = [wind_summary(wind) for wind in campaign.winds]
+    summary["output"] = str(out) if out is not None else None
+    return summary
+
+
+def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
     def say(text: str = "") -> None:
         click.echo(text, err=to_stderr)
 
-    say(f"{summary['path']}: {summary['autopilot']} {summary['log_format']}, "
-        f"{summary['vehicle'] or 'vehicle unknown'}, {summary['duration_s']:.1f} s"
-        + (f", starts {summary['utc_start']}" if summary["utc_start"] else ", no GPS time"))
-    say(f"  {'signal':<11} {'samples':>8} {'rate Hz':>8}  {'unit':<11} source")
-    for name, info in summary["signals"].items():
-        say(f"  {name:<11} {info['samples']:>8} {info['rate_hz']:>8.1f}  {info['unit']:<11} {info['source']}")
-    if summary["missing"]:
-        say(f"  missing: {', '.join(summary['missing'])}")
-    for wind in summary["wind"]:
-        say(f"  wind {wind['path']}: {wind['samples']} samples at {wind['rate_hz']:.1f} Hz, "
-            f"{wind['utc_start']} to {wind['utc_end']}, mean {wind['mean_speed_m_s']:.2f} m/s")
-    for warning in summary["warnings"]:
-        say(f"  warning: {warning}")
+    for entry in summary["logs"]:
+        say(f"{entry['path']}: {entry['autopilot']} {entry['log_format']}, "
+            f"{entry['vehicle'] or 'vehicle unknown'}, {entry['duration_s']:.1f} s"
+            + (f", starts {entry['utc_start']}" if entry["utc_start"] else ", no GPS time"))
+        say(f"  {'signal':<11} {'samples':>8} {'rate Hz':>8}  {'unit':<20} source")
+        for name, info in entry["signals"].items():
+            say(f"  {name:<11} {info['samples']:>8} {info['rate_hz']:>8.1f}  {info['unit']:<20} {info['source']}")
+        if entry["missing"]:
+            say(f"  missing: {', '.join(entry['missing'])}")
+        alignment = entry.get("wind_alignment")
+        if alignment:
+            say(f"  wind {alignment['wind_file']}: clock offset {alignment['clock_offset_s']:+.3f} s "
+                f"({alignment['clock_offset_source']}), transport delay {alignment['transport_delay_s']:.3f} s "
+                f"({alignment['transport_delay_source']}), mean {alignment['mean_speed_m_s']:.2f} m/s")
+            if alignment["residual_offset_s"] is not None:
+                say(f"    residual clock offset {alignment['residual_offset_s']:+.3f} s against "
+                    f"{alignment['residual_against']} (correlation {alignment['residual_correlation']:.2f})")
+        for record in entry.get("records", []):
+            say(f"  record {record['label']}: {record['start_s']:.2f}-{record['end_s']:.2f} s, "
+                f"{record['samples']} samples at {entry['rate_hz']:.0f} Hz")
+        for segment in entry.get("segments", []):
+            axis = segment["axis"] or "-"
+            say(f"  {segment['kind']:<8} {axis:<4} {segment['start_s']:8.2f}-{segment['end_s']:8.2f} s  ({segment['source']})")
+        for warning in entry["warnings"]:
+            say(f"  warning: {warning}")
     if summary["output"]:
-        say(f"  wrote {summary['output']}")
+        say(f"wrote {summary['output']}")

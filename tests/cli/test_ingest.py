@@ -16,7 +16,7 @@ from sysid_cli.main import cli
 REAL_LOGS = [
     ("kd0aij-impulse-response/log1.ulg", "px4", "ulog", {"p", "q", "r", "ax", "ay", "az"}),
     ("px4-ulog-rs/quadrotor_local.ulg", "px4", "ulog",
-     {"p", "q", "r", "phi", "theta", "psi", "vn", "ve", "vd", "ax", "delta_lat", "delta_thr", "motor_1", "motor_4", "battery_v", "height_agl"}),
+     {"p", "q", "r", "phi", "theta", "psi", "vd", "ax", "delta_lat", "delta_thr", "motor_1", "motor_4", "battery_v", "height_agl"}),
     ("px4-ulog-rs/corrupt_unregistered_msg_id.ulg", "px4", "ulog", {"p", "q", "r", "phi", "motor_1", "battery_v"}),
     ("px4-ulog-rs/corrupt_actuator_armed_wrong_size.ulg", "px4", "ulog", {"p", "q", "r"}),
     ("pyulog/sample.ulg", "px4", "ulog", {"p", "q", "r", "phi", "ax", "delta_lat", "delta_thr", "motor_1"}),

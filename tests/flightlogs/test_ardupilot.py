@@ -163,6 +163,18 @@ def test_sidd_gives_the_excitation_and_sids_the_maneuver(tmp_path: Path) -> None
     assert log.vehicle.startswith("ArduCopter V4.5.7 (sim)")
 
 
+def test_the_flightlog_carries_the_system_id_runs(tmp_path: Path) -> None:
+    t = 10_000_000 + 2500 * np.arange(400)
+    sids = standard_block("SIDS", TimeUS=[t[0] - 5, t[250] - 5], Ax=[7, 11], Mag=[10.0, 0.1], FSt=[0.5, 1.0],
+                          FSp=[20.0, 8.0], TFin=[1.0, 0.5], TC=[4.0, 2.0], TR=[2.0, 1.0], TFout=[0.5, 0.5])
+    sidd = standard_block("SIDD", TimeUS=t, Time=(t - t[0]) / 1e6, Targ=np.zeros(400, dtype=np.float32))
+    path = tmp_path / "runs.bin"
+    path.write_bytes(encode_dataflash([sids, sidd]))
+    runs = read_dataflash(path).system_id_runs
+    assert isinstance(runs, tuple) and [run.end_s for run in runs] == [t[249] / 1e6, t[-1] / 1e6]
+    assert runs == system_id_runs(read_messages(path))
+
+
 def test_newer_layouts_instances_and_estimator_choice(tmp_path: Path) -> None:
     t = 5_000_000 + 10_000 * np.arange(100)
     two = np.repeat(t, 2)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from flightlogs.errors import MissingSignalError
-from flightlogs.flightlog import FlightLog, Signal
+from flightlogs.flightlog import FlightLog, Signal, SystemIdRun
 from flightlogs.signals import LOGGED_SIGNALS, describe, is_canonical
 
 
@@ -66,3 +66,10 @@ def test_flightlog_signals_are_immutable() -> None:
     log = FlightLog(Path("a.ulg"), "ulog", "px4", {"p": _signal("p")})
     with pytest.raises(TypeError):
         log.signals["q"] = _signal("q")  # type: ignore[index]
+
+
+def test_flightlog_keeps_system_id_runs_as_a_tuple() -> None:
+    run = SystemIdRun(5.0, 40.0, 7, "rate roll", 10.0, 0.5, 20.0, 1.0, 4.0, 30.0, 0.5)
+    log = FlightLog(Path("sysid.bin"), "dataflash", "ardupilot", {"p": _signal("p")}, system_id_runs=[run])
+    assert log.system_id_runs == (run,)
+    assert FlightLog(Path("a.ulg"), "ulog", "px4", {"p": _signal("p")}).system_id_runs == ()

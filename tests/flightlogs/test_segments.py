@@ -1,4 +1,4 @@
-"""Maneuver segmentation: detection on synthetic closed-loop flights, SIDS rows, user files."""
+"""Maneuver segmentation: detection on synthetic closed-loop flights, System ID runs, user files."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ import pytest
 from scipy.signal import butter, lfilter
 
 from flightlogs.errors import DataError
+from flightlogs.flightlog import SystemIdRun
 from flightlogs.segments import (
     SID_AXES,
     Segment,
-    SidsRow,
     detect_segments,
     read_segments_file,
     segments_from_sid,
@@ -146,11 +146,16 @@ def test_bad_detection_input_is_a_data_error(inputs, time_s, fragment) -> None:
         detect_segments(time_s, inputs)
 
 
-# ------------------------------------------------------------------ SIDS rows
+# ------------------------------------------------------------------ System ID runs
+
+
+def _run(start_s: float, axis: int, *settings: float) -> SystemIdRun:
+    """A System ID run with SIDS `settings` (Mag, FSt, FSp, TFin, TC, TR, TFout) and no SIDD (end unknown)."""
+    return SystemIdRun(start_s, float("nan"), axis, "test", *settings)
 
 
 def test_sids_rows_give_exact_sweep_segments() -> None:
-    rows = [SidsRow(100.0, 11, 0.1, 0.1, 10.0, 2.0, 20.0, 34.0, 1.0), SidsRow(200.5, 13, 0.05, 0.5, 8.0, 1.0, 4.0, 30.0, 2.0)]
+    rows = [_run(100.0, 11, 0.1, 0.1, 10.0, 2.0, 20.0, 34.0, 1.0), _run(200.5, 13, 0.05, 0.5, 8.0, 1.0, 4.0, 30.0, 2.0)]
     lon, thr = segments_from_sid(rows)
     assert (lon.axis, lon.kind, lon.source, lon.start_s, lon.end_s) == ("lon", "sweep", "sids", 101.0, 135.0)
     assert (lon.f_min_hz, lon.f_max_hz) == (0.1, 10.0)
@@ -176,12 +181,12 @@ def test_a_run_ends_with_its_sidd_samples_and_a_run_without_any_is_dropped() -> 
                                                 (10, "lat"), (13, "thr"), (17, "lon"), (18, "lat")])
 def test_sid_axis_values_map_to_mixer_axes(sid_axis: int, axis: str) -> None:
     assert SID_AXES[sid_axis][0] == axis
-    assert segments_from_sid([SidsRow(0.0, sid_axis, 1.0, 1.0, 5.0, 1.0, 2.0, 10.0, 1.0)])[0].axis == axis
+    assert segments_from_sid([_run(0.0, sid_axis, 1.0, 1.0, 5.0, 1.0, 2.0, 10.0, 1.0)])[0].axis == axis
 
 
 def test_an_unknown_sid_axis_is_a_data_error() -> None:
     with pytest.raises(DataError, match="SID_AXIS=26 is not a known axis"):
-        segments_from_sid([SidsRow(3.0, 26, 1.0, 1.0, 5.0, 1.0, 2.0, 10.0, 1.0)])
+        segments_from_sid([_run(3.0, 26, 1.0, 1.0, 5.0, 1.0, 2.0, 10.0, 1.0)])
     with pytest.raises(DataError, match="lack the field"):
         segments_from_sid({"TimeUS": [0], "Ax": [1]})
 
@@ -265,8 +270,6 @@ def test_an_inconsistent_segment_is_rejected(kwargs: dict, fragment: str) -> Non
 
 
 def test_runs_from_the_dataflash_reader_are_accepted() -> None:
-    from flightlogs.ardupilot import SystemIdRun
-
     run = SystemIdRun(50.0, 80.0, 10, "mixer roll", 0.1, 0.5, 20.0, 2.0, 4.0, 40.0, 1.0)
     segment, = segments_from_sid([run])
     assert (segment.axis, segment.start_s, segment.end_s) == ("lat", 51.0, 80.0)  # ended early at the last SIDD

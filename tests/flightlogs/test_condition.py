@@ -1,0 +1,155 @@
+"""Conditioning against simulator truth: delays, clock offsets, segments, gaps, trim."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import signal as sps
+
+from flightlogs.anemometer import read_anemometer_csv
+from flightlogs.condition import ConditioningOptions, condition_flight
+from flightlogs.errors import DataError
+from flightlogs.flightlog import Signal
+from flightlogs.reader import read_log
+from sysid.sim.scenarios import write_demo_flight
+
+ONE_SAMPLE_S = 0.01 + 1e-9  # one sample at the 100 Hz log rate (plus float rounding)
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    files = write_demo_flight(tmp_path_factory.mktemp("demo"), clock_offset_s=1.5)
+    return {
+        "log": read_log(files.log),
+        "wind": read_anemometer_csv(files.wind_csv),
+        "truth": json.loads(files.truth.read_text()),
+    }
+
+
+def test_transport_delay_is_recovered_within_one_sample(demo: dict) -> None:
+    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
+    truth = demo["truth"]["anemometer"]["transport_delay_s"]
+    assert flight.wind is not None
+    assert abs(flight.wind.transport.delay_s - truth) < ONE_SAMPLE_S
+    assert flight.wind.transport.frozen_turbulence_holds
+
+
+def test_clock_offset_is_recovered_within_one_sample(demo: dict) -> None:
+    flight = condition_flight(
+        demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, estimate_wind_offset=True)
+    )
+    assert flight.wind is not None and flight.wind.clock_offset_source == "estimated"
+    assert flight.wind.residual_against == "autopilot wind estimate"
+    assert abs(flight.wind.clock_offset_s - demo["truth"]["anemometer"]["clock_offset_s"]) < ONE_SAMPLE_S
+
+
+def test_aligned_wind_matches_the_wind_at_the_vehicle(demo: dict) -> None:
+    """With the right offset and delay the anemometer reproduces the (logged) wind at the vehicle.
+
+    The comparison is below 2 Hz: a 20 Hz anemometer resolves gusts faithfully
+    only up to 0.4 x its Nyquist (4 Hz), so faster gust content is not its to
+    reproduce. What remains is the 0.01 m/s quantisation of the logged estimate.
+    """
+    sos = sps.butter(4, 2.0, fs=100.0, output="sos")
+
+    def rms_error(options: ConditioningOptions) -> float:
+        flight = condition_flight(demo["log"], demo["wind"], options)
+        errors = [sps.sosfiltfilt(sos, r.absolute("wind_n") - r.absolute("est_wind_n")) for r in flight.records]
+        return float(np.sqrt(np.mean(np.concatenate(errors) ** 2)))
+
+    aligned = rms_error(ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
+    clock_ignored = rms_error(ConditioningOptions(wind_distance_m=4.6))
+    delay_ignored = rms_error(ConditioningOptions(transport_delay_s=0.0, wind_offset_s=1.5))
+    assert aligned < 0.01
+    assert clock_ignored > 30 * aligned and delay_ignored > 30 * aligned
+
+
+def test_transport_delay_can_be_found_by_correlation(demo: dict) -> None:
+    """Assuming no delay, the residual against the autopilot's wind estimate is the transport delay."""
+    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(transport_delay_s=0.0, wind_offset_s=1.5))
+    assert flight.wind is not None and flight.wind.residual is not None
+    assert abs(flight.wind.residual.lag_s - demo["truth"]["anemometer"]["transport_delay_s"]) < ONE_SAMPLE_S
+
+
+def test_every_logged_sweep_is_found_exactly(demo: dict) -> None:
+    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
+    sweeps = [s for s in flight.segments if s.kind == "sweep"]
+    truth = [m for m in demo["truth"]["maneuvers"] if m["kind"] == "sweep"]
+    assert [(s.axis, s.source) for s in sweeps] == [(m["axis"], "sids") for m in truth]
+    for expected, found in zip(truth, sweeps):
+        assert abs(found.start_s - expected["start_s"]) <= ONE_SAMPLE_S
+        assert abs(found.end_s - expected["end_s"]) <= ONE_SAMPLE_S
+        assert (found.f_min_hz, found.f_max_hz) == pytest.approx((0.1, 10.0))
+
+
+def test_hover_is_found_between_maneuvers(demo: dict) -> None:
+    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
+    hover = [s for s in flight.segments if s.kind == "hover"]
+    truth = demo["truth"]["maneuvers"]
+    assert len(hover) >= len(truth) - 1
+    for segment in hover:  # no hover stretch overlaps a flown maneuver
+        assert all(segment.end_s <= m["start_s"] or segment.start_s >= m["end_s"] for m in truth)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 3, open: in closed loop the rate loop cancels a mixer-input doublet within ~0.2 s, "
+    "and detection from the mixer inputs alone misses some or misplaces a bound by up to 1 s",
+)
+def test_every_closed_loop_doublet_is_found_with_its_axis(demo: dict) -> None:
+    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
+    doublets = [s for s in flight.segments if s.kind == "doublet"]
+    truth = [m for m in demo["truth"]["maneuvers"] if m["kind"] == "doublet"]
+    assert [s.axis for s in doublets] == [m["axis"] for m in truth]
+    for expected, found in zip(truth, doublets):
+        assert abs(found.start_s - expected["start_s"]) <= 0.3
+        assert abs(found.end_s - expected["end_s"]) <= 0.3
+
+
+def test_records_are_uniform_with_trim_removed(demo: dict) -> None:
+    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
+    (record,) = flight.records
+    assert record.rate_hz == pytest.approx(100.0)
+    assert {"u", "v", "w", "wind_lon", "wind_lat", "p", "delta_thr"} <= set(record.signals)
+    assert record.trim["az"] == pytest.approx(-9.81, abs=0.05)  # hover: specific force = -g
+    hover = [s for s in flight.segments if s.kind == "hover"]
+    in_hover = np.zeros(record.time_s.size, dtype=bool)
+    raw = demo["log"]["delta_thr"]
+    raw_in_hover = np.zeros(raw.samples, dtype=bool)
+    for segment in hover:
+        in_hover |= (record.time_s >= segment.start_s) & (record.time_s <= segment.end_s)
+        raw_in_hover |= (raw.time_s >= segment.start_s) & (raw.time_s <= segment.end_s)
+    # the trim is the hover mean of the logged signal, and the record's hover stretches average to zero
+    assert record.trim["delta_thr"] == pytest.approx(raw.values[raw_in_hover].mean(), abs=1e-3)
+    assert abs(record["delta_thr"][in_hover].mean()) < 1e-9
+
+
+def test_a_gap_splits_the_record_and_is_reported(demo: dict) -> None:
+    log = demo["log"]
+    q = log["q"]
+    keep = (q.time_s < 60.0) | (q.time_s > 61.0)
+    gapped = replace(log, signals={**log.signals, "q": Signal("q", q.time_s[keep], q.values[keep], q.unit, q.source)})
+    flight = condition_flight(gapped)
+    assert len(flight.records) == 2
+    assert flight.records[0].end_s < 60.0 + ONE_SAMPLE_S and flight.records[1].start_s > 61.0 - ONE_SAMPLE_S
+    assert any(w.startswith("q: 1.0") and "record split" in w for w in flight.warnings)
+
+
+def test_no_gps_time_asks_for_the_wind_offset(demo: dict) -> None:
+    log = replace(demo["log"], utc_offset_s=None)
+    with pytest.raises(DataError, match="--wind-offset"):
+        condition_flight(log, demo["wind"], ConditioningOptions(wind_distance_m=4.6))
+
+
+def test_an_anemometer_off_by_hours_does_not_overlap(demo: dict) -> None:
+    with pytest.raises(DataError, match="does not overlap"):
+        condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=3 * 3600.0))
+
+
+def test_without_distance_or_delay_the_transport_delay_is_asked_for(demo: dict) -> None:
+    with pytest.raises(DataError, match="distance"):
+        condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_offset_s=1.5))
