@@ -149,6 +149,8 @@ def condition_flight(
     values = resample_signals(cut_by | others, time_base, max_gap_samples=options.max_gap_samples)
     for name, signal in others.items():
         values[name] = _hold_edges(values[name], time_base, 1.5 / signal.rate_hz if signal.rate_hz > 0 else 0.0)
+    if "excitation" in values:  # logged only while a System ID run injects it: zero elsewhere
+        values["excitation"] = np.nan_to_num(values["excitation"], nan=0.0)
     units = {name: sig.unit for name, sig in (cut_by | others).items()}
     if alignment is not None:
         alignment = _residual(alignment, time_base, values, rate_hz)

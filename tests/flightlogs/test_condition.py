@@ -116,6 +116,13 @@ def test_records_are_uniform_with_trim_removed(demo: dict) -> None:
     assert record.rate_hz == pytest.approx(100.0)
     assert {"u", "v", "w", "wind_lon", "wind_lat", "p", "delta_thr"} <= set(record.signals)
     assert record.trim["az"] == pytest.approx(-9.81, abs=0.05)  # hover: specific force = -g
+    # the excitation is logged only during System ID runs and is zero elsewhere
+    excitation = record.absolute("excitation")
+    sweeps = [s for s in flight.segments if s.source == "sids"]
+    outside = np.ones(record.time_s.size, dtype=bool)
+    for run in sweeps:
+        outside &= (record.time_s < run.start_s - 0.02) | (record.time_s > run.end_s + 0.02)
+    assert np.all(excitation[outside] == 0.0) and np.abs(excitation[~outside]).max() > 0.07
     hover = [s for s in flight.segments if s.kind == "hover"]
     in_hover = np.zeros(record.time_s.size, dtype=bool)
     raw = demo["log"]["delta_thr"]

@@ -1,0 +1,69 @@
+"""``sysid demo`` end to end, and ``sysid ingest`` with an anemometer."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from flightlogs.store import read_dataset
+from sysid_cli.main import cli
+
+
+@pytest.fixture(scope="module")
+def demo_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("demo")
+    result = CliRunner().invoke(cli, ["demo", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert f"dataset: {out / 'dataset.h5'}" in result.output
+    return out
+
+
+def test_demo_writes_the_flight_and_the_aligned_dataset(demo_dir: Path) -> None:
+    truth = json.loads((demo_dir / "truth.json").read_text())
+    summary = json.loads((demo_dir / "ingest.json").read_text())
+    alignment = summary["wind_alignment"]
+    assert alignment["clock_offset_source"] == "estimated"
+    assert abs(alignment["clock_offset_s"] - truth["anemometer"]["clock_offset_s"]) < 0.01
+    assert abs(alignment["transport_delay_s"] - truth["anemometer"]["transport_delay_s"]) < 0.01
+    assert [s["axis"] for s in summary["segments"] if s["kind"] == "sweep"] == ["lon", "lat", "yaw", "thr"]
+    dataset = read_dataset(demo_dir / "dataset.h5")
+    (flight,) = dataset.conditioned
+    assert flight.wind is not None and flight.wind.clock_offset_s == pytest.approx(alignment["clock_offset_s"], abs=1e-4)
+    assert [s.kind for s in flight.segments] == [s["kind"] for s in summary["segments"]]
+    (record,) = flight.records
+    assert record.time_s.size == summary["records"][0]["samples"]
+    assert {"u", "v", "w", "wind_lon", "wind_lat"} <= set(record.signals)
+
+
+@pytest.mark.parametrize(
+    ("extra", "fragment"),
+    [
+        (["--wind-distance", "4.6", "--wind-offset", "10800"], "no anemometer record overlaps"),
+        ([], "distance"),
+    ],
+)
+def test_wind_that_cannot_be_aligned_is_exit_1(demo_dir: Path, tmp_path: Path, extra: list[str], fragment: str) -> None:
+    out = tmp_path / "set.h5"
+    result = CliRunner().invoke(
+        cli, ["ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"), "-o", str(out), *extra]
+    )
+    assert result.exit_code == 1
+    assert "Traceback" not in result.output and fragment in result.stderr
+    assert not out.exists()
+
+
+def test_a_wind_folder_pairs_each_log_by_utc(demo_dir: Path, tmp_path: Path) -> None:
+    folder = tmp_path / "anemometers"
+    folder.mkdir()
+    (folder / "a.csv").write_text((demo_dir / "anemometer.csv").read_text())
+    (folder / "b.csv").write_text("utc,speed_m_s,direction_deg\n2020-01-01T00:00:00Z,1.0,90\n2020-01-01T00:00:01Z,1.0,90\n")
+    result = CliRunner().invoke(
+        cli, ["ingest", str(demo_dir / "flight.bin"), "--wind", str(folder), "--wind-distance", "4.6", "--json", "-", "-q"]
+    )
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert Path(summary["wind_alignment"]["wind_file"]).name == "a.csv"
+    assert len(summary["wind"]) == 2
