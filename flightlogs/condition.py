@@ -244,14 +244,15 @@ def _residual(alignment: WindAlignment, time_base: np.ndarray, values: dict[str,
     return alignment
 
 
-def _longest_finite_run(mask: np.ndarray) -> tuple[int, int]:
-    """Bounds [start, stop) of the longest run of True in `mask`."""
+def _true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Bounds [start, stop) of every run of True in `mask`, in order."""
     edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(np.int8), [0]])))
-    if edges.size == 0:
-        return 0, 0
-    starts, stops = edges[::2], edges[1::2]
-    best = int(np.argmax(stops - starts))
-    return int(starts[best]), int(stops[best])
+    return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def _longest_finite_run(mask: np.ndarray) -> tuple[int, int]:
+    """Bounds [start, stop) of the longest run of True in `mask` ((0, 0) if none)."""
+    return max(_true_runs(mask), key=lambda run: run[1] - run[0], default=(0, 0))
 
 
 def _with_estimated_offset(log: FlightLog, wind: Any, options: ConditioningOptions, first: WindAlignment) -> ConditionedFlight:
@@ -312,9 +313,8 @@ def _between(time_base: np.ndarray, logged: Sequence[Segment]) -> list[tuple[int
     free = np.ones(time_base.size, dtype=bool)
     for run in logged:
         free &= (time_base < run.start_s - 0.5) | (time_base > run.end_s + 0.5)
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], free.astype(np.int8), [0]])))
     rate = 1.0 / float(np.median(np.diff(time_base)))
-    return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2]) if (b - a) / rate >= _MIN_DETECTION_S]
+    return [(a, b) for a, b in _true_runs(free) if (b - a) / rate >= _MIN_DETECTION_S]
 
 
 def _overlaps(a: Segment, b: Segment) -> bool:

@@ -6,6 +6,7 @@ Layout (schema version 1)::
     /logs/<key>/                    attrs: path, sha256, log_format, autopilot, vehicle,
                                            utc_offset_s (NaN when unknown), warnings (JSON)
     /logs/<key>/parameters          compound dataset (name, value)
+    /logs/<key>/system_id_runs      compound dataset, one row per ArduPilot SIDS run (fields of SystemIdRun)
     /logs/<key>/signals/<name>/     attrs: unit, source
     /logs/<key>/signals/<name>/time_s   float64 (n_samples,), s, log clock
     /logs/<key>/signals/<name>/values   float64 (n_samples,), in `unit`
@@ -38,7 +39,7 @@ import numpy as np
 
 from .atomic import atomic_output
 from .errors import LogFormatError
-from .flightlog import FlightLog, Signal
+from .flightlog import FlightLog, Signal, SystemIdRun
 
 __all__ = ["Dataset", "write_dataset", "read_dataset", "file_sha256", "SCHEMA_VERSION"]
 
@@ -189,6 +190,8 @@ def _write_log(group: h5py.Group, log: FlightLog) -> None:
         dtype=[("name", h5py.string_dtype()), ("value", "f8")],
     )
     group.create_dataset("parameters", data=table)
+    runs = [dataclasses.astuple(run) for run in log.system_id_runs]
+    group.create_dataset("system_id_runs", data=np.array(runs, dtype=_RUN_DTYPE))
     signals = group.create_group("signals")
     for name, signal in log.signals.items():
         sub = signals.create_group(name)
@@ -211,6 +214,10 @@ def _read_log(group: h5py.Group) -> FlightLog:
         for row in table
     }
     offset = float(group.attrs["utc_offset_s"])
+    runs = tuple(
+        SystemIdRun(**{name: (_text(row[name]) if name == "axis_name" else row[name].item()) for name in _RUN_DTYPE.names})
+        for row in group["system_id_runs"][()]
+    ) if "system_id_runs" in group else ()
     return FlightLog(
         path=Path(group.attrs["path"]),
         log_format=str(group.attrs["log_format"]),  # type: ignore[arg-type]
@@ -220,7 +227,14 @@ def _read_log(group: h5py.Group) -> FlightLog:
         parameters=parameters,
         utc_offset_s=None if np.isnan(offset) else offset,
         warnings=tuple(json.loads(group.attrs["warnings"])),
+        system_id_runs=runs,
     )
+
+
+_RUN_DTYPE = np.dtype([
+    (f.name, h5py.string_dtype() if f.name == "axis_name" else ("i8" if f.name == "axis" else "f8"))
+    for f in dataclasses.fields(SystemIdRun)
+])
 
 
 def _write_dataclass(group: h5py.Group, item: Any) -> None:

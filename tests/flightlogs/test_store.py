@@ -106,3 +106,15 @@ def test_wind_measurements_round_trip(tmp_path: Path) -> None:
         wind.path, dict(wind.columns), wind.unit, wind.layout, wind.warnings
     )
     assert read_dataset(out).sha256[str(csv)] == hashlib.sha256(csv.read_bytes()).hexdigest()
+
+
+def test_system_id_runs_round_trip(tmp_path: Path) -> None:
+    from flightlogs.flightlog import SystemIdRun
+
+    runs = (SystemIdRun(25.0, 59.99, 11, "mixer pitch", 0.08, 0.1, 10.0, 5.0, 0.0, 34.0, 1.0),
+            SystemIdRun(75.0, float("nan"), 10, "mixer roll", 0.08, 0.1, 10.0, 5.0, 0.0, 34.0, 1.0))
+    log = FlightLog(tmp_path / "sid.bin", "dataflash", "ardupilot", {}, system_id_runs=runs)
+    write_dataset(tmp_path / "sid.h5", [log])
+    back = read_dataset(tmp_path / "sid.h5").logs[0].system_id_runs
+    assert back[0] == runs[0]
+    assert back[1].axis_name == "mixer roll" and np.isnan(back[1].end_s)
