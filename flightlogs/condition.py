@@ -9,7 +9,8 @@ The steps, in order (chapter 3 of the dissertation, section 3.3.3):
    axes ``wind_lon wind_lat``;
 4. the flight cut where a core signal has a gap, never interpolated across;
 5. maneuvers found (ArduPilot System ID runs, else detected from the mixer
-   inputs, or given by the user) and hover stretches;
+   inputs with the controller's state feedback removed, see
+   :mod:`flightlogs.excitation`, or given by the user) and hover stretches;
 6. trim (mean over hover, else over the record) removed and kept.
 """
 
@@ -25,6 +26,7 @@ import pandas as pd
 
 from .align import WindAlignment, estimate_residual_offset, wind_log_time
 from .errors import DataError
+from .excitation import estimate_excitation
 from .flightlog import FlightLog, Signal
 from .frames import air_velocity_body, wind_to_body_axes
 from .record import Record
@@ -292,13 +294,32 @@ def _segments(log: FlightLog, time_base: np.ndarray, values: dict[str, np.ndarra
     if options.segments is not None:
         return tuple(sorted(options.segments, key=lambda s: s.start_s))
     logged = segments_from_sid(log.system_id_runs) if log.system_id_runs else ()
-    inputs = {axis: np.nan_to_num(values[name]) for axis, name in _MIXER.items() if name in values}
+    inputs = {axis: values[name] for axis, name in _MIXER.items() if name in values}
+    if not inputs:
+        return tuple(logged)
+    pieces = _between(time_base, logged)
+    quiet = np.zeros(time_base.size, dtype=bool)
+    for start, stop in pieces:
+        quiet[start:stop] = True
     detected: list[Segment] = []
-    if inputs:
-        for start, stop in _between(time_base, logged):
-            detected.extend(detect_segments(time_base[start:stop], {a: x[start:stop] for a, x in inputs.items()}))
+    for _ in range(2):  # fit the feedback where nothing is excited, detect, refit without what was found
+        excitation = estimate_excitation(inputs, values, quiet & ~_near(time_base, detected, 2.0))
+        detected = [
+            segment
+            for start, stop in pieces
+            for segment in detect_segments(time_base[start:stop], {a: x[start:stop] for a, x in excitation.items()})
+        ]
     kept = [s for s in detected if not any(_overlaps(s, run) for run in logged)]
     return tuple(sorted([*logged, *kept], key=lambda s: s.start_s))
+
+
+def _near(time_base: np.ndarray, segments: Sequence[Segment], margin_s: float) -> np.ndarray:
+    """Samples within `margin_s` of a maneuver (hover stretches excepted)."""
+    mask = np.zeros(time_base.size, dtype=bool)
+    for segment in segments:
+        if segment.kind != "hover":
+            mask |= (time_base >= segment.start_s - margin_s) & (time_base <= segment.end_s + margin_s)
+    return mask
 
 
 _MIN_DETECTION_S = 5.0

@@ -117,6 +117,24 @@ def _axis_models(p: Mapping[str, float]) -> dict[str, tuple[np.ndarray, np.ndarr
     }
 
 
+def _trim_states(
+    models: dict[str, tuple[np.ndarray, np.ndarray]], gains: dict[str, np.ndarray], wind_ne: np.ndarray
+) -> dict[str, np.ndarray]:
+    """Equilibrium of each loop in a steady wind, so a flight starts in trim rather than in a transient.
+
+    The controller feeds back ground velocity (airspeed + wind): x' = (A - B K) x - B K d = 0 with
+    d the wind on the velocity state.
+    """
+    states = {}
+    for axis, (a, b) in models.items():
+        disturbance = np.zeros(a.shape[0])
+        if axis in ("lon", "lat"):
+            disturbance[0] = wind_ne[0] if axis == "lon" else wind_ne[1]
+        k = gains[axis][None, :]
+        states[axis] = np.linalg.solve(a - b @ k, b @ k @ disturbance)
+    return states
+
+
 def _lqr(a: np.ndarray, b: np.ndarray, weights: np.ndarray) -> np.ndarray:
     x = linalg.solve_continuous_are(a, b, np.diag(weights), np.eye(1) * 0.02)
     return (b.T @ x / 0.02).ravel()
@@ -176,7 +194,7 @@ def simulate_hover(
     gains = {axis: _lqr(*models[axis], np.array(_WEIGHTS[axis])) for axis in _AXES}
     delays = {axis: int(round(parameters.get(f"tau_{axis}", 0.0) / dt)) for axis in _AXES}
     excitation = {axis: excitation_signal(t_fine, maneuvers, axis) for axis in _AXES}
-    states = {axis: np.zeros(models[axis][0].shape[0]) for axis in _AXES}
+    states = _trim_states(models, gains, wind_ne[: max(1, int(round(1.0 / dt)))].mean(axis=0))
     history = {axis: np.zeros(n_fine) for axis in _AXES}
     names = ("u", "v", "w", "p", "q", "r", "phi", "theta", "psi", "ax", "ay", "az", "height_agl")
     log = {name: np.zeros(n_fine) for name in names}

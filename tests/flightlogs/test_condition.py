@@ -95,19 +95,31 @@ def test_hover_is_found_between_maneuvers(demo: dict) -> None:
         assert all(segment.end_s <= m["start_s"] or segment.start_s >= m["end_s"] for m in truth)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 3, open: in closed loop the rate loop cancels a mixer-input doublet within ~0.2 s, "
-    "and detection from the mixer inputs alone misses some or misplaces a bound by up to 1 s",
-)
-def test_every_closed_loop_doublet_is_found_with_its_axis(demo: dict) -> None:
-    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
-    doublets = [s for s in flight.segments if s.kind == "doublet"]
-    truth = [m for m in demo["truth"]["maneuvers"] if m["kind"] == "doublet"]
-    assert [s.axis for s in doublets] == [m["axis"] for m in truth]
-    for expected, found in zip(truth, doublets):
-        assert abs(found.start_s - expected["start_s"]) <= 0.3
-        assert abs(found.end_s - expected["end_s"]) <= 0.3
+@pytest.mark.slow
+def test_closed_loop_doublets_over_twelve_flights(tmp_path: Path) -> None:
+    """Doublets the rate loop cancels in the mixer input, found from the excitation left once the
+    fitted state feedback is removed, over 12 simulated flights (48 doublets).
+
+    Measured when written (issue 3, open for the rest): within 0.3 s at both ends, yaw 12/12,
+    roll 10/12, pitch 9/12, thrust 7/12, and no spurious maneuver. The floors below are those
+    counts, so a regression shows; "every doublet" is not reached yet.
+    """
+    found = {"lat": 0, "lon": 0, "yaw": 0, "thr": 0}
+    for seed in range(1, 13):
+        files = write_demo_flight(tmp_path / str(seed), seed=seed)
+        flight = condition_flight(read_log(files.log))
+        truth = [m for m in json.loads(files.truth.read_text())["maneuvers"] if m["kind"] == "doublet"]
+        maneuvers = [s for s in flight.segments if s.kind not in ("hover", "sweep")]
+        for m in truth:
+            found[m["axis"]] += any(
+                s.axis == m["axis"] and s.kind == "doublet"
+                and abs(s.start_s - m["start_s"]) <= 0.3 and abs(s.end_s - m["end_s"]) <= 0.3
+                for s in maneuvers
+            )
+        near_truth = [s for s in maneuvers if any(abs(s.start_s - m["start_s"]) < 1.5 for m in truth)]
+        assert near_truth == maneuvers, f"seed {seed}: spurious {set(maneuvers) - set(near_truth)}"
+    assert found["yaw"] == 12
+    assert found["lat"] >= 10 and found["lon"] >= 9 and found["thr"] >= 7
 
 
 def test_records_are_uniform_with_trim_removed(demo: dict) -> None:
