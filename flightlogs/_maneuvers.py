@@ -268,8 +268,13 @@ def _lobes(x: np.ndarray, t: np.ndarray, h: float) -> list[tuple[int, float, flo
 
 
 def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float) -> tuple | None:
-    """(kind, f_min_hz, f_max_hz) of the maneuver on samples [lo, hi], or None for no known kind."""
-    lobes = _lobes(act.detrended[lo : hi + 1], t[lo : hi + 1], threshold * act.sigma)
+    """(kind, f_min_hz, f_max_hz[, (first, last)]) of the maneuver on samples [lo, hi], or None.
+
+    Doublets come with refined bounds: the first and last sample of their two
+    lobes that stand out of the noise, since their edges are steps.
+    """
+    x, h = act.detrended[lo : hi + 1], threshold * act.sigma
+    lobes = _lobes(x, t[lo : hi + 1], h)
     if len(lobes) >= 8:
         return _oscillation(lobes)
     if not lobes:
@@ -280,21 +285,30 @@ def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float)
     if big.size == 2 and big[1] == big[0] + 1:
         area_ratio, time_ratio = areas[big[1]] / areas[big[0]], durations[big[1]] / durations[big[0]]
         if 1 / 3 <= area_ratio <= 3 and 1 / 3 <= time_ratio <= 3:
-            return "doublet", None, None
+            return "doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h)
     if big.size == 3 and np.all(np.diff(big) == 1):
         # closed loop: the rate loop cancels each edge of the doublet, leaving +, -, + (middle largest);
         # the third lobe is the recovery after the doublet has ended
         signs = [lobes[i][0] for i in big]
         if signs[0] == signs[2] == -signs[1] and areas[big[1]] == areas[big].max():
-            return "doublet", None, None, _span(t, lo, lobes[big[0]][1], lobes[big[1]][2])
-    pair = _dominant_pair(lobes, areas)
+            return "doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h)
     if big.size == 4 and np.all(np.diff(big) == 1):
         unit = durations[big].sum() / 7.0
         if np.all(np.abs(durations[big] / unit - [3, 2, 1, 1]) <= [1.0, 0.7, 0.4, 0.4]):
             return "3211", None, None
+    pair = _dominant_pair(lobes, areas)
     if pair is not None:
-        return "doublet", None, None, _span(t, lo, lobes[pair][1], lobes[pair + 1][2])
+        return "doublet", None, None, _loud_span(x, t, lo, lobes[pair], lobes[pair + 1], h)
     return None
+
+
+def _loud_span(x: np.ndarray, t: np.ndarray, lo: int, first: tuple, second: tuple, h: float) -> tuple[int, int]:
+    """Absolute indices of the first and last sample above `h` in magnitude from lobe `first` to `second`."""
+    local = t[lo : lo + x.size]
+    inside = np.flatnonzero((local >= first[1]) & (local <= second[2]) & (np.abs(x) > h))
+    if inside.size == 0:
+        return _span(t, lo, first[1], second[2])
+    return lo + int(inside[0]), lo + int(inside[-1])
 
 
 def _dominant_pair(lobes: list, areas: np.ndarray) -> int | None:

@@ -100,9 +100,10 @@ def test_closed_loop_doublets_over_twelve_flights(tmp_path: Path) -> None:
     """Doublets the rate loop cancels in the mixer input, found from the excitation left once the
     fitted state feedback is removed, over 12 simulated flights (48 doublets).
 
-    Measured when written (issue 3, open for the rest): within 0.3 s at both ends, yaw 12/12,
-    roll 10/12, pitch 9/12, thrust 7/12, and no spurious maneuver. The floors below are those
-    counts, so a regression shows; "every doublet" is not reached yet.
+    Measured when written: roll, pitch and yaw 12/12 and thrust 11/12, every one found with both
+    ends within one sample (10 ms) of the truth, and no spurious maneuver. The one thrust doublet
+    missed (seed 7) recovers lopsided (lobe areas 3.0:1) and is left unclassified. The floors
+    below are those counts, so a regression shows.
     """
     found = {"lat": 0, "lon": 0, "yaw": 0, "thr": 0}
     for seed in range(1, 13):
@@ -113,13 +114,13 @@ def test_closed_loop_doublets_over_twelve_flights(tmp_path: Path) -> None:
         for m in truth:
             found[m["axis"]] += any(
                 s.axis == m["axis"] and s.kind == "doublet"
-                and abs(s.start_s - m["start_s"]) <= 0.3 and abs(s.end_s - m["end_s"]) <= 0.3
+                and abs(s.start_s - m["start_s"]) <= 0.05 and abs(s.end_s - m["end_s"]) <= 0.05
                 for s in maneuvers
             )
         near_truth = [s for s in maneuvers if any(abs(s.start_s - m["start_s"]) < 1.5 for m in truth)]
         assert near_truth == maneuvers, f"seed {seed}: spurious {set(maneuvers) - set(near_truth)}"
-    assert found["yaw"] == 12
-    assert found["lat"] >= 10 and found["lon"] >= 9 and found["thr"] >= 7
+    assert (found["lat"], found["lon"], found["yaw"]) == (12, 12, 12)
+    assert found["thr"] >= 11
 
 
 def test_records_are_uniform_with_trim_removed(demo: dict) -> None:
