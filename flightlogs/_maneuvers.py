@@ -330,7 +330,7 @@ def _dominant_pair(lobes: list, areas: np.ndarray) -> int | None:
 def _span(t: np.ndarray, lo: int, begin_s: float, end_s: float) -> tuple[int, int]:
     """Sample indices (absolute) of the times `begin_s`..`end_s` inside the burst starting at `lo`."""
     del lo  # t is the full time base; kept for symmetry with the caller's indices
-    return int(np.searchsorted(t, begin_s)), int(min(np.searchsorted(t, end_s), t.size - 1))
+    return int(np.searchsorted(t, begin_s)), min(int(np.searchsorted(t, end_s)), t.size - 1)
 
 
 def _oscillation(lobes: list) -> tuple:

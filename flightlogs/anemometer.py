@@ -305,7 +305,7 @@ def _find_header(path: Path, header: list[str], name: str, key: str) -> str:
 
 def _speed_unit_name(unit: str) -> str:
     alias = _UNIT_ALIASES.get(re.sub(r"\s", "", unit.lower()))
-    if alias not in SPEED_UNITS:
+    if alias is None or alias not in SPEED_UNITS:
         raise ValueError(f"speed unit {unit!r} is not one of {sorted(SPEED_UNITS)} "
                          "(or their aliases)")
     return alias

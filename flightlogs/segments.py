@@ -371,7 +371,8 @@ def _sids_runs(runs: Sequence[SystemIdRun] | Mapping[str, Any]) -> list[SystemId
     if missing:
         raise DataError(f"SIDS rows lack the field(s) {', '.join(missing)}")
     columns = {ours: np.asarray(runs[name], dtype=np.float64) for name, ours in _SID_FIELDS.items()}
-    rows = [SystemIdRun(float(t), float("nan"), axis_name="", **{k: float(v[i]) for k, v in columns.items()})
+    rows = [SystemIdRun(float(t), float("nan"), int(columns["axis"][i]), "",
+                        *(float(columns[k][i]) for k in _SID_FIELDS.values() if k != "axis"))
             for i, t in enumerate(times)]
     return [replace(run, axis_name=_axis_name(run.axis)) for run in map(_checked_run, rows)]
 

@@ -32,7 +32,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import h5py
 import numpy as np
@@ -214,10 +214,7 @@ def _read_log(group: h5py.Group) -> FlightLog:
         for row in table
     }
     offset = float(group.attrs["utc_offset_s"])
-    runs = tuple(
-        SystemIdRun(**{name: (_text(row[name]) if name == "axis_name" else row[name].item()) for name in _RUN_DTYPE.names})
-        for row in group["system_id_runs"][()]
-    ) if "system_id_runs" in group else ()
+    runs = tuple(_run_from_row(row) for row in group["system_id_runs"][()]) if "system_id_runs" in group else ()
     return FlightLog(
         path=Path(group.attrs["path"]),
         log_format=str(group.attrs["log_format"]),  # type: ignore[arg-type]
@@ -235,6 +232,12 @@ _RUN_DTYPE = np.dtype([
     (f.name, h5py.string_dtype() if f.name == "axis_name" else ("i8" if f.name == "axis" else "f8"))
     for f in dataclasses.fields(SystemIdRun)
 ])
+
+
+def _run_from_row(row: np.void) -> SystemIdRun:
+    numbers = [float(row[name]) for name in ("magnitude", "f_start_hz", "f_stop_hz", "fade_in_s", "const_s",
+                                              "record_s", "fade_out_s")]
+    return SystemIdRun(float(row["start_s"]), float(row["end_s"]), int(row["axis"]), _text(row["axis_name"]), *numbers)
 
 
 def _write_dataclass(group: h5py.Group, item: Any) -> None:
@@ -330,8 +333,9 @@ def _read_conditioned(group: h5py.Group) -> Any:
 
     segments = tuple(
         Segment(
-            _text(row["axis"]) or None, _text(row["kind"]), float(row["start_s"]), float(row["end_s"]),
-            _text(row["source"]), None if np.isnan(row["f_min_hz"]) else float(row["f_min_hz"]),
+            cast(Any, _text(row["axis"]) or None), cast(Any, _text(row["kind"])), float(row["start_s"]),
+            float(row["end_s"]), cast(Any, _text(row["source"])),
+            None if np.isnan(row["f_min_hz"]) else float(row["f_min_hz"]),
             None if np.isnan(row["f_max_hz"]) else float(row["f_max_hz"]), _text(row["detail"]),
         )
         for row in group["segments"][()]

@@ -7,7 +7,7 @@ from typing import Literal
 
 import numpy as np
 
-__all__ = ["Maneuver", "sweep", "doublet", "excitation_signal"]
+__all__ = ["Axis", "Maneuver", "sweep", "doublet", "excitation_signal"]
 
 Axis = Literal["lat", "lon", "yaw", "thr"]
 

@@ -15,7 +15,7 @@ from typing import Mapping
 import numpy as np
 from scipy import linalg, signal as sps
 
-from .excitation import Maneuver, excitation_signal, sweep
+from .excitation import Axis, Maneuver, excitation_signal, sweep
 
 __all__ = ["CALM_HOVER", "LIGHT_WIND_TERMS", "WindField", "SimulatedFlight", "simulate_hover"]
 
@@ -32,7 +32,7 @@ CALM_HOVER: Mapping[str, float] = MappingProxyType({
 LIGHT_WIND_TERMS: Mapping[str, float] = MappingProxyType(
     {"X_w_lon": -0.1486, "Z_w_lon": 0.8451, "tau_w_lon": 0.0178, "tau_w_thr": 0.0386}
 )
-_AXES = ("lat", "lon", "yaw", "thr")
+_AXES: tuple[Axis, ...] = ("lat", "lon", "yaw", "thr")
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,7 +118,7 @@ def _axis_models(p: Mapping[str, float]) -> dict[str, tuple[np.ndarray, np.ndarr
 
 
 def _trim_states(
-    models: dict[str, tuple[np.ndarray, np.ndarray]], gains: dict[str, np.ndarray], wind_ne: np.ndarray
+    models: Mapping[str, tuple[np.ndarray, np.ndarray]], gains: Mapping[str, np.ndarray], wind_ne: np.ndarray
 ) -> dict[str, np.ndarray]:
     """Equilibrium of each loop in a steady wind, so a flight starts in trim rather than in a transient.
 
@@ -191,7 +191,7 @@ def simulate_hover(
     terms = dict(wind_terms or {})
     models = _axis_models(parameters)
     discrete = {axis: sps.cont2discrete((a, b, np.eye(a.shape[0]), 0), dt)[:2] for axis, (a, b) in models.items()}
-    gains = {axis: _lqr(*models[axis], np.array(_WEIGHTS[axis])) for axis in _AXES}
+    gains: dict[str, np.ndarray] = {axis: _lqr(*models[axis], np.array(_WEIGHTS[axis])) for axis in _AXES}
     delays = {axis: int(round(parameters.get(f"tau_{axis}", 0.0) / dt)) for axis in _AXES}
     excitation = {axis: excitation_signal(t_fine, maneuvers, axis) for axis in _AXES}
     states = _trim_states(models, gains, wind_ne[: max(1, int(round(1.0 / dt)))].mean(axis=0))

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
-from .excitation import Maneuver
+from .excitation import Axis, Maneuver
 from .linear_flight import CALM_HOVER, LIGHT_WIND_TERMS, WindField, simulate_hover
 from .logwriters import AnemometerSetup, write_anemometer_csv, write_ardupilot_log, write_truth
 
@@ -46,7 +46,10 @@ def demo_maneuvers() -> tuple[Maneuver, ...]:
     plan = []
     start = 6.0
     # doublets sized well above the gust-driven control activity (about 2.5 % RMS), as a test engineer would
-    for axis, sweep_pct, doublet_pct in (("lon", 8.0, 15.0), ("lat", 8.0, 15.0), ("yaw", 10.0, 15.0), ("thr", 4.0, 8.0)):
+    amplitudes: tuple[tuple[Axis, float, float], ...] = (
+        ("lon", 8.0, 15.0), ("lat", 8.0, 15.0), ("yaw", 10.0, 15.0), ("thr", 4.0, 8.0)
+    )
+    for axis, sweep_pct, doublet_pct in amplitudes:
         plan.append(Maneuver(axis, "sweep", start, sweep_pct, 34.0))
         plan.append(Maneuver(axis, "doublet", start + 40.0, doublet_pct, 2.0))
         start += 50.0
