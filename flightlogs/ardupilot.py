@@ -15,6 +15,7 @@ canonical                     DataFlash source
 ``height_agl``                RFND Dist / Dist1, else CTUN Alt (above home)
 ``vn ve vd``                  XKF1 / NKF1 / EKF1 VN VE VD (core 0)
 ``est_wind_n/e``              XKF2 / NKF2 / EKF2 VWN VWE (core 0)
+``latitude longitude``        GPS Lat, Lng (instance 0, Status ≥ 3, deg → rad)
 ``excitation``                SIDD Targ
 ============================  ================================================
 
@@ -41,6 +42,7 @@ __all__ = ["read_dataflash", "flightlog_from_messages", "SystemIdRun", "system_i
 
 _TYPES = ("IMU", "ATT", "RATE", "CTUN", "RCOU", "BAT", "CURR", "RFND", "XKF1", "XKF2", "NKF1", "NKF2",
           "EKF1", "EKF2", "GPS", "SIDD", "SIDS", "PARM", "MSG")
+_GPS_FIX_3D = 3  # GPS.Status: 3 = 3-D fix, 4-6 DGPS and RTK
 _GPS_EPOCH_UNIX = 315964800  # 1980-01-06T00:00:00Z
 _LEAP_DATES = ("1981-07", "1982-07", "1983-07", "1985-07", "1988-01", "1990-01", "1991-01", "1992-07",
                "1993-07", "1994-07", "1996-01", "1997-07", "1999-01", "2006-01", "2009-01", "2012-07",
@@ -118,6 +120,7 @@ def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
     n_motors = _map_motors(messages, parameters, add)
     _map_battery_height(messages, add)
     _map_estimator(messages, parameters, add, warnings)
+    _map_position(messages, add, warnings)
     runs = system_id_runs(messages)
     _map_excitation(messages, runs, add)
     return FlightLog(messages.path, "dataflash", "ardupilot", signals, _vehicle(messages, parameters, n_motors),
@@ -254,6 +257,24 @@ def _map_estimator(messages: DataFlashMessages, parameters: dict[str, float], ad
             if not np.any(wind[0]["VWN"]) and not np.any(wind[0]["VWE"]):
                 warnings.append(f"{wind[1]}: the EKF wind estimate is zero throughout (not estimated).")
         return
+
+
+def _map_position(messages: DataFlashMessages, add: _Add, warnings: list[str]) -> None:
+    """GNSS latitude and longitude where the receiver has a 3-D fix (Status ≥ 3)."""
+    found = _first_instance(messages, "GPS")
+    if found is None or not {"Status", "Lat", "Lng"} <= set(found[0].columns):
+        return
+    table, label = found
+    fixed = table["Status"] >= _GPS_FIX_3D
+    if not fixed.any():
+        warnings.append(f"{label}: the receiver never had a 3-D fix (Status < 3); no position read.")
+        return
+    if not fixed.all():
+        warnings.append(f"{label}.Lat, Lng: dropped {int((~fixed).sum())} of {fixed.size} samples "
+                        "without a 3-D fix (Status < 3).")
+    table = table.select(fixed)
+    add("latitude", table, "Lat", "rad", f"{label}.Lat (deg→rad, Status ≥ 3)", np.deg2rad)
+    add("longitude", table, "Lng", "rad", f"{label}.Lng (deg→rad, Status ≥ 3)", np.deg2rad)
 
 
 def _map_excitation(messages: DataFlashMessages, runs: tuple[SystemIdRun, ...], add: _Add) -> None:

@@ -4,7 +4,9 @@ The steps, in order (chapter 3 of the dissertation, section 3.3.3):
 
 1. one uniform time base, by default at the rate of the fastest core signal;
 2. the anemometer wind put on the log's clock (UTC pairing, clock offset,
-   transport delay of Taylor's frozen turbulence) and resampled onto it;
+   transport delay of Taylor's frozen turbulence, over a distance given or
+   found from the anemometer's and the vehicle's GPS positions) and
+   resampled onto it;
 3. the body air-relative velocity ``u v w`` of eq. 3.1 and the wind in body
    axes ``wind_lon wind_lat``;
 4. the flight cut where a core signal has a gap, never interpolated across;
@@ -32,13 +34,17 @@ from .frames import air_velocity_body, wind_to_body_axes
 from .record import Record
 from .resample import contiguous_spans, resample_signals, uniform_time_base
 from .segments import Segment, detect_segments, segments_from_sid
-from .timing import transport_delay
+from .timing import TransportDelay, bearing_and_distance, transport_delay
 
 __all__ = ["ConditioningOptions", "ConditionedFlight", "condition_flight", "CORE_SIGNALS"]
 
 #: Signals whose gaps cut a record; the time base follows the fastest of them.
 CORE_SIGNALS = ("p", "q", "r", "phi", "theta", "psi", "ax", "ay", "az", "delta_lat", "delta_lon", "delta_yaw", "delta_thr")
 _MIXER = {"lat": "delta_lat", "lon": "delta_lon", "yaw": "delta_yaw", "thr": "delta_thr"}
+#: Where the vehicle is: used for the anemometer geometry, not carried into the records.
+_POSITION = ("latitude", "longitude")
+_EARTH_RADIUS_M = 6_371_008.8
+_MAX_GPS_DISTANCE_M = 1000.0  # farther, the anemometer's position is more likely mistyped than meant
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,6 +65,12 @@ class ConditioningOptions:
     wind_bearing_rad : float or None
         Direction from the anemometer to the vehicle, rad from north; None for
         straight upstream.
+    anemometer_position_rad : tuple of (float, float) or None
+        WGS-84 latitude and longitude of the anemometer, rad. Without
+        `wind_distance_m` and `transport_delay_s`, the distance and bearing
+        come from it to the vehicle's mean GNSS position (signals
+        ``latitude``, ``longitude``) while the anemometer record overlaps the
+        flight.
     transport_delay_s : float or None
         Transport delay to use instead of distance / mean speed, s.
     max_gap_samples : float
@@ -75,10 +87,19 @@ class ConditioningOptions:
     estimate_wind_offset: bool = False
     wind_distance_m: float | None = None
     wind_bearing_rad: float | None = None
+    anemometer_position_rad: tuple[float, float] | None = None
     transport_delay_s: float | None = None
     max_gap_samples: float = 5
     min_record_s: float = 2.0
     segments: tuple[Segment, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.anemometer_position_rad is not None:
+            lat, lon = (float(v) for v in self.anemometer_position_rad)
+            if not (abs(lat) <= np.pi / 2 and abs(lon) <= np.pi):
+                raise ValueError(f"anemometer_position_rad={self.anemometer_position_rad} must be a latitude "
+                                 "within ±π/2 and a longitude within ±π, rad")
+            object.__setattr__(self, "anemometer_position_rad", (lat, lon))
 
 
 @dataclass(frozen=True, slots=True)
@@ -139,7 +160,7 @@ def condition_flight(
     core = {name: _unwrapped(log.signals[name]) for name in CORE_SIGNALS if name in log.signals}
     if not core:
         raise DataError(f"{log.path}: none of the core signals ({', '.join(CORE_SIGNALS)}) is in the log")
-    others = {n: s for n, s in log.signals.items() if n not in core}
+    others = {n: s for n, s in log.signals.items() if n not in core and n not in _POSITION}
     alignment, wind_signals = (None, {}) if wind is None else _wind_signals(log, wind, options, notes)
     cut_by = core | wind_signals
     time_base = uniform_time_base(cut_by, rate_hz=options.rate_hz)
@@ -209,10 +230,7 @@ def _wind_signals(
     if during.sum() < 2:
         raise DataError(f"{wind.path}: the anemometer record does not overlap {log.path.name} in time")
     wind_ne = np.column_stack([wind.wind_n, wind.wind_e])
-    delay = transport_delay(
-        wind_ne[during], distance_m=options.wind_distance_m, bearing_rad=options.wind_bearing_rad,
-        delay_s=options.transport_delay_s,
-    )
+    delay = _transport_delay(log, wind_ne[during], raw_time[during], options, notes)
     if not delay.frozen_turbulence_holds:
         notes.append(
             f"{wind.path}: sigma_M/M = {delay.turbulence_ratio:.2f} is not below 0.5, so Taylor's frozen "
@@ -226,6 +244,61 @@ def _wind_signals(
         for name, column, label in (("wind_n", wind.wind_n, "north"), ("wind_e", wind.wind_e, "east"))
     }
     return alignment, series
+
+
+def _transport_delay(
+    log: FlightLog, wind_ne: np.ndarray, wind_time_s: np.ndarray, options: ConditioningOptions, notes: list[str]
+) -> TransportDelay:
+    """Distance / mean speed along the line, the line from the options or from GNSS positions."""
+    if options.anemometer_position_rad is None or options.transport_delay_s is not None:
+        return transport_delay(wind_ne, distance_m=options.wind_distance_m, bearing_rad=options.wind_bearing_rad,
+                               delay_s=options.transport_delay_s)
+    if options.wind_distance_m is not None:
+        notes.append("the anemometer-to-vehicle distance was given (--wind-distance): the anemometer's "
+                     "position is not used")
+        return transport_delay(wind_ne, distance_m=options.wind_distance_m, bearing_rad=options.wind_bearing_rad)
+    if options.wind_bearing_rad is not None:
+        notes.append("the bearing from the anemometer to the vehicle comes from their positions; "
+                     "--wind-bearing is not used")
+    bearing, distance = _gps_geometry(log, options.anemometer_position_rad, wind_time_s, notes)
+    return replace(transport_delay(wind_ne, distance_m=distance, bearing_rad=bearing), source="gps")
+
+
+def _gps_geometry(
+    log: FlightLog, anemometer_rad: tuple[float, float], wind_time_s: np.ndarray, notes: list[str]
+) -> tuple[float, float]:
+    """Bearing (rad) and distance (m) from the anemometer to the vehicle's mean position while the wind overlaps."""
+    if not set(_POSITION) <= log.signals.keys():
+        raise DataError(
+            f"{log.path}: the log holds no GNSS position (latitude, longitude), so the anemometer-to-vehicle "
+            "distance cannot be found from the anemometer's position; give --wind-distance"
+        )
+    lat_signal, lon_signal = log.signals["latitude"], log.signals["longitude"]
+    time_s = lat_signal.time_s
+    inside = (time_s >= wind_time_s[0]) & (time_s <= wind_time_s[-1])
+    if not inside.any():
+        inside = np.ones(time_s.size, dtype=bool)
+    lat = lat_signal.values[inside]
+    lon = np.interp(time_s[inside], lon_signal.time_s, lon_signal.values)
+    mean_lat = float(lat.mean())
+    mean_lon = float(np.arctan2(np.sin(lon).mean(), np.cos(lon).mean()))  # across ±180° too
+    bearing, distance = bearing_and_distance(*anemometer_rad, mean_lat, mean_lon)
+    if distance > _MAX_GPS_DISTANCE_M:
+        raise DataError(
+            f"{log.path}: the anemometer ({np.degrees(anemometer_rad[0]):.6f}, {np.degrees(anemometer_rad[1]):.6f}) "
+            f"is {distance / 1000:.1f} km from the vehicle's mean GPS position ({np.degrees(mean_lat):.6f}, "
+            f"{np.degrees(mean_lon):.6f}), too far for its wind to stand for the vehicle's; check the "
+            "anemometer's position (latitude first, degrees) or give --wind-distance"
+        )
+    north = (lat - mean_lat) * _EARTH_RADIUS_M
+    east = np.angle(np.exp(1j * (lon - mean_lon))) * _EARTH_RADIUS_M * np.cos(mean_lat)
+    spread = float(np.hypot(north, east).max())
+    if spread > 0.5 * distance:
+        notes.append(
+            f"{log.path.name}: the vehicle moved up to {spread:.1f} m from its mean position, which is "
+            f"{distance:.1f} m from the anemometer: one transport delay is a rough stand-in for a varying one"
+        )
+    return bearing, distance
 
 
 def _residual(alignment: WindAlignment, time_base: np.ndarray, values: dict[str, np.ndarray], rate_hz: float) -> WindAlignment:

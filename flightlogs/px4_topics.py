@@ -7,13 +7,16 @@ chosen ``topic[instance].field`` is recorded as the signal's ``source``.
 Motor commands (:data:`PX4_MOTOR_SOURCES`) have a variable channel count and
 are handled apart.
 
-Conventions (PX4's): body axes FRD, earth axes NED, SI units, radians. Two
-choices made here:
+Conventions (PX4's): body axes FRD, earth axes NED, SI units, radians.
+Choices made here:
 
 * ``delta_thr`` is ``-vehicle_thrust_setpoint.xyz[2]``: PX4 logs the thrust
   along body z (negative up), the sign is flipped so that more thrust is
   positive, as it already is in the old ``actuator_controls_0.control[3]``.
   The source string carries the minus sign.
+* ``latitude longitude`` prefer the estimator's ``vehicle_global_position``
+  (samples with ``lat_lon_valid`` set), then the receiver's ``sensor_gps``
+  or ``vehicle_gps_position`` (samples with ``fix_type`` ≥ 3, a 3-D fix).
 * ``height_agl`` prefers a downward rangefinder (``distance_sensor``), then
   the estimator's ``dist_bottom`` when ``dist_bottom_valid`` is set in every
   sample (it is terrain-relative, where ``-z`` is relative to the origin the
@@ -45,11 +48,13 @@ __all__ = [
 
 #: How the fields of a source become the signals of a group.
 #: ``copy``: one field per signal; ``negate``: the same with the sign flipped;
+#: ``degrees``: one field per signal, degrees to radians; ``degrees_e7``: the
+#: same from integers in 1e-7 degrees (GNSS positions before PX4 v1.14);
 #: ``quaternion_to_euler``: four fields ``w, x, y, z`` give ``phi, theta, psi``;
 #: ``rangefinder``: ``distance_sensor`` fields ``current_distance``,
 #: ``min_distance``, ``max_distance`` (in that order) give the distance where
 #: it is within range, the signal quality is not 0 and the sensor faces down.
-Conversion = Literal["copy", "negate", "quaternion_to_euler", "rangefinder"]
+Conversion = Literal["copy", "negate", "degrees", "degrees_e7", "quaternion_to_euler", "rangefinder"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,6 +78,10 @@ class TopicSource:
     min_valid_fraction : float
         Smallest fraction of valid samples for a signal to be taken from this
         source (1.0: every sample must be valid, else the next source is tried).
+    at_least : tuple of (str, float)
+        Fields of the same topic that must reach a value for a sample to be
+        valid, e.g. ``(("fix_type", 3),)`` for a 3-D GNSS fix; a field absent
+        from an old log is not checked.
     """
 
     topic: str
@@ -80,6 +89,7 @@ class TopicSource:
     conversion: Conversion = "copy"
     valid: tuple[str, ...] = ()
     min_valid_fraction: float = 0.0
+    at_least: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.min_valid_fraction <= 1.0:
@@ -143,6 +153,10 @@ def _xyz(topic: str, field: str, **options: object) -> TopicSource:
     return TopicSource(topic, tuple(f"{field}[{i}]" for i in range(3)), **options)  # type: ignore[arg-type]
 
 
+#: Topics with ``time_utc_usec`` (GPS time) and the receiver's position, in order of preference.
+GPS_TOPICS: tuple[str, ...] = ("sensor_gps", "vehicle_gps_position")
+_FIX_3D = (("fix_type", 3.0),)  # GNSS samples without a 3-D fix carry no position
+
 #: Canonical signal groups and their PX4 sources, in order of preference.
 PX4_GROUPS: tuple[SignalGroup, ...] = (
     SignalGroup(("p", "q", "r"), "rad/s", (
@@ -190,6 +204,13 @@ PX4_GROUPS: tuple[SignalGroup, ...] = (
         TopicSource("wind", ("windspeed_north", "windspeed_east")),
         TopicSource("wind_estimate", ("windspeed_north", "windspeed_east")),
     )),
+    SignalGroup(("latitude", "longitude"), "rad", (
+        TopicSource("vehicle_global_position", ("lat", "lon"), "degrees", valid=("lat_lon_valid",) * 2),
+        TopicSource("sensor_gps", ("latitude_deg", "longitude_deg"), "degrees", at_least=_FIX_3D),  # v1.14 on
+        TopicSource("sensor_gps", ("lat", "lon"), "degrees_e7", at_least=_FIX_3D),
+        TopicSource("vehicle_gps_position", ("latitude_deg", "longitude_deg"), "degrees", at_least=_FIX_3D),
+        TopicSource("vehicle_gps_position", ("lat", "lon"), "degrees_e7", at_least=_FIX_3D),
+    )),
 )
 
 #: Motor command topics in order of preference.
@@ -197,9 +218,6 @@ PX4_MOTOR_SOURCES: tuple[MotorSource, ...] = (
     MotorSource("actuator_motors", "control[{i}]", "normalised", "channels"),
     MotorSource("actuator_outputs", "output[{i}]", "PWM us", "airframe"),
 )
-
-#: Topics with ``time_utc_usec`` (GPS time), in order of preference.
-GPS_TOPICS: tuple[str, ...] = ("sensor_gps", "vehicle_gps_position")
 
 #: MAVLink ``MAV_TYPE`` values seen on multirotors and their names.
 MAV_TYPE_NAMES: dict[int, str] = {

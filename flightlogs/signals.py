@@ -69,6 +69,8 @@ _SPECS = (
     SignalSpec("excitation", "injected excitation signal", "as logged"),
     SignalSpec("est_wind_n", "autopilot's own north wind estimate", "m/s"),
     SignalSpec("est_wind_e", "autopilot's own east wind estimate", "m/s"),
+    SignalSpec("latitude", "WGS-84 latitude of the vehicle (GNSS receiver or estimator)", "rad"),
+    SignalSpec("longitude", "WGS-84 longitude of the vehicle (GNSS receiver or estimator)", "rad"),
 )
 
 #: Every canonical signal with a fixed name, by name.
@@ -81,8 +83,10 @@ LOGGED_SIGNALS: tuple[str, ...] = (
     "delta_lat", "delta_lon", "delta_yaw", "delta_thr", "height_agl", "battery_v",
 )
 
-#: Optional signals a reader adds when the autopilot logs them.
-ESTIMATOR_SIGNALS: tuple[str, ...] = ("excitation", "est_wind_n", "est_wind_e")
+#: Optional signals a reader adds when the autopilot logs them. ``latitude``
+#: and ``longitude`` locate the vehicle for the anemometer's transport delay;
+#: they are not dynamic signals and stay out of conditioned records.
+ESTIMATOR_SIGNALS: tuple[str, ...] = ("excitation", "est_wind_n", "est_wind_e", "latitude", "longitude")
 
 _MOTOR = re.compile(r"motor_([1-9][0-9]?)")
 

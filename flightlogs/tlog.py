@@ -21,6 +21,8 @@ canonical                  MAVLink source                                   conv
                            ``GLOBAL_POSITION_INT.relative_alt``
 ``motor_1..n``             ``SERVO_OUTPUT_RAW.servoN_raw``                  µs, as logged
 ``battery_v``              ``SYS_STATUS.voltage_battery``                   mV / 1000
+``latitude longitude``     ``GLOBAL_POSITION_INT.lat/lon`` (not 0, 0);      1e-7 deg → rad
+                           else ``GPS_RAW_INT.lat/lon`` (``fix_type`` ≥ 3)
 =========================  ===============================================  ===========
 
 Mixer inputs (``delta_*``) are not in the telemetry stream and are reported
@@ -157,6 +159,7 @@ def read_tlog(
         builder(tables, clock, signals, warnings)
     _motors(tables, clock, mav_type, autopilot, parameters, signals, warnings)
     _battery(tables, clock, signals, warnings)
+    _position(tables, clock, signals, warnings)
     return FlightLog(
         path=path,
         log_format="tlog",
@@ -380,6 +383,35 @@ def _battery(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: li
     time_s = clock.log_time_s(boot_s, table["rx"])
     _add(signals, warnings, "battery_v", time_s[monitored], millivolts[monitored] * 1e-3, "V",
          "SYS_STATUS.voltage_battery (mV / 1000; time from the receive clock)")
+
+
+def _position(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: list[str]) -> None:
+    """Latitude and longitude: the estimator's global position, else the receiver's with a 3-D fix."""
+    table = tables["GLOBAL_POSITION_INT"]
+    if (known := _not_null_island(table)).any():
+        _add_position(signals, warnings, "GLOBAL_POSITION_INT", table, _log_time(table, "GLOBAL_POSITION_INT", clock),
+                      known, "at 0, 0 (no position yet)", "")
+        return
+    table = tables["GPS_RAW_INT"]
+    fixed = (table["fix_type"] >= 3) & _not_null_island(table)
+    boot_s = clock.boot_time_s(table["rx"])
+    if fixed.any() and boot_s is not None:
+        _add_position(signals, warnings, "GPS_RAW_INT", table, clock.log_time_s(boot_s, table["rx"]), fixed,
+                      "without a 3-D fix (fix_type < 3) or at 0, 0", "; time from the receive clock")
+
+
+def _not_null_island(table: dict[str, np.ndarray]) -> np.ndarray:
+    """Rows whose position is not exactly 0, 0 (what MAVLink sends before there is one)."""
+    return (table["lat"] != 0) | (table["lon"] != 0)
+
+
+def _add_position(signals: _Signals, warnings: list[str], msg: str, table: dict[str, np.ndarray],
+                  time_s: np.ndarray, keep: np.ndarray, why: str, note: str) -> None:
+    if (~keep).any():
+        warnings.append(f"{msg}.lat, lon: dropped {int((~keep).sum())} of {keep.size} samples {why}")
+    for name, field_name in (("latitude", "lat"), ("longitude", "lon")):
+        _add(signals, warnings, name, time_s[keep], np.deg2rad(table[field_name][keep] * 1e-7), "rad",
+             f"{msg}.{field_name} (1e-7 deg→rad{note})")
 
 
 # --------------------------------------------------------------------------- metadata

@@ -130,7 +130,6 @@ def read_ulog(
     return log
 
 
-
 def _check_header(path: Path) -> int:
     """Check the 16-byte ULog header ourselves, for messages pyulog cannot give; return the size."""
     try:
@@ -319,7 +318,6 @@ def _damage_notes(ulog: _CountingULog, tracked: _TrackedFile, size: int) -> list
     return notes
 
 
-
 def _map_group(group: SignalGroup, datasets: _Datasets, notes: list[str]) -> dict[str, Signal]:
     """Signals of one group from its first usable source and instance."""
     for source in group.sources:
@@ -381,6 +379,12 @@ def _usable(
         if (count := int((unset & valid).sum())):
             reasons.append(f"{count} with {flag} not set")
         valid &= ~unset
+    for field, least in source.at_least:
+        if field in data:
+            below = np.asarray(data[field]) < least
+            if (count := int((below & valid).sum())):
+                reasons.append(f"{count} with {field} < {least:g}")
+            valid &= ~below
     unstamped = stamps == 0
     if (count := int((unstamped & valid).sum())):
         reasons.append(f"{count} with timestamp 0")
@@ -393,6 +397,9 @@ def _convert(source: TopicSource, data: Mapping[str, np.ndarray]) -> tuple[list[
     usable = np.ones(columns[0].shape, dtype=bool)
     if source.conversion == "negate":
         columns = [-column for column in columns]
+    elif source.conversion in ("degrees", "degrees_e7"):
+        scale = 1e-7 if source.conversion == "degrees_e7" else 1.0
+        columns = [np.deg2rad(column * scale) for column in columns]
     elif source.conversion == "quaternion_to_euler":
         quaternion = np.column_stack(columns)
         norm = np.linalg.norm(quaternion, axis=1)
@@ -417,7 +424,8 @@ def _source_text(source: TopicSource, label: str, k: int) -> str:
         return f"{label}.{first.split('[')[0]}[{first[-2]}..{last[-2]}] (quaternion→Euler)"
     field = source.fields[0] if source.conversion == "rangefinder" else source.fields[k]
     sign = "-" if source.conversion == "negate" else ""
-    return f"{sign}{label}.{field}"
+    unit = {"degrees": " (deg→rad)", "degrees_e7": " (1e-7 deg→rad)"}.get(source.conversion, "")
+    return f"{sign}{label}.{field}{unit}"
 
 
 def _map_motors(
@@ -471,7 +479,6 @@ def _motor_channels(
     if "noutputs" in data and np.size(data["noutputs"]):
         rotors = min(rotors, int(np.max(data["noutputs"])))
     return present[:rotors]
-
 
 
 def _utc_offset(datasets: _Datasets) -> float | None:

@@ -10,13 +10,14 @@ import click
 
 from ._common import emit_json, json_option, progress_bar
 
-__all__ = ["ingest", "parse_columns"]
+__all__ = ["ingest", "parse_columns", "parse_position"]
 
 _EPILOG = """\b
 Examples:
   sysid ingest flight.ulg --json -
   sysid ingest 00000042.BIN --wind mast.csv --wind-distance 4.6 -o flight.h5
   sysid ingest sweeps/*.bin --wind anemometer/ --wind-distance 4.6 -o campaign.h5
+  sysid ingest flight.bin --wind mast.csv --anemometer-at 35.000021,-106.900043 --json -
   sysid ingest flight.ulg --wind mast.csv --columns time=UTC,speed=WS,direction=WD --transport-delay 0.8
 """
 
@@ -34,6 +35,21 @@ def parse_columns(_ctx: click.Context, _param: click.Parameter, value: str | Non
     return mapping
 
 
+def parse_position(_ctx: click.Context, _param: click.Parameter, value: str | None) -> tuple[float, float] | None:
+    """Parse ``LAT,LON`` in degrees into latitude and longitude in radians (click callback)."""
+    if value is None:
+        return None
+    parts = value.split(",")
+    try:
+        lat, lon = (float(part) for part in parts)
+    except ValueError:
+        raise click.BadParameter(
+            f"{value!r} is not LAT,LON in decimal degrees (e.g. 35.000021,-106.900043)") from None
+    if not (math.isfinite(lat) and math.isfinite(lon) and abs(lat) <= 90.0 and abs(lon) <= 180.0):
+        raise click.BadParameter(f"{value!r}: latitude must lie within ±90° and longitude within ±180°")
+    return math.radians(lat), math.radians(lon)
+
+
 @click.command(epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--wind", "wind_paths", multiple=True, type=click.Path(exists=True, path_type=Path),
@@ -44,6 +60,9 @@ def parse_columns(_ctx: click.Context, _param: click.Parameter, value: str | Non
               help="Anemometer-to-vehicle distance, m (transport delay = distance / mean wind speed).")
 @click.option("--wind-bearing", type=float, metavar="DEG",
               help="Direction from the anemometer to the vehicle, deg from north (default: straight upstream).")
+@click.option("--anemometer-at", "anemometer_at", callback=parse_position, metavar="LAT,LON",
+              help="Anemometer position, deg (WGS-84); without --wind-distance, the distance and bearing "
+                   "to the vehicle come from its mean GPS position in the log.")
 @click.option("--transport-delay", type=float, metavar="S", help="Use this transport delay, s, instead.")
 @click.option("--wind-offset", type=float, metavar="S",
               help="Anemometer clock minus UTC, s (minus the log's clock when the log has no GPS time).")
@@ -58,7 +77,8 @@ def parse_columns(_ctx: click.Context, _param: click.Parameter, value: str | Non
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
 def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[str, str] | None,
-           wind_distance: float | None, wind_bearing: float | None, transport_delay: float | None,
+           wind_distance: float | None, wind_bearing: float | None, anemometer_at: tuple[float, float] | None,
+           transport_delay: float | None,
            wind_offset: float | None, estimate_wind_offset: bool, rate_hz: float | None,
            segments_file: Path | None, out: Path | None, json_path: str | None, quiet: bool) -> None:
     """Read LOGS (PX4 .ulg, ArduPilot .bin or MAVLink .tlog, detected from content), report every
@@ -71,7 +91,7 @@ def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[s
     options = ConditioningOptions(
         rate_hz=rate_hz, wind_offset_s=wind_offset, estimate_wind_offset=estimate_wind_offset,
         wind_distance_m=wind_distance, wind_bearing_rad=None if wind_bearing is None else math.radians(wind_bearing),
-        transport_delay_s=transport_delay,
+        anemometer_position_rad=anemometer_at, transport_delay_s=transport_delay,
         segments=read_segments_file(segments_file) if segments_file is not None else None,
     )
     with progress_bar("reading", quiet=quiet) as bar:
@@ -120,7 +140,9 @@ def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
         if alignment:
             say(f"  wind {alignment['wind_file']}: clock offset {alignment['clock_offset_s']:+.3f} s "
                 f"({alignment['clock_offset_source']}), transport delay {alignment['transport_delay_s']:.3f} s "
-                f"({alignment['transport_delay_source']}), mean {alignment['mean_speed_m_s']:.2f} m/s")
+                f"({alignment['transport_delay_source']}"
+                + (f", {alignment['distance_m']:.2f} m" if alignment["distance_m"] is not None else "")
+                + f"), mean {alignment['mean_speed_m_s']:.2f} m/s")
             if alignment["residual_offset_s"] is not None:
                 say(f"    residual clock offset {alignment['residual_offset_s']:+.3f} s against "
                     f"{alignment['residual_against']} (correlation {alignment['residual_correlation']:.2f})")

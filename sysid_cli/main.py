@@ -59,9 +59,10 @@ def cli(ctx: click.Context, debug: bool) -> None:
 
 
 def _register() -> None:
-    from . import demo, ingest
+    from . import demo, ingest, simulate
 
     cli.add_command(ingest.ingest)
+    cli.add_command(simulate.simulate)
     cli.add_command(demo.demo)
 
 

@@ -17,7 +17,8 @@ from scipy import linalg, signal as sps
 
 from .excitation import Axis, Maneuver, excitation_signal, sweep
 
-__all__ = ["CALM_HOVER", "LIGHT_WIND_TERMS", "WindField", "SimulatedFlight", "simulate_hover"]
+__all__ = ["CALM_HOVER", "LIGHT_WIND_TERMS", "STRONG_WIND_TERMS", "wind_terms_for", "WindField", "SimulatedFlight",
+           "simulate_hover"]
 
 G = 9.81
 
@@ -32,6 +33,26 @@ CALM_HOVER: Mapping[str, float] = MappingProxyType({
 LIGHT_WIND_TERMS: Mapping[str, float] = MappingProxyType(
     {"X_w_lon": -0.1486, "Z_w_lon": 0.8451, "tau_w_lon": 0.0178, "tau_w_thr": 0.0386}
 )
+#: Table 3.5, strong wind.
+STRONG_WIND_TERMS: Mapping[str, float] = MappingProxyType(
+    {"X_w_lon": -0.3560, "Z_w_lon": 1.323, "tau_w_lon": 0.0132, "tau_w_thr": 0.0203}
+)
+
+
+def wind_terms_for(mean_speed_m_s: float) -> Mapping[str, float] | None:
+    """The Table 3.5 wind terms of the nearest identified condition (none in a calm).
+
+    Parameters
+    ----------
+    mean_speed_m_s : float
+        Mean wind speed, m/s; the dissertation's calm, light and strong were
+        0.9, 2.7 and 5.4 m/s.
+    """
+    if mean_speed_m_s < 1.8:
+        return None
+    return LIGHT_WIND_TERMS if mean_speed_m_s < 4.05 else STRONG_WIND_TERMS
+
+
 _AXES: tuple[Axis, ...] = ("lat", "lon", "yaw", "thr")
 
 

@@ -3,6 +3,11 @@
 An ArduPilot DataFlash log (IMU, ATT, RATE, CTUN, RCOU, BAT, GPS, XKF1, and
 SIDS/SIDD for System ID sweeps), the CSV of a ground anemometer on its own
 clock upstream of the vehicle, and a truth JSON.
+
+The vehicle hovers over a fixed point (``vehicle_position_deg``); its GPS
+position wanders about it as a position hold would let it: the horizontal
+velocity, its mean removed, through a leaky integrator of time constant
+2 s (about ±1 m in the demo's light wind, a few millimetres of mean offset).
 """
 
 from __future__ import annotations
@@ -13,19 +18,26 @@ from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
 import numpy as np
+from scipy import signal as sps
 
 from flightlogs.atomic import atomic_output
 from flightlogs.dataflash_writer import standard_block, write_dataflash
+from flightlogs.timing import destination_point
 
 from .excitation import sweep
 from .linear_flight import SimulatedFlight
 
-__all__ = ["AnemometerSetup", "write_ardupilot_log", "write_anemometer_csv", "write_truth"]
+__all__ = ["AnemometerSetup", "VEHICLE_POSITION_DEG", "write_ardupilot_log", "write_anemometer_csv", "write_truth"]
+
+#: Where the simulated vehicle hovers by default: latitude, longitude, deg (WGS-84).
+VEHICLE_POSITION_DEG: tuple[float, float] = (35.0, -106.9)
 
 _GPS_EPOCH = datetime(1980, 1, 6, tzinfo=timezone.utc)
 _LEAP_SECONDS = 18
 _SID_AXIS = {"lat": 10, "lon": 11, "yaw": 12, "thr": 13}  # ArduPilot SID_AXIS: mixer roll/pitch/yaw/thrust
 _BOOT_S = 20.0  # the log starts this long after boot
+_EARTH_RADIUS_M = 6_371_008.8
+_HOLD_S = 2.0  # time constant of the position hold's wander
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,6 +58,29 @@ class AnemometerSetup:
     rate_hz: float = 20.0
     clock_offset_s: float = 0.0
 
+    def position_rad(
+        self, flight: SimulatedFlight, *, vehicle_position_deg: tuple[float, float] = VEHICLE_POSITION_DEG
+    ) -> tuple[float, float]:
+        """Where the anemometer stands: `distance_m` straight upstream of the vehicle's hover point.
+
+        Parameters
+        ----------
+        flight : SimulatedFlight
+            The flight; the mean of its ``wind_at_vehicle`` sets upstream.
+        vehicle_position_deg : tuple of (float, float), optional
+            The hover point, latitude and longitude, deg (as given to
+            :func:`write_ardupilot_log`).
+
+        Returns
+        -------
+        tuple of (float, float)
+            Latitude and longitude of the anemometer, rad.
+        """
+        mean_n, mean_e = flight.wind_at_vehicle.mean(axis=0)
+        upstream_rad = float(np.arctan2(-mean_e, -mean_n))  # where the air comes from
+        lat, lon = np.radians(vehicle_position_deg)
+        return destination_point(float(lat), float(lon), upstream_rad, self.distance_m)
+
 
 def _gps_week_ms(utc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     gps_s = utc - _GPS_EPOCH.timestamp() + _LEAP_SECONDS
@@ -53,7 +88,10 @@ def _gps_week_ms(utc: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return week.astype(np.int64), np.round((gps_s - week * 604_800.0) * 1000).astype(np.int64)
 
 
-def write_ardupilot_log(flight: SimulatedFlight, path: str | Path, *, utc_start: datetime) -> Path:
+def write_ardupilot_log(
+    flight: SimulatedFlight, path: str | Path, *, utc_start: datetime,
+    vehicle_position_deg: tuple[float, float] = VEHICLE_POSITION_DEG,
+) -> Path:
     """Write `flight` as an ArduCopter 4.x DataFlash log.
 
     Parameters
@@ -64,6 +102,9 @@ def write_ardupilot_log(flight: SimulatedFlight, path: str | Path, *, utc_start:
         Destination ``.bin``.
     utc_start : datetime
         UTC of the first sample (aware).
+    vehicle_position_deg : tuple of (float, float), optional
+        The point the vehicle hovers over, latitude and longitude, deg; the
+        GPS (5 Hz, 3-D fix) logs it plus the position hold's wander.
 
     Returns
     -------
@@ -89,13 +130,28 @@ def write_ardupilot_log(flight: SimulatedFlight, path: str | Path, *, utc_start:
     ]
     gps_t = t[::20]
     week, ms = _gps_week_ms(utc_start.timestamp() + flight.time_s[::20])
+    lat_deg, lng_deg = _gps_track(flight, vehicle_position_deg)
     blocks.append(standard_block("GPS", TimeUS=np.round(gps_t * 1e6).astype(np.int64), Status=np.full(gps_t.size, 3),
-                                 GWk=week, GMS=ms, NSats=np.full(gps_t.size, 14)))
+                                 GWk=week, GMS=ms, NSats=np.full(gps_t.size, 14), Lat=lat_deg[::20], Lng=lng_deg[::20]))
     sweeps = [m for m in flight.maneuvers if m.kind == "sweep"]
     if sweeps:
         blocks += _system_id_blocks(flight, sweeps, us)
     parameters = {"FRAME_CLASS": 3.0, "FRAME_TYPE": 1.0, "SID_MAGNITUDE": float(sweeps[0].amplitude) / 100 if sweeps else 0.0}
     return write_dataflash(path, blocks, parameters=parameters, firmware="ArduCopter V4.5.7 (flight-sysid sim)")
+
+
+def _gps_track(flight: SimulatedFlight, hover_deg: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Latitude and longitude, deg, of the hover point plus the position hold's wander (see the module notes)."""
+    dt = float(np.median(np.diff(flight.time_s)))
+    keep = np.exp(-dt / _HOLD_S)
+    wander = []
+    for name in ("vn", "ve"):
+        velocity = flight.signals[name] - flight.signals[name].mean()
+        wander.append(sps.lfilter([dt], [1.0, -keep], velocity))
+    lat0 = np.radians(hover_deg[0])
+    lat = hover_deg[0] + np.degrees(wander[0] / _EARTH_RADIUS_M)
+    lng = hover_deg[1] + np.degrees(wander[1] / (_EARTH_RADIUS_M * np.cos(lat0)))
+    return lat, lng
 
 
 def _octo_pwm(out: dict[str, np.ndarray], hover: float) -> dict[str, np.ndarray]:
@@ -175,7 +231,10 @@ def write_anemometer_csv(
     return Path(path)
 
 
-def write_truth(flight: SimulatedFlight, path: str | Path, *, utc_start: datetime, setup: AnemometerSetup | None) -> Path:
+def write_truth(
+    flight: SimulatedFlight, path: str | Path, *, utc_start: datetime, setup: AnemometerSetup | None,
+    vehicle_position_deg: tuple[float, float] = VEHICLE_POSITION_DEG,
+) -> Path:
     """Write what the files conceal: parameters, maneuvers, delays and offsets.
 
     Parameters
@@ -188,6 +247,9 @@ def write_truth(flight: SimulatedFlight, path: str | Path, *, utc_start: datetim
         UTC of the first sample.
     setup : AnemometerSetup or None
         The anemometer, if one was written.
+    vehicle_position_deg : tuple of (float, float), optional
+        The hover point given to :func:`write_ardupilot_log`, deg; with it the
+        anemometer's position (``anemometer.position_deg``) is recorded.
 
     Returns
     -------
@@ -206,7 +268,10 @@ def write_truth(flight: SimulatedFlight, path: str | Path, *, utc_start: datetim
         truth["anemometer"] = {
             "distance_m": setup.distance_m, "rate_hz": setup.rate_hz, "clock_offset_s": setup.clock_offset_s,
             "transport_delay_s": setup.distance_m / float(np.hypot(*flight.wind_at_vehicle.mean(axis=0))),
+            "position_deg": [float(np.degrees(v)) for v in
+                             setup.position_rad(flight, vehicle_position_deg=vehicle_position_deg)],
         }
+        truth["vehicle_position_deg"] = list(vehicle_position_deg)
     with atomic_output(path) as tmp:
         tmp.write_text(json.dumps(truth, indent=2) + "\n")
     return Path(path)

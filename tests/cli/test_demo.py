@@ -67,3 +67,33 @@ def test_a_wind_folder_pairs_each_log_by_utc(demo_dir: Path, tmp_path: Path) -> 
     summary = json.loads(result.stdout)
     assert Path(summary["wind_alignment"]["wind_file"]).name == "a.csv"
     assert len(summary["wind"]) == 2
+
+
+def test_anemometer_position_gives_the_transport_delay_from_gps(demo_dir: Path) -> None:
+    """``--anemometer-at`` (deg): distance and bearing to the vehicle's mean GPS position, delay within a sample."""
+    truth = json.loads((demo_dir / "truth.json").read_text())["anemometer"]
+    lat, lon = truth["position_deg"]
+    result = CliRunner().invoke(cli, [
+        "ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"),
+        "--anemometer-at", f"{lat:.9f},{lon:.9f}", "--wind-offset", str(truth["clock_offset_s"]), "--json", "-", "-q",
+    ])
+    assert result.exit_code == 0, result.output
+    alignment = json.loads(result.stdout)["wind_alignment"]
+    assert alignment["transport_delay_source"] == "gps"
+    assert abs(alignment["distance_m"] - truth["distance_m"]) < 0.05
+    assert abs(alignment["transport_delay_s"] - truth["transport_delay_s"]) < 0.01
+
+
+@pytest.mark.parametrize(("value", "fragment"), [
+    ("35.0", "not LAT,LON"),
+    ("35.0;-106.9", "not LAT,LON"),
+    ("north,west", "not LAT,LON"),
+    ("-106.9,35.0", "latitude must lie within"),
+    ("nan,1", "latitude must lie within"),
+])
+def test_a_bad_anemometer_position_is_a_usage_error(demo_dir: Path, value: str, fragment: str) -> None:
+    result = CliRunner().invoke(cli, [
+        "ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"), f"--anemometer-at={value}",
+    ])
+    assert result.exit_code == 2
+    assert "--anemometer-at" in result.stderr and fragment in result.stderr

@@ -114,6 +114,43 @@ def test_utc_offset_from_gps_week_and_ms(real_data: Path, where, leap: int, day:
     reader.close()
 
 
+@pytest.mark.parametrize(("where", "dropped"), [(SAMPLE, 0), (LOG171, 161)], ids=lambda v: v[1] if isinstance(v, tuple) else None)
+def test_gps_position_equals_dfreader_where_the_fix_is_3d(real_data: Path, where, dropped: int) -> None:
+    """GPS Lat/Lng (deg as DFReader gives them) → rad, samples with Status ≥ 3 only."""
+    path = real_data.joinpath(*where)
+    log = read_dataflash(path)
+    reader = DFReader_binary(str(path))
+    rows = []
+    while (msg := reader.recv_match(type="GPS")) is not None:
+        boot_s = msg.TimeUS / 1e6 if "TimeUS" in msg.fmt.columns else msg.T / 1e3  # Copter 3.3: T is boot time
+        rows.append((boot_s, msg.Status, msg.Lat, msg.Lng))
+    reader.close()
+    boot_s, status, lat, lng = np.array(rows, dtype=np.float64).T
+    fixed = status >= 3
+    assert int((~fixed).sum()) == dropped
+    for name, values, column in (("latitude", lat, "Lat"), ("longitude", lng, "Lng")):
+        np.testing.assert_array_equal(log[name].time_s, boot_s[fixed])
+        np.testing.assert_array_equal(log[name].values, np.deg2rad(values[fixed]))
+        assert log[name].source == f"GPS[0].{column} (deg→rad, Status ≥ 3)" and log[name].unit == "rad"
+    assert any(f"dropped {dropped} of" in w for w in log.warnings if w.startswith("GPS[0].Lat")) == bool(dropped)
+
+
+def test_gps_position_from_instance_0_and_none_without_a_fix(tmp_path: Path) -> None:
+    stamps = [1_000_000, 1_200_000, 1_400_000]
+    gps = standard_block("GPS", TimeUS=stamps * 2, I=[0, 0, 0, 1, 1, 1], Status=[1, 3, 6, 3, 3, 3],
+                         Lat=[0.0, 35.0, 35.0000001, 1.0, 1.0, 1.0], Lng=[0.0, -106.9, -106.9, 2.0, 2.0, 2.0])
+    path = tmp_path / "gps.bin"
+    path.write_bytes(encode_dataflash([gps]))
+    log = read_dataflash(path)
+    np.testing.assert_array_equal(log["latitude"].values, np.deg2rad([35.0, 35.0000001]))
+    np.testing.assert_array_equal(log["longitude"].time_s, [1.2, 1.4])
+    assert "GPS[0].Lat, Lng: dropped 1 of 3 samples without a 3-D fix (Status < 3)." in log.warnings
+    nofix = standard_block("GPS", TimeUS=stamps, Status=[1, 2, 1], Lat=[35.0] * 3, Lng=[-106.9] * 3)
+    path.write_bytes(encode_dataflash([nofix]))
+    log = read_dataflash(path)
+    assert "latitude" not in log.signals and any("never had a 3-D fix" in w for w in log.warnings)
+
+
 def _gps_block(utc: datetime, leap: int, boot_s: float) -> object:
     """Three GPS fixes at `utc` (+0.2 s steps) logged at boot time `boot_s`."""
     gps_s = calendar.timegm(utc.timetuple()) + leap - GPS_EPOCH + np.array([0.0, 0.2, 0.4])

@@ -15,6 +15,7 @@ from flightlogs.condition import ConditioningOptions, condition_flight
 from flightlogs.errors import DataError
 from flightlogs.flightlog import Signal
 from flightlogs.reader import read_log
+from flightlogs.timing import destination_point
 from sysid.sim.scenarios import write_demo_flight
 
 ONE_SAMPLE_S = 0.01 + 1e-9  # one sample at the 100 Hz log rate (plus float rounding)
@@ -173,3 +174,77 @@ def test_an_anemometer_off_by_hours_does_not_overlap(demo: dict) -> None:
 def test_without_distance_or_delay_the_transport_delay_is_asked_for(demo: dict) -> None:
     with pytest.raises(DataError, match="distance"):
         condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_offset_s=1.5))
+
+
+# --------------------------------------------------------------------------- anemometer position and GPS
+
+
+def _anemometer_rad(truth: dict) -> tuple[float, float]:
+    """The simulator's anemometer: 4.6 m straight upstream of the hover point (truth JSON, deg)."""
+    lat, lon = truth["anemometer"]["position_deg"]
+    return float(np.radians(lat)), float(np.radians(lon))
+
+
+def test_anemometer_position_and_gps_give_the_distance_and_delay(demo: dict) -> None:
+    """Geometry from positions matches the distance given outright: within 0.05 m and one sample.
+
+    The GPS position wanders about the hover point as a position hold lets it
+    (±1 m); its mean lands millimetres from the point, and Lat/Lng are logged
+    to 1e-7 deg (about 1 cm).
+    """
+    truth = demo["truth"]["anemometer"]
+    by_gps = condition_flight(
+        demo["log"], demo["wind"], ConditioningOptions(anemometer_position_rad=_anemometer_rad(demo["truth"]), wind_offset_s=1.5)
+    )
+    by_distance = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
+    assert by_gps.wind is not None and by_distance.wind is not None
+    gps, given = by_gps.wind.transport, by_distance.wind.transport
+    assert gps.source == "gps" and given.source == "geometry"
+    assert gps.distance_m == pytest.approx(truth["distance_m"], abs=0.05)
+    assert abs(gps.delay_s - given.delay_s) < ONE_SAMPLE_S
+    assert abs(gps.delay_s - truth["transport_delay_s"]) < ONE_SAMPLE_S
+    # the bearing from the anemometer to the vehicle is the way the mean wind blows
+    mean_wind = np.column_stack([demo["wind"].wind_n, demo["wind"].wind_e]).mean(axis=0)
+    downwind = np.arctan2(mean_wind[1], mean_wind[0])
+    assert gps.bearing_rad is not None
+    assert abs(np.angle(np.exp(1j * (gps.bearing_rad - downwind)))) < np.radians(2.0)
+    # the position locates the vehicle; it is not a signal of the records
+    assert not {"latitude", "longitude"} & set(by_gps.records[0].signals)
+    assert not any("moved up to" in w for w in by_gps.warnings)  # ±1 m of wander, 4.6 m away
+
+
+def test_a_vehicle_wandering_far_for_the_distance_is_noted(demo: dict) -> None:
+    """1 m upstream, the vehicle's ±1 m wander matters: the one delay is flagged as rough."""
+    lat, lon = np.radians(demo["truth"]["vehicle_position_deg"])
+    mean_n, mean_e = np.column_stack([demo["wind"].wind_n, demo["wind"].wind_e]).mean(axis=0)
+    position = destination_point(lat, lon, np.arctan2(-mean_e, -mean_n), 1.0)
+    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(anemometer_position_rad=position,
+                                                                             wind_offset_s=1.5))
+    assert flight.wind is not None and flight.wind.transport.distance_m == pytest.approx(1.0, abs=0.05)
+    assert any("moved up to" in w and "rough stand-in" in w for w in flight.warnings)
+
+
+def test_a_given_distance_wins_over_the_anemometer_position(demo: dict) -> None:
+    options = ConditioningOptions(anemometer_position_rad=_anemometer_rad(demo["truth"]), wind_distance_m=5.0,
+                                  wind_offset_s=1.5)
+    flight = condition_flight(demo["log"], demo["wind"], options)
+    assert flight.wind is not None and flight.wind.transport.source == "geometry"
+    assert flight.wind.transport.distance_m == 5.0
+    assert any("position is not used" in w for w in flight.warnings)
+
+
+def test_anemometer_position_without_gps_in_the_log_asks_for_the_distance(demo: dict) -> None:
+    log = demo["log"]
+    no_gps = replace(log, signals={n: s for n, s in log.signals.items() if n not in ("latitude", "longitude")})
+    options = ConditioningOptions(anemometer_position_rad=_anemometer_rad(demo["truth"]), wind_offset_s=1.5)
+    with pytest.raises(DataError, match=r"no GNSS position.*--wind-distance"):
+        condition_flight(no_gps, demo["wind"], options)
+
+
+def test_a_mistyped_anemometer_position_is_refused(demo: dict) -> None:
+    lat, lon = _anemometer_rad(demo["truth"])
+    with pytest.raises(DataError, match="km from the vehicle's mean GPS position"):
+        condition_flight(demo["log"], demo["wind"],
+                         ConditioningOptions(anemometer_position_rad=(lat, -lon), wind_offset_s=1.5))
+    with pytest.raises(ValueError, match="latitude within"):
+        ConditioningOptions(anemometer_position_rad=(lon, lat))

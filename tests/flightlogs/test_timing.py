@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from scipy import signal as sps
 
 from flightlogs.errors import DataError
-from flightlogs.timing import bearing_and_distance, estimate_lag, transport_delay
+from flightlogs.timing import bearing_and_distance, destination_point, estimate_lag, transport_delay
 
 RATE_HZ = 100.0
 
@@ -93,7 +93,28 @@ def test_a_downstream_anemometer_is_refused() -> None:
 
 
 def test_bearing_and_distance_against_known_points() -> None:
-    bearing, distance = bearing_and_distance(45.0, 7.0, 45.0 + 4.6 / 111_195.0, 7.0)
+    """Radians in; one degree of latitude is 111 195 m on the mean-radius sphere (analytic)."""
+    lat, lon = np.radians(45.0), np.radians(7.0)
+    bearing, distance = bearing_and_distance(lat, lon, lat + np.radians(4.6 / 111_195.0), lon)
     assert bearing == pytest.approx(0.0, abs=1e-9) and distance == pytest.approx(4.6, rel=1e-3)
-    bearing, _ = bearing_and_distance(45.0, 7.0, 45.0, 6.9999)
+    bearing, _ = bearing_and_distance(lat, lon, lat, np.radians(6.9999))
     assert np.degrees(bearing) == pytest.approx(270.0, abs=1e-3)
+
+
+@pytest.mark.parametrize("bearing_deg", [0.0, 37.0, 90.0, 211.0, 300.0])
+@pytest.mark.parametrize("lat_deg, lon_deg", [(35.0, -106.9), (-35.36, 149.16), (51.9, 179.99999)])
+def test_destination_point_inverts_bearing_and_distance(lat_deg: float, lon_deg: float, bearing_deg: float) -> None:
+    """Out 4.6 m and back: the bearing and distance come back to 1e-9 rad and 1 µm (round trip)."""
+    start = np.radians(lat_deg), np.radians(lon_deg)
+    end = destination_point(*start, np.radians(bearing_deg), 4.6)
+    bearing, distance = bearing_and_distance(*start, *end)
+    assert distance == pytest.approx(4.6, abs=1e-6)
+    assert np.angle(np.exp(1j * (bearing - np.radians(bearing_deg)))) == pytest.approx(0.0, abs=1e-7)
+
+
+def test_the_transport_delay_records_the_bearing_it_used() -> None:
+    wind = np.column_stack([np.full(100, 3.0), np.full(100, 4.0)])
+    assert transport_delay(wind, distance_m=4.6).bearing_rad is None
+    delay = transport_delay(wind, distance_m=5.0, bearing_rad=np.arctan2(4.0, 3.0))
+    assert delay.bearing_rad == pytest.approx(np.arctan2(4.0, 3.0))
+    assert delay.delay_s == pytest.approx(1.0)  # straight downwind at 5 m/s

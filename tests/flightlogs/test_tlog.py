@@ -48,6 +48,7 @@ def direct(phoenix) -> dict[str, dict[str, np.ndarray]]:
         "LOCAL_POSITION_NED": ("time_boot_ms", "vx", "vy", "vz", "z"),
         "SERVO_OUTPUT_RAW": ("time_usec", "servo1_raw", "servo2_raw", "servo3_raw", "servo4_raw"),
         "SYSTEM_TIME": ("time_boot_ms", "time_unix_usec"),
+        "GLOBAL_POSITION_INT": ("time_boot_ms", "lat", "lon"),
     }
     rows: dict[str, list] = {name: [] for name in wanted}
     params: dict[str, float] = {}
@@ -110,6 +111,36 @@ def test_real_tlog_matches_pymavlink_sample_for_sample(phoenix_log, direct):
     assert np.unique(shifts[0]).size == 2 and shifts[0][0] == 0.0
     assert set(np.unique(np.concatenate(shifts))) == set(np.unique(shifts[0]))
     assert np.all(np.diff(log["p"].time_s) > 0)
+
+
+def test_real_tlog_position_matches_pymavlink(phoenix_log, direct):
+    """GLOBAL_POSITION_INT lat/lon (1e-7 deg) → rad, the samples at 0, 0 before the first fix left out."""
+    log, gpi, att = phoenix_log, direct["GLOBAL_POSITION_INT"], direct["ATTITUDE"]
+    known = (gpi["lat"] != 0) | (gpi["lon"] != 0)
+    assert (~known).sum() == 10
+    for name, field in (("latitude", "lat"), ("longitude", "lon")):
+        np.testing.assert_array_equal(log[name].values, np.deg2rad(gpi[field][known] * 1e-7))
+        assert log[name].source == f"GLOBAL_POSITION_INT.{field} (1e-7 deg→rad)" and log[name].unit == "rad"
+    # on the same clock as the attitude: its own boot time, shifted once after the reboot
+    shifts = np.unique(_shift(log["latitude"].time_s, gpi["time_boot_ms"][known] * 1e-3))
+    assert set(shifts) <= set(np.unique(_shift(log["p"].time_s, att["time_boot_ms"] * 1e-3)))
+    assert "GLOBAL_POSITION_INT.lat, lon: dropped 10 of 782 samples at 0, 0 (no position yet)" in log.warnings
+
+
+def test_gps_raw_int_gives_the_position_without_global_position(tmp_path):
+    items = [(0.0, VEHICLE, _heartbeat(2, 3))]
+    for k in range(4):
+        boot_ms = 5000 + 1000 * k
+        items += [
+            (1.0 + k, VEHICLE, _attitude(boot_ms)),
+            (1.0 + k, VEHICLE, mavlink2.MAVLink_gps_raw_int_message(
+                0, 2 if k == 0 else 3, 350_000_000 + k, -1_069_000_000 - k, 0, 0, 0, 0, 0, 9)),
+        ]
+    log = read_tlog(_tlog(tmp_path / "raw.tlog", items))
+    np.testing.assert_array_equal(log["latitude"].values, np.deg2rad((350_000_000 + np.arange(1, 4)) * 1e-7))
+    np.testing.assert_allclose(log["longitude"].time_s, [6.0, 7.0, 8.0], atol=1e-6)  # via the receive clock
+    assert log["longitude"].source == "GPS_RAW_INT.lon (1e-7 deg→rad; time from the receive clock)"
+    assert any(w.startswith("GPS_RAW_INT.lat, lon: dropped 1 of 4 samples without a 3-D fix") for w in log.warnings)
 
 
 def test_real_tlog_utc_offset_and_parameters(phoenix_log, direct):
@@ -243,6 +274,7 @@ def test_ardupilot_servo_functions_map_motors_and_global_position_fallback(tmp_p
     assert log["vd"].source == "GLOBAL_POSITION_INT.vz (cm/s / 100)"
     np.testing.assert_allclose(log["height_agl"].values, 12.345)
     assert log.utc_offset_s == pytest.approx(1.6e9, abs=1e-3)  # GPS_RAW_INT via receive time
+    assert "latitude" not in log.signals  # every position message reads 0, 0: none known
 
 
 def test_servo_clock_wrap_and_reboot_are_unwrapped(tmp_path):

@@ -34,6 +34,7 @@ MOTORS_4 = {f"motor_{i}" for i in range(1, 5)}
 DELTAS = {"delta_lat", "delta_lon", "delta_yaw", "delta_thr"}
 ATTITUDE = {"phi", "theta", "psi"}
 RATES_ACCEL = {"p", "q", "r", "ax", "ay", "az"}
+POSITION = {"latitude", "longitude"}
 
 # file -> (signals present, exactly; sources of some of them), from the data README
 REAL_ULOGS = {
@@ -49,9 +50,10 @@ REAL_ULOGS = {
          "battery_v": "battery_status[0].voltage_v"},
     ),
     GPS_LOG: (
-        set(LOGGED_SIGNALS) | MOTORS_4,
+        set(LOGGED_SIGNALS) | MOTORS_4 | POSITION,
         {"vn": "vehicle_local_position[0].vx", "delta_lat": "vehicle_torque_setpoint[0].xyz[0]",
-         "motor_1": "actuator_motors[0].control[0]"},
+         "motor_1": "actuator_motors[0].control[0]", "latitude": "vehicle_global_position[0].lat (deg→rad)",
+         "longitude": "vehicle_global_position[0].lon (deg→rad)"},
     ),
     "px4-ulog-rs/corrupt_actuator_armed_wrong_size.ulg": (
         RATES_ACCEL | ATTITUDE | {"vd", "height_agl", "battery_v"},
@@ -193,6 +195,28 @@ def test_utc_offset_from_gps_gives_the_flight_date(real_data: Path) -> None:
     assert datetime(2020, 1, 1, tzinfo=timezone.utc) < log.utc_start < datetime(2030, 1, 1, tzinfo=timezone.utc)
 
 
+def test_gps_position_matches_pyulog_sample_for_sample(real_data: Path) -> None:
+    """The estimator's global position, deg → rad, where lat_lon_valid is set (pyulog read directly)."""
+    log, raw = _read(real_data / GPS_LOG), _pyulog(real_data / GPS_LOG)["vehicle_global_position"]
+    valid = (raw["lat_lon_valid"] != 0) & (raw["timestamp"] > 0)
+    assert 0 < (~valid).sum() < 10  # the few samples before the estimator had a position
+    for name, field in (("latitude", "lat"), ("longitude", "lon")):
+        np.testing.assert_array_equal(log[name].time_s, _seconds(raw["timestamp"][valid]))
+        np.testing.assert_array_equal(log[name].values, np.deg2rad(raw[field][valid]))
+        assert log[name].unit == "rad"
+    assert f"vehicle_global_position[0].lat (deg→rad): dropped {(~valid).sum()} of {valid.size} samples " \
+           f"({(~valid).sum()} with lat_lon_valid not set)" in log.warnings
+
+
+def test_gps_without_a_fix_gives_no_position(real_data: Path) -> None:
+    """quadrotor_local logs sensor_gps and vehicle_gps_position, but with fix_type 0 throughout."""
+    raw = _pyulog(real_data / QUAD)
+    assert not np.any(raw["sensor_gps"]["fix_type"]) and not np.any(raw["vehicle_gps_position"]["fix_type"])
+    log = _read(real_data / QUAD)
+    assert not POSITION & set(log.signals)
+    assert not any("latitude" in w or "fix_type" in w for w in log.warnings)
+
+
 @pytest.mark.parametrize("relative", [QUAD, "kd0aij-impulse-response/log1.ulg"])
 def test_no_gps_time_gives_none(real_data: Path, relative: str) -> None:
     # quadrotor_local logs sensor_gps, but never with a time (no fix); log1 has no GPS topic
@@ -330,7 +354,8 @@ def test_without_sensor_combined_rates_fall_back_to_sensor_gyro(real_data: Path,
     assert set(log.signals) == RATES_ACCEL
 
 
-_TYPES = {"uint64": "uint64_t", "float32": "float", "uint8": "uint8_t", "int8": "int8_t", "uint32": "uint32_t"}
+_TYPES = {"uint64": "uint64_t", "float32": "float", "uint8": "uint8_t", "int8": "int8_t", "uint32": "uint32_t",
+          "int32": "int32_t", "float64": "double"}
 
 
 def _synthetic(path: Path, topics: dict[tuple[str, int], dict[str, np.ndarray]], parameters: dict[str, int]) -> Path:
@@ -425,3 +450,35 @@ def test_height_prefers_dist_bottom_only_when_valid_throughout(tmp_path: Path, v
         "dist_bottom_valid": valid}}
     log = read_ulog(_synthetic(tmp_path / "height.ulg", topics, {}))
     assert log["height_agl"].source == source and log["height_agl"].samples == N
+
+
+@pytest.mark.parametrize("topic", ["sensor_gps", "vehicle_gps_position"])
+def test_receiver_position_keeps_3d_fixes_in_either_layout(tmp_path: Path, topic: str) -> None:
+    """Before PX4 v1.14 lat/lon are int32 in 1e-7 deg; from v1.14 latitude_deg/longitude_deg are double deg."""
+    fix = np.where(np.arange(N) < 30, 2, 3).astype(np.uint8)  # a 2-D fix first
+    lat_deg, lon_deg = 35.0 + 1e-6 * np.arange(N), -106.9 - 1e-6 * np.arange(N)
+    old = {"timestamp": STAMPS, "lat": np.round(lat_deg * 1e7).astype(np.int32),
+           "lon": np.round(lon_deg * 1e7).astype(np.int32), "fix_type": fix}
+    new = {"timestamp": STAMPS, "latitude_deg": lat_deg, "longitude_deg": lon_deg, "fix_type": fix}
+    for layout, fields in (("old", old), ("new", new)):
+        log = read_ulog(_synthetic(tmp_path / f"{layout}.ulg", {(topic, 0): fields}, {}))
+        np.testing.assert_array_equal(log["latitude"].time_s, _seconds(STAMPS[30:]))
+        if layout == "old":
+            assert log["latitude"].source == f"{topic}[0].lat (1e-7 deg→rad)"
+            np.testing.assert_array_equal(log["longitude"].values, np.deg2rad(old["lon"][30:] * 1e-7))
+        else:
+            assert log["latitude"].source == f"{topic}[0].latitude_deg (deg→rad)"
+            np.testing.assert_array_equal(log["longitude"].values, np.deg2rad(lon_deg[30:]))
+        np.testing.assert_allclose(log["latitude"].values, np.deg2rad(lat_deg[30:]), rtol=0, atol=1e-9)
+        assert any("dropped 30 of 200 samples (30 with fix_type < 3)" in w for w in log.warnings)
+
+
+def test_the_estimator_position_wins_over_the_receiver(tmp_path: Path) -> None:
+    topics = {
+        ("sensor_gps", 0): {"timestamp": STAMPS, "latitude_deg": np.full(N, 10.0), "longitude_deg": np.full(N, 20.0),
+                            "fix_type": np.full(N, 3, np.uint8)},
+        ("vehicle_global_position", 0): {"timestamp": STAMPS, "lat": np.full(N, 10.5), "lon": np.full(N, 20.5)},
+    }
+    log = read_ulog(_synthetic(tmp_path / "both.ulg", topics, {}))
+    assert log["longitude"].source == "vehicle_global_position[0].lon (deg→rad)"  # no lat_lon_valid: all valid
+    np.testing.assert_array_equal(log["longitude"].values, np.deg2rad(20.5))

@@ -1,0 +1,202 @@
+"""Fly a scenario: plan its trials, simulate them, write every trial's files and an index."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from datetime import datetime, timedelta
+from pathlib import Path
+
+from flightlogs.atomic import atomic_output
+
+from .excitation import Maneuver
+from .linear_flight import CALM_HOVER, SimulatedFlight, WindField, simulate_hover, wind_terms_for
+from .logwriters import AnemometerSetup, write_anemometer_csv, write_ardupilot_log, write_truth
+from .scenario import ManeuverSpec, Scenario, WindCondition
+
+__all__ = ["TrialPlan", "TrialFiles", "plan_trials", "run_scenario"]
+
+_GAP_BETWEEN_TRIALS_S = 60.0
+
+
+@dataclass(frozen=True, slots=True)
+class TrialPlan:
+    """One trial of a scenario.
+
+    Parameters
+    ----------
+    index : int
+        Position in the campaign, from 0.
+    name : str
+        File stem, e.g. ``"light-lon-sweep-3"``.
+    condition : WindCondition
+        Wind flown in.
+    spec : ManeuverSpec
+        Maneuver flown.
+    maneuvers : tuple of Maneuver
+        The excitation, timed on the trial's clock.
+    duration_s : float
+        Trial length, s.
+    seed : int
+        Seed of the gusts and sensor noise.
+    utc_start : datetime
+        UTC of the trial's first sample.
+    """
+
+    index: int
+    name: str
+    condition: WindCondition
+    spec: ManeuverSpec
+    maneuvers: tuple[Maneuver, ...]
+    duration_s: float
+    seed: int
+    utc_start: datetime
+
+
+@dataclass(frozen=True, slots=True)
+class TrialFiles:
+    """What one trial left on disk.
+
+    Parameters
+    ----------
+    plan : TrialPlan
+        The trial.
+    logs : tuple of Path
+        One log per requested format.
+    wind_csv : Path or None
+        The anemometer record, if the scenario has an anemometer.
+    truth : Path
+        Truth JSON.
+    """
+
+    plan: TrialPlan
+    logs: tuple[Path, ...]
+    wind_csv: Path | None
+    truth: Path
+
+
+def plan_trials(scenario: Scenario) -> list[TrialPlan]:
+    """Every (condition, maneuver, repeat) of a scenario as a trial, in flight order.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The campaign.
+
+    Returns
+    -------
+    list of TrialPlan
+        ``scenario.n_trials`` trials with consecutive seeds and UTC starts.
+    """
+    plans: list[TrialPlan] = []
+    utc = scenario.utc_start
+    for condition in scenario.conditions:
+        for spec in scenario.maneuvers:
+            for repeat in range(scenario.trials):
+                maneuvers = _maneuvers(spec, scenario.margin_s)
+                duration = _duration(spec, scenario.margin_s)
+                name = f"{condition.name}-{spec.axis}-{spec.kind}-{repeat + 1}"
+                plans.append(TrialPlan(len(plans), name, condition, spec, maneuvers, duration,
+                                       scenario.seed + len(plans), utc))
+                utc = utc + timedelta(seconds=duration + _GAP_BETWEEN_TRIALS_S)
+    return plans
+
+
+def _maneuvers(spec: ManeuverSpec, margin_s: float) -> tuple[Maneuver, ...]:
+    if spec.kind == "height_steps":
+        return ()
+    if spec.kind not in ("sweep", "doublet"):
+        raise NotImplementedError(f"{spec.kind} maneuvers are flown by the nonlinear simulator only")
+    fade = min(spec.fade_in_s, spec.duration_s / 3)
+    return (Maneuver(spec.axis, spec.kind, margin_s, spec.amplitude, spec.duration_s,  # type: ignore[arg-type]
+                     spec.f_start_hz, spec.f_stop_hz, fade, min(1.0, spec.duration_s / 10)),)
+
+
+def _duration(spec: ManeuverSpec, margin_s: float) -> float:
+    if spec.kind == "height_steps":
+        return 2 * margin_s + spec.hold_s * len(spec.heights_m)
+    return 2 * margin_s + spec.duration_s
+
+
+def _simulate_linear(plan: TrialPlan) -> SimulatedFlight:
+    condition = plan.condition
+    wind = WindField(condition.mean_speed_m_s, condition.direction_from_deg, condition.turbulence_ratio)
+    return simulate_hover(plan.duration_s, plan.maneuvers, parameters=CALM_HOVER, wind=wind,
+                          wind_terms=wind_terms_for(condition.mean_speed_m_s), seed=plan.seed)
+
+
+def _write_trial(scenario: Scenario, plan: TrialPlan, flight: SimulatedFlight, folder: Path) -> TrialFiles:
+    logs = []
+    if "dataflash" in scenario.formats:
+        logs.append(write_ardupilot_log(flight, folder / f"{plan.name}.bin", utc_start=plan.utc_start))
+    if "ulog" in scenario.formats:
+        from .px4_writer import write_px4_log
+
+        logs.append(write_px4_log(flight, folder / f"{plan.name}.ulg", utc_start=plan.utc_start))
+    setup = None
+    wind_csv = None
+    if scenario.anemometer is not None and plan.condition.mean_speed_m_s > 0:
+        spec = scenario.anemometer
+        setup = AnemometerSetup(spec.distance_m, spec.rate_hz, spec.clock_offset_s)
+        wind_csv = write_anemometer_csv(flight, folder / f"{plan.name}-anemometer.csv",
+                                        utc_start=plan.utc_start, setup=setup)
+    truth = write_truth(flight, folder / f"{plan.name}-truth.json", utc_start=plan.utc_start, setup=setup)
+    return TrialFiles(plan, tuple(logs), wind_csv, truth)
+
+
+def run_scenario(
+    scenario: Scenario,
+    out_dir: str | Path,
+    *,
+    progress: Callable[[int, int], None] | None = None,
+    trials: Sequence[int] | None = None,
+) -> list[TrialFiles]:
+    """Simulate every trial of a scenario and write its files into `out_dir`.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The campaign.
+    out_dir : str or Path
+        Destination folder (created); an index ``campaign.json`` lists the trials.
+    progress : callable, optional
+        ``progress(done, total)`` in trials.
+    trials : sequence of int, optional
+        Only these trial indices (all when None).
+
+    Returns
+    -------
+    list of TrialFiles
+    """
+    folder = Path(out_dir)
+    folder.mkdir(parents=True, exist_ok=True)
+    plans = [p for p in plan_trials(scenario) if trials is None or p.index in set(trials)]
+    written = []
+    for done, plan in enumerate(plans, start=1):
+        flight = _simulate_linear(plan)
+        written.append(_write_trial(scenario, plan, flight, folder))
+        if progress is not None:
+            progress(done, len(plans))
+    _write_index(scenario, written, folder / "campaign.json")
+    return written
+
+
+def _write_index(scenario: Scenario, written: Sequence[TrialFiles], path: Path) -> None:
+    index = {
+        "scenario": scenario.name,
+        "description": scenario.description,
+        "vehicle": scenario.vehicle,
+        "trials": [
+            {
+                "index": t.plan.index, "name": t.plan.name, "condition": t.plan.condition.name,
+                "axis": t.plan.spec.axis, "kind": t.plan.spec.kind, "seed": t.plan.seed,
+                "utc_start": t.plan.utc_start.isoformat(), "duration_s": t.plan.duration_s,
+                "logs": [p.name for p in t.logs], "anemometer": t.wind_csv.name if t.wind_csv else None,
+                "truth": t.truth.name,
+            }
+            for t in written
+        ],
+    }
+    with atomic_output(path) as tmp:
+        tmp.write_text(json.dumps(index, indent=2) + "\n")

@@ -1,0 +1,68 @@
+"""``sysid simulate``: fly a scenario in the simulator and write real-format logs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from ._common import emit_json, json_option, progress_bar
+
+__all__ = ["simulate"]
+
+_EPILOG = """\b
+Examples:
+  sysid simulate --list
+  sysid simulate chapter3-campaign -o campaign/
+  sysid simulate my-scenario.toml -o out/ --trials 0-3 --json -
+"""
+
+
+def _trial_range(_ctx: click.Context, _param: click.Parameter, value: str | None) -> list[int] | None:
+    if not value:
+        return None
+    picked: list[int] = []
+    for part in value.split(","):
+        first, sep, last = part.partition("-")
+        try:
+            picked.extend(range(int(first), int(last) + 1) if sep else [int(first)])
+        except ValueError:
+            raise click.BadParameter(f"{part!r} is not a trial number or range like 0-3") from None
+    return picked
+
+
+@click.command(epilog=_EPILOG)
+@click.argument("scenario", required=False)
+@click.option("-o", "--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Folder for the logs, anemometer files, truth and campaign.json (default: the scenario name).")
+@click.option("--list", "list_only", is_flag=True, help="List the built-in scenarios and exit.")
+@click.option("--trials", callback=_trial_range, help="Only these trials, e.g. 0-3,7.")
+@json_option
+@click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")
+def simulate(scenario: str | None, out_dir: Path | None, list_only: bool, trials: list[int] | None,
+             json_path: str | None, quiet: bool) -> None:
+    """Fly SCENARIO (a built-in name or a TOML file) and write each trial's logs (ArduPilot .bin,
+    PX4 .ulg), the ground anemometer's CSV and a truth JSON."""
+    from sysid.sim.campaign import run_scenario
+    from sysid.sim.scenario import builtin_scenarios, load_builtin, read_scenario
+
+    if list_only:
+        for name, path in sorted(builtin_scenarios().items()):
+            click.echo(f"{name:<24} {read_scenario(path).description}")
+        return
+    if scenario is None:
+        raise click.UsageError("give a SCENARIO (a built-in name or a .toml file), or --list")
+    plan = read_scenario(scenario) if scenario.endswith(".toml") else load_builtin(scenario)
+    folder = out_dir if out_dir is not None else Path(plan.name)
+    with progress_bar(f"simulating {plan.name}", quiet=quiet) as bar:
+        written = run_scenario(plan, folder, progress=bar, trials=trials)
+    summary = {
+        "scenario": plan.name,
+        "out": str(folder),
+        "trials": [{"name": t.plan.name, "logs": [str(p) for p in t.logs],
+                    "anemometer": str(t.wind_csv) if t.wind_csv else None, "truth": str(t.truth)} for t in written],
+    }
+    if not quiet:
+        click.echo(f"{plan.name}: {len(written)} trials written to {folder}/ (index: {folder / 'campaign.json'})",
+                   err=json_path == "-")
+    emit_json(summary, json_path)
