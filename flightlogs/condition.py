@@ -60,6 +60,10 @@ class ConditioningOptions:
         own clock without GPS time), s; None to rely on GPS time alone.
     estimate_wind_offset : bool
         Also apply the residual clock offset found by cross-correlation.
+    estimate_transport_delay : bool
+        Find the transport delay by cross-correlation instead (the clock
+        offset is then trusted); a delay and a clock offset shift the wind the
+        same way, so only one of the two can be estimated.
     wind_distance_m : float or None
         Anemometer-to-vehicle distance, m (the dissertation: 4.6 m).
     wind_bearing_rad : float or None
@@ -85,6 +89,7 @@ class ConditioningOptions:
     rate_hz: float | None = None
     wind_offset_s: float | None = None
     estimate_wind_offset: bool = False
+    estimate_transport_delay: bool = False
     wind_distance_m: float | None = None
     wind_bearing_rad: float | None = None
     anemometer_position_rad: tuple[float, float] | None = None
@@ -94,6 +99,9 @@ class ConditioningOptions:
     segments: tuple[Segment, ...] | None = None
 
     def __post_init__(self) -> None:
+        if self.estimate_wind_offset and self.estimate_transport_delay:
+            raise ValueError("estimate either the clock offset or the transport delay, not both: "
+                             "they shift the wind alike")
         if self.anemometer_position_rad is not None:
             lat, lon = (float(v) for v in self.anemometer_position_rad)
             if not (abs(lat) <= np.pi / 2 and abs(lon) <= np.pi):
@@ -156,6 +164,8 @@ def condition_flight(
         If the log has none of the core signals, no stretch long enough, or
         the wind cannot be aligned.
     """
+    if options.estimate_transport_delay and wind is not None:
+        return _with_estimated_delay(log, wind, options)
     notes: list[str] = []
     core = {name: _unwrapped(log.signals[name]) for name in CORE_SIGNALS if name in log.signals}
     if not core:
@@ -339,6 +349,28 @@ def _with_estimated_offset(log: FlightLog, wind: Any, options: ConditioningOptio
     alignment = replace(again.wind, clock_offset_source="estimated", residual=first.residual,
                         residual_against=first.residual_against)
     return replace(again, wind=alignment)
+
+
+def _with_estimated_delay(log: FlightLog, wind: Any, options: ConditioningOptions) -> ConditionedFlight:
+    """Condition without a delay, take the vehicle's lag behind the wind as the delay, condition again."""
+    first = condition_flight(log, wind, replace(options, transport_delay_s=0.0, estimate_transport_delay=False))
+    assert first.wind is not None
+    if first.wind.residual is None:
+        raise DataError(
+            f"{log.path}: the transport delay cannot be estimated: the log has neither an autopilot wind "
+            "estimate nor attitude to correlate the wind with; give --wind-distance or --transport-delay"
+        )
+    delay = first.wind.residual.lag_s
+    if delay < 0:
+        raise DataError(
+            f"{log.path}: the vehicle sees the wind {-delay:.2f} s before the anemometer: it is not upstream "
+            "(or its clock is off); give --wind-distance or --transport-delay"
+        )
+    again = condition_flight(log, wind, replace(options, transport_delay_s=delay, estimate_transport_delay=False))
+    assert again.wind is not None
+    transport = replace(again.wind.transport, source="correlation")
+    return replace(again, wind=replace(again.wind, transport=transport, residual=first.wind.residual,
+                                       residual_against=first.wind.residual_against))
 
 
 def _derived(values: dict[str, np.ndarray], units: dict[str, str], *, wind_given: bool, notes: list[str]) -> None:

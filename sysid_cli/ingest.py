@@ -68,6 +68,8 @@ def parse_position(_ctx: click.Context, _param: click.Parameter, value: str | No
               help="Anemometer clock minus UTC, s (minus the log's clock when the log has no GPS time).")
 @click.option("--estimate-wind-offset", is_flag=True,
               help="Correct the clock offset by cross-correlating the wind with the vehicle's response.")
+@click.option("--estimate-transport-delay", is_flag=True,
+              help="Find the transport delay by that cross-correlation instead (trusting the clock offset).")
 @click.option("--rate", "rate_hz", type=click.FloatRange(min=0, min_open=True), metavar="HZ",
               help="Rate of the common time base (default: the fastest core signal's).")
 @click.option("--segments", "segments_file", type=click.Path(exists=True, dir_okay=False, path_type=Path),
@@ -79,7 +81,8 @@ def parse_position(_ctx: click.Context, _param: click.Parameter, value: str | No
 def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[str, str] | None,
            wind_distance: float | None, wind_bearing: float | None, anemometer_at: tuple[float, float] | None,
            transport_delay: float | None,
-           wind_offset: float | None, estimate_wind_offset: bool, rate_hz: float | None,
+           wind_offset: float | None, estimate_wind_offset: bool, estimate_transport_delay: bool,
+           rate_hz: float | None,
            segments_file: Path | None, out: Path | None, json_path: str | None, quiet: bool) -> None:
     """Read LOGS (PX4 .ulg, ArduPilot .bin or MAVLink .tlog, detected from content), report every
     canonical signal with its rate, unit and source, align the anemometer wind, and find the maneuvers."""
@@ -88,8 +91,11 @@ def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[s
     from flightlogs.segments import read_segments_file
     from flightlogs.store import write_dataset
 
+    if estimate_wind_offset and estimate_transport_delay:
+        raise click.UsageError("--estimate-wind-offset and --estimate-transport-delay shift the wind alike; pick one")
     options = ConditioningOptions(
         rate_hz=rate_hz, wind_offset_s=wind_offset, estimate_wind_offset=estimate_wind_offset,
+        estimate_transport_delay=estimate_transport_delay,
         wind_distance_m=wind_distance, wind_bearing_rad=None if wind_bearing is None else math.radians(wind_bearing),
         anemometer_position_rad=anemometer_at, transport_delay_s=transport_delay,
         segments=read_segments_file(segments_file) if segments_file is not None else None,

@@ -97,3 +97,30 @@ def test_a_bad_anemometer_position_is_a_usage_error(demo_dir: Path, value: str, 
     ])
     assert result.exit_code == 2
     assert "--anemometer-at" in result.stderr and fragment in result.stderr
+
+
+def test_transport_delay_by_correlation_from_the_command_line(demo_dir: Path) -> None:
+    truth = json.loads((demo_dir / "truth.json").read_text())["anemometer"]
+    result = CliRunner().invoke(cli, [
+        "ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"),
+        "--wind-offset", str(truth["clock_offset_s"]), "--estimate-transport-delay", "--json", "-", "-q",
+    ])
+    assert result.exit_code == 0, result.output
+    alignment = json.loads(result.stdout)["wind_alignment"]
+    assert alignment["transport_delay_source"] == "correlation"
+    assert abs(alignment["transport_delay_s"] - truth["transport_delay_s"]) < 0.01
+    both = CliRunner().invoke(cli, ["ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"),
+                                    "--estimate-wind-offset", "--estimate-transport-delay"])
+    assert both.exit_code == 2 and "pick one" in both.output
+
+
+def test_a_segments_file_overrides_detection(demo_dir: Path, tmp_path: Path) -> None:
+    segments = tmp_path / "maneuvers.csv"
+    segments.write_text("start_s,end_s,axis,kind\n26.0,60.0,lon,sweep\n66.0,68.0,lon,doublet\n")
+    result = CliRunner().invoke(cli, ["ingest", str(demo_dir / "flight.bin"), "--segments", str(segments), "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    found = [(s["axis"], s["kind"], s["start_s"], s["end_s"], s["source"]) for s in json.loads(result.stdout)["segments"]]
+    assert found == [("lon", "sweep", 26.0, 60.0, "user"), ("lon", "doublet", 66.0, 68.0, "user")]
+    segments.write_text("start_s,end_s,axis\n50,45,lon\n")
+    bad = CliRunner().invoke(cli, ["ingest", str(demo_dir / "flight.bin"), "--segments", str(segments)])
+    assert bad.exit_code == 1 and f"{segments.name}:2" in bad.stderr

@@ -69,6 +69,14 @@ def test_aligned_wind_matches_the_wind_at_the_vehicle(demo: dict) -> None:
     assert clock_ignored > 30 * aligned and delay_ignored > 30 * aligned
 
 
+def test_transport_delay_is_estimated_within_one_sample_on_request(demo: dict) -> None:
+    flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_offset_s=1.5, estimate_transport_delay=True))
+    assert flight.wind is not None and flight.wind.transport.source == "correlation"
+    assert abs(flight.wind.transport.delay_s - demo["truth"]["anemometer"]["transport_delay_s"]) < ONE_SAMPLE_S
+    with pytest.raises(ValueError, match="not both"):
+        ConditioningOptions(estimate_wind_offset=True, estimate_transport_delay=True)
+
+
 def test_transport_delay_can_be_found_by_correlation(demo: dict) -> None:
     """Assuming no delay, the residual against the autopilot's wind estimate is the transport delay."""
     flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(transport_delay_s=0.0, wind_offset_s=1.5))
