@@ -340,12 +340,24 @@ def _longest_finite_run(mask: np.ndarray) -> tuple[int, int]:
     return max(_true_runs(mask), key=lambda run: run[1] - run[0], default=(0, 0))
 
 
+_MAX_OFFSET_ITERATIONS = 6
+
+
 def _with_estimated_offset(log: FlightLog, wind: Any, options: ConditioningOptions, first: WindAlignment) -> ConditionedFlight:
-    """Condition again with the clock offset corrected by the residual found (vehicle lags by +lag)."""
+    """Condition again with the clock offset corrected by the residual found (vehicle lags by +lag).
+
+    A large first residual is measured on a broad correlation peak, so the
+    correction is repeated until what is left is under a tenth of a sample.
+    """
     assert first.residual is not None
     corrected = first.clock_offset_s - first.residual.lag_s
-    again = condition_flight(log, wind, replace(options, wind_offset_s=corrected, estimate_wind_offset=False))
-    assert again.wind is not None
+    for _ in range(_MAX_OFFSET_ITERATIONS):
+        again = condition_flight(log, wind, replace(options, wind_offset_s=corrected, estimate_wind_offset=False))
+        assert again.wind is not None
+        left = again.wind.residual
+        if left is None or abs(left.lag_s) < 0.1 / again.rate_hz:
+            break
+        corrected -= left.lag_s
     alignment = replace(again.wind, clock_offset_source="estimated", residual=first.residual,
                         residual_against=first.residual_against)
     return replace(again, wind=alignment)

@@ -7,8 +7,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta
 from pathlib import Path
+from typing import Any
 
 from flightlogs.atomic import atomic_output
+from flightlogs.errors import DataError
 
 from .excitation import Maneuver
 from .linear_flight import CALM_HOVER, SimulatedFlight, WindField, simulate_hover, wind_terms_for
@@ -104,19 +106,68 @@ def plan_trials(scenario: Scenario) -> list[TrialPlan]:
 
 
 def _maneuvers(spec: ManeuverSpec, margin_s: float) -> tuple[Maneuver, ...]:
-    if spec.kind == "height_steps":
-        return ()
     if spec.kind not in ("sweep", "doublet"):
-        raise NotImplementedError(f"{spec.kind} maneuvers are flown by the nonlinear simulator only")
+        return ()  # height steps and 3-2-1-1 / multisine injections: see _injections
     fade = min(spec.fade_in_s, spec.duration_s / 3)
     return (Maneuver(spec.axis, spec.kind, margin_s, spec.amplitude, spec.duration_s,  # type: ignore[arg-type]
                      spec.f_start_hz, spec.f_stop_hz, fade, min(1.0, spec.duration_s / 10)),)
+
+
+def _injections(spec: ManeuverSpec, margin_s: float) -> tuple[Any, ...]:
+    if spec.kind not in ("3211", "multisine"):
+        return ()
+    from .control import Injection
+
+    return (Injection(spec.axis, spec.kind, margin_s, spec.amplitude, spec.duration_s,  # type: ignore[arg-type]
+                      spec.f_start_hz, spec.f_stop_hz),)
 
 
 def _duration(spec: ManeuverSpec, margin_s: float) -> float:
     if spec.kind == "height_steps":
         return 2 * margin_s + spec.hold_s * len(spec.heights_m)
     return 2 * margin_s + spec.duration_s
+
+
+def _nonlinear_trial(scenario: Scenario, plan: TrialPlan) -> Any:
+    """The nonlinear simulator's Trial for one plan: wind, anemometer, ground effect, height steps."""
+    from .control import HeightSteps
+    from .environment import Anemometer, Environment, GroundEffect
+    from .nonlinear import Trial
+    from .wind_field import Dryden, Wind
+
+    condition, spec = plan.condition, plan.spec
+    height = spec.heights_m[0] if spec.kind == "height_steps" else 4.6
+    turbulence = None
+    if condition.mean_speed_m_s > 0 and condition.turbulence_ratio > 0:
+        nominal = Dryden.low_altitude(height, condition.mean_speed_m_s)
+        turbulence = Dryden.low_altitude(height, condition.mean_speed_m_s,
+                                         scale=condition.turbulence_ratio * condition.mean_speed_m_s / nominal.sigma_m_s[0])
+    wind = Wind(condition.mean_speed_m_s, condition.direction_from_deg, turbulence)
+    anemometer = Anemometer(distance_m=scenario.anemometer.distance_m) if scenario.anemometer else Anemometer()
+    ground = str(scenario.effects.get("ground_effect", "none")).replace("-", "_").replace("4_rotor", "4rotor")
+    ground = ground.replace("2_rotor", "2rotor")
+    environment = Environment(wind=wind, anemometer=anemometer, ground_effect=GroundEffect(model=ground))  # type: ignore[arg-type]
+    steps = None
+    if spec.kind == "height_steps":
+        times = tuple(scenario.margin_s + k * spec.hold_s for k in range(len(spec.heights_m)))
+        steps = HeightSteps(times, spec.heights_m)
+    return Trial(plan.duration_s, plan.maneuvers, _injections(spec, scenario.margin_s), environment=environment,
+                 seed=plan.seed, hover_height_m=height, height_steps=steps, label=plan.name)
+
+
+def _simulate(scenario: Scenario, plans: Sequence[TrialPlan],
+              progress: Callable[[int, int], None] | None) -> list[SimulatedFlight]:
+    if scenario.vehicle == "linear-octo":
+        unsupported = sorted({p.spec.kind for p in plans} - {"sweep", "doublet"})
+        if unsupported:
+            raise DataError(f"scenario {scenario.name!r}: the linear model flies sweeps and doublets only, "
+                            f"not {', '.join(unsupported)}; use vehicle octo-s1000")
+        return [_simulate_linear(plan) for plan in plans]
+    from .nonlinear import simulate_flights
+    from .presets import CRAZYFLIE, OCTO_S1000
+
+    vehicle = OCTO_S1000 if scenario.vehicle == "octo-s1000" else CRAZYFLIE
+    return list(simulate_flights([_nonlinear_trial(scenario, plan) for plan in plans], vehicle, progress=progress))
 
 
 def _simulate_linear(plan: TrialPlan) -> SimulatedFlight:
@@ -161,7 +212,7 @@ def run_scenario(
     out_dir : str or Path
         Destination folder (created); an index ``campaign.json`` lists the trials.
     progress : callable, optional
-        ``progress(done, total)`` in trials.
+        ``progress(done, total)`` as the simulation advances.
     trials : sequence of int, optional
         Only these trial indices (all when None).
 
@@ -172,12 +223,8 @@ def run_scenario(
     folder = Path(out_dir)
     folder.mkdir(parents=True, exist_ok=True)
     plans = [p for p in plan_trials(scenario) if trials is None or p.index in set(trials)]
-    written = []
-    for done, plan in enumerate(plans, start=1):
-        flight = _simulate_linear(plan)
-        written.append(_write_trial(scenario, plan, flight, folder))
-        if progress is not None:
-            progress(done, len(plans))
+    flights = _simulate(scenario, plans, progress)
+    written = [_write_trial(scenario, plan, flight, folder) for plan, flight in zip(plans, flights)]
     _write_index(scenario, written, folder / "campaign.json")
     return written
 

@@ -7,7 +7,7 @@ from typing import Literal
 
 import numpy as np
 
-__all__ = ["Axis", "Maneuver", "sweep", "doublet", "excitation_signal"]
+__all__ = ["Axis", "Maneuver", "sweep", "doublet", "excitation_signal", "three_two_one_one", "multisine"]
 
 Axis = Literal["lat", "lon", "yaw", "thr"]
 
@@ -144,3 +144,94 @@ def excitation_signal(time_s: np.ndarray, maneuvers: tuple[Maneuver, ...], axis:
             continue
         total += sweep(time_s, maneuver)[0] if maneuver.kind == "sweep" else doublet(time_s, maneuver)
     return total
+
+
+def three_two_one_one(time_s: np.ndarray, start_s: float, amplitude: float, pulse_s: float) -> np.ndarray:
+    """3-2-1-1 multistep: +A for 3 pulses, -A for 2, +A for 1, -A for 1.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (n_samples,)
+        Times, s.
+    start_s : float
+        Start, s.
+    amplitude : float
+        Step height, in the mixer input's unit.
+    pulse_s : float
+        Length of the shortest step, s (the whole input lasts 7 pulses).
+
+    Returns
+    -------
+    ndarray, shape (n_samples,)
+        Excitation, zero outside.
+
+    Examples
+    --------
+    >>> three_two_one_one(np.arange(8.0) + 0.5, 0.0, 1.0, 1.0)
+    array([ 1.,  1.,  1., -1., -1.,  1., -1.,  0.])
+    """
+    if pulse_s <= 0:
+        raise ValueError(f"{pulse_s=} must be > 0")
+    k = np.floor((np.asarray(time_s, dtype=np.float64) - start_s) / pulse_s)
+    pattern = np.array([1.0, 1.0, 1.0, -1.0, -1.0, 1.0, -1.0])
+    inside = (k >= 0) & (k < 7)
+    return np.where(inside, amplitude * pattern[np.clip(k, 0, 6).astype(np.intp)], 0.0)
+
+
+def multisine(
+    time_s: np.ndarray,
+    start_s: float,
+    duration_s: float,
+    amplitude: float,
+    *,
+    f_min_hz: float = 0.1,
+    f_max_hz: float = 10.0,
+    n_tones: int = 30,
+    fade_s: float = 1.0,
+) -> np.ndarray:
+    """Schroeder-phased multisine: log-spaced harmonics of 1/duration, peak `amplitude`.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (n_samples,)
+        Times, s.
+    start_s : float
+        Start, s.
+    duration_s : float
+        Length, s (the tones are harmonics of 1/duration_s).
+    amplitude : float
+        Peak value (before the fades), in the mixer input's unit.
+    f_min_hz, f_max_hz : float, optional
+        Frequency band, Hz.
+    n_tones : int, optional
+        Number of tones (fewer if the band holds fewer harmonics).
+    fade_s : float, optional
+        Linear fade in and out, s.
+
+    Returns
+    -------
+    ndarray, shape (n_samples,)
+        Excitation, zero outside.
+
+    Notes
+    -----
+    Schroeder phases ``-pi k (k - 1) / n`` keep the crest factor low; the
+    peak is normalised on a grid of 64 samples per period of the top tone
+    (within 0.2 % of the true peak).
+    """
+    if duration_s <= 2 * fade_s or not 0 < f_min_hz < f_max_hz:
+        raise ValueError("need duration_s > 2 fade_s and 0 < f_min_hz < f_max_hz")
+    base = 1.0 / duration_s
+    harmonics = np.unique(np.round(np.geomspace(max(f_min_hz / base, 1.0), f_max_hz / base, n_tones)))
+    k = np.arange(1, harmonics.size + 1)
+    phases = -np.pi * k * (k - 1) / harmonics.size
+
+    def shape(t: np.ndarray) -> np.ndarray:
+        return np.sum(np.cos(2 * np.pi * base * harmonics[:, None] * t[None, :] + phases[:, None]), axis=0)
+
+    grid = np.arange(0.0, duration_s, 1.0 / (64 * f_max_hz))
+    peak = float(np.max(np.abs(shape(grid))))
+    t = np.asarray(time_s, dtype=np.float64) - start_s
+    inside = (t >= 0) & (t < duration_s)
+    envelope = np.clip(t / fade_s, 0, 1) * np.clip((duration_s - t) / fade_s, 0, 1) if fade_s > 0 else 1.0
+    return np.where(inside, amplitude * envelope * shape(t) / peak, 0.0)

@@ -214,12 +214,17 @@ def write_anemometer_csv(
     -------
     Path
     """
-    wind = flight.wind_at_vehicle
-    delay = setup.distance_m / float(np.hypot(*wind.mean(axis=0)))
-    sensor_t = np.arange(flight.time_s[0] - delay, flight.time_s[-1] - delay, 1.0 / setup.rate_hz)
-    sensor_t = sensor_t[sensor_t + delay >= flight.time_s[0]]
-    wind_n = np.interp(sensor_t + delay, flight.time_s, wind[:, 0])
-    wind_e = np.interp(sensor_t + delay, flight.time_s, wind[:, 1])
+    at_anemometer = getattr(flight, "wind_at_anemometer", None)
+    if at_anemometer is not None:  # the simulator sampled the frozen field at the anemometer itself
+        sensor_t = np.arange(flight.time_s[0], flight.time_s[-1], 1.0 / setup.rate_hz)
+        wind_n = np.interp(sensor_t, flight.time_s, at_anemometer[:, 0])
+        wind_e = np.interp(sensor_t, flight.time_s, at_anemometer[:, 1])
+    else:  # the vehicle's wind, seen the transport delay earlier
+        delay = _transport_delay_s(flight, setup)
+        sensor_t = np.arange(flight.time_s[0] - delay, flight.time_s[-1] - delay, 1.0 / setup.rate_hz)
+        sensor_t = sensor_t[sensor_t + delay >= flight.time_s[0]]
+        wind_n = np.interp(sensor_t + delay, flight.time_s, flight.wind_at_vehicle[:, 0])
+        wind_e = np.interp(sensor_t + delay, flight.time_s, flight.wind_at_vehicle[:, 1])
     speed = np.hypot(wind_n, wind_e)
     direction_from = np.mod(np.degrees(np.arctan2(-wind_e, -wind_n)), 360.0)
     lines = ["utc,speed_m_s,direction_deg"]
@@ -229,6 +234,27 @@ def write_anemometer_csv(
     with atomic_output(path) as tmp:
         tmp.write_text("\n".join(lines) + "\n")
     return Path(path)
+
+
+def _transport_delay_s(flight: SimulatedFlight, setup: AnemometerSetup) -> float:
+    """The simulator's own delay when it advected a frozen field, else distance / mean speed."""
+    simulated = getattr(flight, "transport_delay_s", None)
+    if simulated is not None:
+        return float(simulated)
+    return setup.distance_m / float(np.hypot(*flight.wind_at_vehicle.mean(axis=0)))
+
+
+def _effective_transport_delay_s(flight: SimulatedFlight, setup: AnemometerSetup) -> float:
+    """Delay to where the vehicle actually was on average: a position hold leaves it a few cm up- or
+    downwind of its set point, which moves the delay by that distance over the mean wind speed."""
+    nominal = _transport_delay_s(flight, setup)
+    truth = getattr(flight, "truth", None)
+    if not truth or "pn" not in truth or nominal <= 0:
+        return nominal
+    mean_wind = flight.wind_at_vehicle.mean(axis=0)
+    towards = mean_wind / np.hypot(*mean_wind)
+    along_m = float(np.mean(truth["pn"] * towards[0] + truth["pe"] * towards[1]))
+    return nominal + along_m / (setup.distance_m / nominal)
 
 
 def write_truth(
@@ -267,7 +293,8 @@ def write_truth(
     if setup is not None:
         truth["anemometer"] = {
             "distance_m": setup.distance_m, "rate_hz": setup.rate_hz, "clock_offset_s": setup.clock_offset_s,
-            "transport_delay_s": setup.distance_m / float(np.hypot(*flight.wind_at_vehicle.mean(axis=0))),
+            "transport_delay_s": _transport_delay_s(flight, setup),
+            "effective_transport_delay_s": _effective_transport_delay_s(flight, setup),
             "position_deg": [float(np.degrees(v)) for v in
                              setup.position_rad(flight, vehicle_position_deg=vehicle_position_deg)],
         }
