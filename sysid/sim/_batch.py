@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from types import MappingProxyType
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -45,6 +45,7 @@ class _Setup:
     delay_whole: np.ndarray  # (4,) int
     delay_frac: np.ndarray  # (4,)
     buffer_len: int
+    seen_noise: np.ndarray  # (n_log, n, 10): rates, attitude, velocity, height errors the controller sees
 
 
 def _trim_for(trial, vehicle: Vehicle, conditions: Conditions, cache: dict) -> Trim:
@@ -108,7 +109,36 @@ def _setup(trials: list, vehicle: Vehicle, gains: ControllerGains, n_log: int, r
         state0, initial_controller_state(gains, euler, mixer_trim, gravity), mixer_trim, reference, heights,
         excitation, BatchWindField.stack([t.environment.wind for t in trials], fields), fields,
         np.array(anemometers), whole, delays - whole, int(whole.max()) + 2,
+        np.stack([_seen_noise(t, n_steps // decimation + 1) for t in trials], axis=1),
     )
+
+
+def _seen_noise(trial: Any, n_log: int) -> np.ndarray:
+    """Estimation errors the controller acts on, (n_log, 10), drawn per trial (batching cannot change them).
+
+    A real autopilot flies on noisy estimates, which is why its mixer inputs are never
+    noise-free; the errors are white at the log rate and held between log samples.
+    """
+    sensors = trial.environment.sensors
+    sigma = np.array([sensors.gyro_rad_s] * 3 + [sensors.attitude_rad] * 3 + [sensors.velocity_m_s] * 3
+                     + [sensors.height_m])
+    rng = np.random.default_rng(np.random.SeedSequence(trial.seed).spawn(4)[3])
+    return rng.standard_normal((n_log, sigma.size)) * sigma
+
+
+def _as_seen(state: np.ndarray, noise: np.ndarray) -> np.ndarray:
+    """The state as the controller's estimator reports it: rates, attitude, velocity and height with errors."""
+    seen = state.copy()
+    seen[:, 10:13] += noise[:, 0:3]
+    half = 0.5 * noise[:, 3:6]  # small rotation, body axes
+    w, x, y, z = state[:, 6], state[:, 7], state[:, 8], state[:, 9]
+    a, b, c = half[:, 0], half[:, 1], half[:, 2]
+    quat = np.column_stack([w - x * a - y * b - z * c, x + w * a + y * c - z * b,
+                            y + w * b + z * a - x * c, z + w * c + x * b - y * a])
+    seen[:, 6:10] = quat / np.linalg.norm(quat, axis=1, keepdims=True)
+    seen[:, 3:6] += noise[:, 6:9]
+    seen[:, 2] += noise[:, 9]
+    return seen
 
 
 def _step(vehicle: Vehicle, state: np.ndarray, command: np.ndarray, wind: np.ndarray, mass: np.ndarray,
@@ -148,7 +178,8 @@ def _integrate(setup: _Setup, vehicle: Vehicle, gains: ControllerGains, method: 
         t = k * setup.dt_s
         wind = setup.wind.at(state[:, 0:2], t)
         reference[:, 2] = setup.height_ref[k]
-        mixer, integrators = controller_step(gains, integrators, state, reference, setup.dt_s, gravity)
+        seen = _as_seen(state, setup.seen_noise[k // setup.decimation])
+        mixer, integrators = controller_step(gains, integrators, seen, reference, setup.dt_s, gravity)
         mixer = mixer + setup.excitation[k]
         buffer[k % length] = mixer
         newer = buffer[(k - setup.delay_whole) % length, :, axes]  # (4, n)

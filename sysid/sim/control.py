@@ -334,7 +334,7 @@ def controller_step(gains: ControllerGains, integrators: np.ndarray, state: np.n
     integrators : ndarray, shape (n_trials, N_CONTROLLER_STATES)
         Integrator values.
     state : ndarray, shape (n_trials, n_states)
-        Vehicle states (the controller sees the truth: a perfect estimator).
+        Vehicle states as the estimator reports them (the simulator adds estimation errors).
     reference : ndarray, shape (n_trials, 4)
         North, east (m), height above ground (m), heading (rad) to hold.
     dt_s : float
