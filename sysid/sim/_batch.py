@@ -166,7 +166,7 @@ def _integrate(setup: _Setup, vehicle: Vehicle, gains: ControllerGains, method: 
     n_log = setup.n_steps // setup.decimation
     logs = {"state": np.empty((n_log, n, setup.state0.shape[1])), "specific": np.empty((n_log, n, 3)),
             "mixer": np.empty((n_log, n, 4)), "command": np.empty((n_log, n, vehicle.n_rotors)),
-            "wind": np.empty((n_log, n, 3)), "mass": np.empty((n_log, n))}
+            "wind": np.empty((n_log, n, 3)), "mass": np.empty((n_log, n)), "seen": np.empty((n_log, n, 13))}
     state, integrators = setup.state0.copy(), setup.integrators0.copy()
     length = setup.buffer_len
     buffer = np.repeat(setup.mixer_trim[None], length, axis=0)
@@ -192,6 +192,7 @@ def _integrate(setup: _Setup, vehicle: Vehicle, gains: ControllerGains, method: 
             j = k // setup.decimation
             logs["state"][j], logs["specific"][j], logs["mixer"][j] = previous, specific, mixer
             logs["command"][j], logs["wind"][j], logs["mass"][j] = command, wind, mass
+            logs["seen"][j] = seen[:, :13]
             if progress is not None and j % 100 == 0:
                 progress(k, setup.n_steps)
     return logs
@@ -220,6 +221,19 @@ def _anemometer_wind(field: FrozenField, trial, position_ne: np.ndarray, time_s:
         g = gusts + rho * (g - gusts) + np.sqrt(1.0 - rho**2) * other
     mean = wind.mean_ned
     return np.column_stack([mean[0] + g[:, 0] * e[0] - g[:, 1] * e[1], mean[1] + g[:, 0] * e[1] + g[:, 1] * e[0]])
+
+
+def _estimates(logs: dict[str, np.ndarray], i: int, sensors: Any) -> dict[str, np.ndarray]:
+    """The rates, attitude, velocity and height the controller flew on: what an autopilot logs.
+
+    The gyro bias is added here (the controller's estimate carries white errors only).
+    """
+    seen = logs["seen"][:, i]
+    euler = quaternion_to_euler(seen[:, 6:10])
+    bias = sensors.gyro_bias_rad_s
+    return {"p": seen[:, 10] + bias[0], "q": seen[:, 11] + bias[1], "r": seen[:, 12] + bias[2],
+            "phi": euler[:, 0], "theta": euler[:, 1], "psi": euler[:, 2],
+            "vn": seen[:, 3], "ve": seen[:, 4], "vd": seen[:, 5], "height_agl": -seen[:, 2]}
 
 
 def _flight_signals(vehicle: Vehicle, logs: dict[str, np.ndarray], i: int) -> dict[str, np.ndarray]:
@@ -256,7 +270,7 @@ def run_batch(trials: list, vehicle: Vehicle, gains: ControllerGains, *, n_log: 
     for i, trial in enumerate(trials):
         clean = _flight_signals(vehicle, logs, i)
         noise_rng = np.random.default_rng(np.random.SeedSequence(trial.seed).spawn(3)[1])
-        noisy = trial.environment.sensors.apply(clean, noise_rng)
+        noisy = trial.environment.sensors.apply(clean, noise_rng) | _estimates(logs, i, trial.environment.sensors)
         wind = trial.environment.wind
         truth = dict(clean) | {"wind_d": logs["wind"][:, i, 2].copy(), "mass_kg": logs["mass"][:, i].copy(),
                                "pn": logs["state"][:, i, 0].copy(), "pe": logs["state"][:, i, 1].copy()}
