@@ -24,3 +24,11 @@ def real_data() -> Path:
     if not REAL_DATA.is_dir():
         pytest.fail(f"real flight data not found at {REAL_DATA} (set SYSID_REAL_DATA)")
     return REAL_DATA
+
+
+# CI runs Hypothesis derandomized, so a green run is reproducible; local runs keep exploring.
+from hypothesis import settings as _hypothesis_settings  # noqa: E402
+
+_hypothesis_settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
+if os.environ.get("CI"):
+    _hypothesis_settings.load_profile("ci")

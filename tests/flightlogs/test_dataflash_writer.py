@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pymavlink.DFReader import FORMAT_TO_STRUCT, DFReader_binary
 
-from flightlogs.dataflash import DataFlashMessages, decode_messages, read_messages
+from flightlogs.dataflash import DataFlashMessages, decode_messages, message_dtype, read_messages
 from flightlogs.dataflash_writer import (
     STANDARD_FORMATS, MessageBlock, MessageSpec, encode_dataflash, parameter_block, standard_block, text_block,
     write_dataflash,
@@ -69,7 +69,9 @@ def _blocks(draw: st.DrawFn) -> list[MessageBlock]:
     chars = "".join(sorted(FORMAT_TO_STRUCT))
     blocks = []
     for k in range(draw(st.integers(1, 3))):
-        fmt = draw(st.text(st.sampled_from(chars), min_size=1, max_size=8))
+        # a message is at most 255 bytes (its FMT Length is one byte): draw formats that fit
+        fmt = draw(st.text(st.sampled_from(chars), min_size=1, max_size=8).filter(
+            lambda f: message_dtype("Q" + f).itemsize <= 255))
         n = draw(st.integers(0, 6))
         spec = MessageSpec(f"T{k}", "Q" + fmt, ("TimeUS", *(f"F{i}" for i in range(len(fmt)))))
         data = {"TimeUS": np.array(draw(st.lists(st.integers(0, 10**12), min_size=n, max_size=n)), dtype=np.uint64)}
@@ -178,3 +180,13 @@ def test_standard_formats_are_valid_and_sized_like_ardupilot() -> None:
     assert STANDARD_FORMATS["SIDS"].length == 3 + 8 + 1 + 7 * 4
     assert STANDARD_FORMATS["SIDD"].length == 3 + 8 + 9 * 4
     assert STANDARD_FORMATS["IMU"].units[1] == "#"
+
+
+def test_a_message_longer_than_255_bytes_is_refused(tmp_path: Path) -> None:
+    """DataFlash's FMT Length is one byte: Q + four 64-byte strings (3 + 8 + 256 bytes) cannot be written."""
+    spec = MessageSpec("LONG", "QZZZZ", ("TimeUS", "A", "B", "C", "D"))
+    block = MessageBlock(spec, {"TimeUS": np.array([1], dtype=np.uint64),
+                                **{c: np.array(["x"], dtype=object) for c in "ABCD"}})
+    with pytest.raises(ValueError, match="FMT.Length"):
+        write_dataflash(tmp_path / "long.bin", [block])
+    assert not (tmp_path / "long.bin").exists()
