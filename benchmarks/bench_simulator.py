@@ -25,11 +25,13 @@ def main() -> None:
     for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[name] = str(args.threads)
 
-    from sysid.sim.nonlinear import chapter3_campaign, simulate_flights, truth_parameters
+    from sysid.sim.campaign import scenario_trials
+    from sysid.sim.nonlinear import simulate_flights, truth_parameters
     from sysid.sim.presets import OCTO_S1000
+    from sysid.sim.scenario import load_builtin
 
     truth_parameters(OCTO_S1000)  # linearise once, outside the timing
-    campaign = chapter3_campaign()
+    campaign = scenario_trials(load_builtin("chapter3-campaign"))
     steps = sum(round(t.duration_s * 400) for t in campaign)
     start = time.perf_counter()
     flights = simulate_flights(campaign, method=args.method)

@@ -21,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
@@ -232,8 +232,8 @@ def _wind_signals(
             "give --wind-offset (anemometer time minus log time, s)"
         )
     clock_offset = options.wind_offset_s or 0.0
-    source = "user" if options.wind_offset_s is not None else "gps"
-    reference = "utc" if log.utc_offset_s is not None else "log"
+    source: Literal["gps", "user"] = "user" if options.wind_offset_s is not None else "gps"
+    reference: Literal["utc", "log"] = "utc" if log.utc_offset_s is not None else "log"
     start, end = log.time_range_s
     raw_time = wind_log_time(log, wind, clock_offset_s=clock_offset, transport_delay_s=0.0)
     during = (raw_time >= start) & (raw_time <= end)
@@ -358,6 +358,7 @@ def _with_estimated_offset(log: FlightLog, wind: Any, options: ConditioningOptio
         if left is None or abs(left.lag_s) < 0.1 / again.rate_hz:
             break
         corrected -= left.lag_s
+    assert again.wind is not None
     alignment = replace(again.wind, clock_offset_source="estimated", residual=first.residual,
                         residual_against=first.residual_against)
     return replace(again, wind=alignment)
@@ -484,5 +485,5 @@ def _record(
         if segment.kind == "hover":
             quiet |= (t >= segment.start_s) & (t <= segment.end_s)
     reference = table[quiet] if quiet.sum() >= 10 else table
-    trim = reference.mean().to_dict()
+    trim = {str(name): float(value) for name, value in reference.mean().items()}
     return Record(table - pd.Series(trim), units, trim, log.path, label)

@@ -17,7 +17,7 @@ from .linear_flight import CALM_HOVER, SimulatedFlight, WindField, simulate_hove
 from .logwriters import AnemometerSetup, write_anemometer_csv, write_ardupilot_log, write_truth
 from .scenario import ManeuverSpec, Scenario, WindCondition
 
-__all__ = ["TrialPlan", "TrialFiles", "plan_trials", "run_scenario"]
+__all__ = ["TrialPlan", "TrialFiles", "plan_trials", "scenario_trials", "run_scenario"]
 
 _GAP_BETWEEN_TRIALS_S = 60.0
 
@@ -155,6 +155,23 @@ def _nonlinear_trial(scenario: Scenario, plan: TrialPlan) -> Any:
                  seed=plan.seed, hover_height_m=height, height_steps=steps, label=plan.name)
 
 
+def scenario_trials(scenario: Scenario, plans: Sequence[TrialPlan] | None = None) -> list[Any]:
+    """The nonlinear simulator's trials for a scenario (all of them, or the given plans).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The campaign; its vehicle must be a nonlinear preset.
+    plans : sequence of TrialPlan, optional
+        Trials to build; default every trial of :func:`plan_trials`.
+
+    Returns
+    -------
+    list of sysid.sim.nonlinear.Trial
+    """
+    return [_nonlinear_trial(scenario, plan) for plan in (plan_trials(scenario) if plans is None else plans)]
+
+
 def _simulate(scenario: Scenario, plans: Sequence[TrialPlan],
               progress: Callable[[int, int], None] | None) -> list[SimulatedFlight]:
     if scenario.vehicle == "linear-octo":
@@ -167,7 +184,7 @@ def _simulate(scenario: Scenario, plans: Sequence[TrialPlan],
     from .presets import CRAZYFLIE, OCTO_S1000
 
     vehicle = OCTO_S1000 if scenario.vehicle == "octo-s1000" else CRAZYFLIE
-    return list(simulate_flights([_nonlinear_trial(scenario, plan) for plan in plans], vehicle, progress=progress))
+    return list(simulate_flights(scenario_trials(scenario, plans), vehicle, progress=progress))
 
 
 def _simulate_linear(plan: TrialPlan) -> SimulatedFlight:

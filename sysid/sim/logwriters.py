@@ -177,7 +177,7 @@ def _system_id_blocks(flight: SimulatedFlight, sweeps: list, us: np.ndarray) -> 
         FSt=[m.f_start_hz for m in sweeps], FSp=[m.f_stop_hz for m in sweeps], TFin=[m.fade_in_s for m in sweeps],
         TC=[0.0] * len(sweeps), TR=[m.duration_s for m in sweeps], TFout=[m.fade_out_s for m in sweeps],
     )
-    rows = [], [], [], []
+    rows: tuple[list[np.ndarray], ...] = ([], [], [], [])
     for maneuver in sweeps:
         inside = (flight.time_s >= maneuver.start_s) & (flight.time_s < maneuver.end_s)
         value, freq = sweep(flight.time_s[inside], maneuver)

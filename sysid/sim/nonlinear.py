@@ -21,13 +21,13 @@ import numpy as np
 
 from .control import ControllerGains, HeightSteps, Injection, design_gains
 from .environment import Environment
-from .excitation import Axis, Maneuver
+from .excitation import Maneuver
 from .linear_flight import SimulatedFlight
 from .linearize import hover_derivatives, linearize_hover
 from .presets import OCTO_S1000
 from .vehicle import Vehicle
 
-__all__ = ["Trial", "NonlinearFlight", "simulate_flights", "chapter3_campaign", "truth_parameters"]
+__all__ = ["Trial", "NonlinearFlight", "simulate_flights", "truth_parameters"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -229,50 +229,3 @@ def _with_truth(flight: NonlinearFlight, truth: Mapping[str, float], trial: Tria
         MappingProxyType(dict(truth) | settings), flight.wind_at_anemometer, flight.anemometer_ne_m,
         flight.transport_delay_s, flight.truth, flight.injections, flight.label,
     )
-
-
-_SWEEP_PCT: dict[Axis, float] = {"lat": 8.0, "lon": 8.0, "yaw": 10.0, "thr": 4.0}
-_DOUBLET_PCT: dict[Axis, float] = {"lat": 10.0, "lon": 10.0, "yaw": 12.0, "thr": 6.0}
-_DAYS: dict[str, float] = {"calm": 20.0, "light": 300.0, "strong": 270.0}  # direction the wind comes from, deg
-
-
-def chapter3_campaign(*, trials_per_case: int = 5, sweep_s: float = 40.0, doublet_s: float = 10.0,
-                      seed: int = 0, sensors: bool = True) -> list[Trial]:
-    """The chapter 3 campaign: 4 axes x (sweep, doublet) x (calm, light, strong) x 5 trials = 120.
-
-    Parameters
-    ----------
-    trials_per_case : int, optional
-        Trials per axis, signal and wind day.
-    sweep_s : float, optional
-        Sweep trial length, s: a 34 s sweep (0.1-10 Hz, 5 s fade-in) with 3 s of trim either side.
-    doublet_s : float, optional
-        Doublet trial length, s: a 2 s doublet 2.5 s in.
-    seed : int, optional
-        Base seed; each trial gets its own.
-    sensors : bool, optional
-        Add sensor noise (default levels), else log the truth.
-
-    Returns
-    -------
-    list of Trial
-    """
-    from .environment import SensorNoise
-    from .wind_field import Wind
-
-    trials: list[Trial] = []
-    for day, direction in _DAYS.items():
-        wind = Wind.dissertation(day, direction_from_deg=direction)  # type: ignore[arg-type]
-        environment = Environment(wind=wind, sensors=SensorNoise() if sensors else SensorNoise.off())
-        for axis in ("lat", "lon", "yaw", "thr"):
-            for kind in ("sweep", "doublet"):
-                for k in range(trials_per_case):
-                    if kind == "sweep":
-                        maneuver = Maneuver(axis, "sweep", 3.0, _SWEEP_PCT[axis], 34.0)  # type: ignore[arg-type]
-                        duration = sweep_s
-                    else:
-                        maneuver = Maneuver(axis, "doublet", 2.5, _DOUBLET_PCT[axis], 2.0)  # type: ignore[arg-type]
-                        duration = doublet_s
-                    trials.append(Trial(duration, (maneuver,), environment=environment, seed=seed + len(trials),
-                                        label=f"{day}-{axis}-{kind}-{k + 1}"))
-    return trials

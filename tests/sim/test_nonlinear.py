@@ -12,7 +12,9 @@ from sysid.sim.environment import Anemometer, Environment, GroundEffect, Payload
 from sysid.sim.excitation import Maneuver
 from sysid.sim.linear_flight import SimulatedFlight
 from sysid.sim.logwriters import write_ardupilot_log
-from sysid.sim.nonlinear import NonlinearFlight, Trial, chapter3_campaign, simulate_flights
+from sysid.sim.campaign import scenario_trials
+from sysid.sim.nonlinear import NonlinearFlight, Trial, simulate_flights
+from sysid.sim.scenario import load_builtin
 from sysid.sim.presets import CRAZYFLIE, OCTO_S1000
 from sysid.sim.wind_field import Gust, Wind
 
@@ -143,9 +145,9 @@ def test_the_log_writer_accepts_a_nonlinear_flight(tmp_path) -> None:
 
 
 def test_campaign_has_120_trials_and_euler_agrees_with_rk4() -> None:
-    campaign = chapter3_campaign()
+    campaign = scenario_trials(load_builtin("chapter3-campaign"))
     assert len(campaign) == 120
-    assert sorted({t.duration_s for t in campaign}) == [10.0, 40.0]
+    assert sorted({t.duration_s for t in campaign}) == [8.0, 40.0]  # 2 s doublet or 34 s sweep + 3 s trim each side
     assert len({t.seed for t in campaign}) == 120
     doublet = Maneuver("lon", "doublet", 1.0, 10.0, 2.0)
     trial = Trial(4.0, (doublet,), environment=Environment(sensors=SensorNoise.off()))
