@@ -15,6 +15,8 @@ __all__ = [
     "LogFormatError",
     "DataError",
     "MissingSignalError",
+    "ModelError",
+    "FitError",
     "SysidWarning",
 ]
 
@@ -40,6 +42,14 @@ class MissingSignalError(SysidError, KeyError):
 
     def __str__(self) -> str:  # KeyError would quote the message
         return str(self.args[0]) if self.args else ""
+
+
+class ModelError(SysidError, ValueError):
+    """A model structure or model file is invalid (unknown name, bad expression, wrong shape)."""
+
+
+class FitError(SysidError, RuntimeError):
+    """An identification could not be carried out (no usable response, optimiser failure)."""
 
 
 class SysidWarning(UserWarning):
