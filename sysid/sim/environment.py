@@ -14,6 +14,7 @@ from typing import Callable, Literal
 
 import numpy as np
 
+from ..groundeffect import formulas as _laws
 from .wind_field import Wind
 
 __all__ = [
@@ -75,17 +76,17 @@ def thrust_ratio(
     if model == "none":
         return np.ones_like(x)
     if model == "cheeseman_bennett":
-        return 1.0 / (1.0 - (1.0 / (4.0 * x)) ** 2)
+        return _laws.cheeseman_bennett(x)
     if model in ("corrected", "fitted_2rotor"):
-        factor = 3.315 if model == "fitted_2rotor" else rho
-        denominator = 1.0 - factor * (1.0 / (4.0 * x)) ** 2
-        if np.any(denominator <= 0.05):
+        factor = _laws.FITTED_2ROTOR_RHO if model == "fitted_2rotor" else rho
+        if np.any(1.0 - factor * (1.0 / (4.0 * x)) ** 2 <= 0.05):
             raise ValueError(f"eq. 2.2 with rho={factor} diverges near Z/R={min_height_ratio}: raise min_height_ratio")
-        return 1.0 / denominator
+        return _laws.corrected(x, factor)
     if model == "exponential":
-        return a * np.exp(-x / b) + 1.0
+        return _laws.exponential(x, a, b)
     if model == "fitted_4rotor":
-        return np.where(x < 4.42, -0.0373 * x + 1.1651, 1.0)
+        return _laws.piecewise_linear(x, _laws.FITTED_4ROTOR_SLOPE, _laws.FITTED_4ROTOR_INTERCEPT,
+                                      _laws.FITTED_4ROTOR_BREAKPOINT)
     raise ValueError(f"unknown ground-effect model {model!r}; choose from {_MODELS}")
 
 

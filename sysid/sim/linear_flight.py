@@ -194,7 +194,8 @@ def simulate_hover(
     rate_hz : float, optional
         Log rate, Hz.
     substeps : int, optional
-        Integration steps per log sample (delays are whole integration steps).
+        Integration steps per log sample (delays are whole integration steps); the
+        controller updates once per log sample and holds its command in between.
     hover_height_m : float, optional
         Trim height above ground, m (the dissertation's 4.6 m, out of ground effect).
     seed : int, optional
@@ -223,11 +224,17 @@ def simulate_hover(
     w_thr_delay = int(round(terms.get("tau_w_thr", 0.0) / dt))
     for k in range(n_fine):
         # the controller holds ground velocity: airspeed plus the wind along each axis
-        feedback = {axis: states[axis].copy() for axis in _AXES}
-        feedback["lon"][0] += wind_ne[k, 0]
-        feedback["lat"][0] += wind_ne[k, 1]
-        for axis in _AXES:
-            history[axis][k] = -gains[axis] @ feedback[axis] + excitation[axis][k]
+        # the flight controller runs at the log rate and holds its command between updates
+        # (zero-order hold), so the logged mixer input is exactly the input the airframe got
+        if k % substeps == 0:
+            feedback = {axis: states[axis].copy() for axis in _AXES}
+            feedback["lon"][0] += wind_ne[k, 0]
+            feedback["lat"][0] += wind_ne[k, 1]
+            for axis in _AXES:
+                history[axis][k] = -gains[axis] @ feedback[axis] + excitation[axis][k]
+        else:
+            for axis in _AXES:
+                history[axis][k] = history[axis][k - 1]
         wind_lon_u = wind_ne[max(k - w_lon_delay, 0), 0]
         wind_lon_w = wind_ne[max(k - w_thr_delay, 0), 0]
         derivative_u = models["lon"][0][0] @ states["lon"] + terms.get("X_w_lon", 0.0) * wind_lon_u

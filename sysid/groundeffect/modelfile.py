@@ -1,0 +1,234 @@
+"""The fitted ground-effect model as a JSON file, and the summary the CLI prints.
+
+A controller study (``sysid mrac compare --ground-effect FILE``) reads the
+file back with :func:`read_ground_effect_model` and calls ``ratio(Z/R)``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flightlogs.atomic import atomic_output
+from flightlogs.errors import ModelError
+
+from .models import PARAMETER_NAMES, GroundEffectFit, evaluate_model
+
+__all__ = ["FittedGroundEffect", "fit_summary", "write_ground_effect_model", "read_ground_effect_model",
+           "MODEL_FILE_FORMAT"]
+
+#: Value of the file's ``format`` key.
+MODEL_FILE_FORMAT = "flight-sysid ground-effect model"
+_VERSION = 1
+
+
+@dataclass(frozen=True, slots=True)
+class FittedGroundEffect:
+    """A ground-effect law with fitted values: F/F0 as a function of Z/R.
+
+    Parameters
+    ----------
+    model : str
+        Family (``"cheeseman_bennett"``, ``"corrected"``, ``"exponential"``, ``"piecewise_linear"``).
+    param_names : tuple of str
+        Parameter names, as ``PARAMETER_NAMES[model]``.
+    values : ndarray, shape (n_params,)
+        Parameter values.
+    rotor_radius_m : float
+        Propeller radius R of the vehicle fitted, m.
+    min_height_ratio : float
+        Lowest Z/R of the data; lower Z/R is clamped to it (no extrapolation
+        toward the ground, where eq. 2.2 diverges).
+    source : str
+        Data the model was fitted to.
+    """
+
+    model: str
+    param_names: tuple[str, ...]
+    values: np.ndarray
+    rotor_radius_m: float
+    min_height_ratio: float = 0.0
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        if self.model not in PARAMETER_NAMES:
+            raise ModelError(f"unknown ground-effect model {self.model!r}; choose from {tuple(PARAMETER_NAMES)}")
+        if tuple(self.param_names) != PARAMETER_NAMES[self.model]:
+            raise ModelError(f"{self.model} takes parameters {PARAMETER_NAMES[self.model]}, got {self.param_names}")
+        values = np.asarray(self.values, dtype=np.float64)
+        if values.shape != (len(self.param_names),) or not np.all(np.isfinite(values)):
+            raise ModelError(f"{self.model}: parameter values {values.tolist()} must be {len(self.param_names)} finite numbers")
+        if not (self.rotor_radius_m > 0 and self.min_height_ratio >= 0):
+            raise ModelError(f"rotor_radius_m={self.rotor_radius_m} must be > 0 and min_height_ratio >= 0")
+        object.__setattr__(self, "param_names", tuple(self.param_names))
+        object.__setattr__(self, "values", values)
+
+    @property
+    def params(self) -> dict[str, float]:
+        """Parameter name to value."""
+        return {n: float(v) for n, v in zip(self.param_names, self.values)}
+
+    def ratio(self, height_ratio: np.ndarray) -> np.ndarray:
+        """F/F0 at `height_ratio` (Z/R), clamped from below at `min_height_ratio`.
+
+        Parameters
+        ----------
+        height_ratio : ndarray, any shape
+            Z/R.
+
+        Returns
+        -------
+        ndarray
+            F/F0, same shape.
+        """
+        x = np.maximum(np.asarray(height_ratio, dtype=np.float64), self.min_height_ratio)
+        return evaluate_model(self.model, self.values, x)
+
+    @classmethod
+    def from_fit(cls, fit: GroundEffectFit) -> FittedGroundEffect:
+        """The chosen model of a fit.
+
+        Parameters
+        ----------
+        fit : GroundEffectFit
+            The fit.
+
+        Returns
+        -------
+        FittedGroundEffect
+        """
+        best = fit.model(fit.best)
+        return cls(best.name, best.param_names, best.values, fit.data.rotor_radius_m,
+                   float(fit.data.height_ratio.min()), fit.data.source)
+
+
+def fit_summary(fit: GroundEffectFit) -> dict[str, Any]:
+    """A JSON-ready summary of a fit: ``best``, ``models.NAME.params|ci|rmse|r2|...``, the data.
+
+    Parameters
+    ----------
+    fit : GroundEffectFit
+        The fit.
+
+    Returns
+    -------
+    dict
+        Plain numbers, strings, lists and dicts (NaN stays NaN; the CLI writes null).
+    """
+    data = fit.data
+    models = {}
+    for m in fit.models:
+        models[m.name] = {
+            "params": m.params,
+            "stderr": {n: float(v) for n, v in zip(m.param_names, m.stderr)},
+            "ci": {n: [float(lo), float(hi)] for n, lo, hi in zip(m.param_names, m.ci_low, m.ci_high)},
+            "n_free": m.n_free, "rmse": m.rmse, "r2": m.r2, "aicc": m.aicc, "bic": m.bic,
+            "delta": fit.delta(m.name), "notes": list(m.notes),
+        }
+    summary: dict[str, Any] = {
+        "best": fit.best, "criterion": fit.criterion, "confidence": fit.confidence, "models": models,
+        "source": data.source, "f0_source": data.f0_source, "f0_n": data.f0_n,
+        "rotor_radius_m": data.rotor_radius_m, "n_points": data.n_points,
+        "height_ratio": data.height_ratio.tolist(), "thrust_ratio": data.thrust_ratio.tolist(),
+    }
+    if data.steps is not None:
+        summary["steps"] = [{"start_s": s.start_s, "end_s": s.end_s, "steady_start_s": s.steady_start_s,
+                             "height_m": s.height_m, "height_ratio": s.height_m / data.rotor_radius_m,
+                             "climb_rate_m_s": s.climb_rate_m_s, "f0_n": s.f0_n, "thrust_ratio": s.thrust_ratio}
+                            for s in data.steps.steps]
+        summary["dropped_steps"] = list(data.steps.dropped)
+    return summary
+
+
+def write_ground_effect_model(fit: GroundEffectFit, path: str | Path) -> Path:
+    """Write the chosen model (and the full fit summary) as JSON, atomically.
+
+    Parameters
+    ----------
+    fit : GroundEffectFit
+        The fit.
+    path : str or Path
+        Destination; its folder must exist.
+
+    Returns
+    -------
+    Path
+        The path written.
+    """
+    chosen = FittedGroundEffect.from_fit(fit)
+    document = {
+        "format": MODEL_FILE_FORMAT, "version": _VERSION, "model": chosen.model, "params": chosen.params,
+        "rotor_radius_m": chosen.rotor_radius_m, "min_height_ratio": chosen.min_height_ratio,
+        "source": chosen.source, "fit": _finite(fit_summary(fit)),
+    }
+    path = Path(path)
+    with atomic_output(path) as tmp:
+        tmp.write_text(json.dumps(document, indent=2, allow_nan=False) + "\n")
+    return path
+
+
+def read_ground_effect_model(path: str | Path) -> FittedGroundEffect:
+    """Read a model written by :func:`write_ground_effect_model`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file.
+
+    Returns
+    -------
+    FittedGroundEffect
+        Has ``ratio(height_ratio)``.
+
+    Raises
+    ------
+    ModelError
+        If the file is not such a model, or its model or values are invalid.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from sysid.groundeffect import ThrustRatioData, fit_ground_effect
+    >>> x = np.linspace(1.2, 9.0, 20)
+    >>> fit = fit_ground_effect(ThrustRatioData(x, evaluate_model("corrected", [3.0], x), 0.0225))
+    >>> target = write_ground_effect_model(fit, pathlib.Path(tempfile.mkdtemp()) / "ge.json")
+    >>> model = read_ground_effect_model(target)
+    >>> model.model, round(float(model.ratio(np.array(2.0))), 4)
+    ('corrected', 1.0492)
+    """
+    path = Path(path)
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise ModelError(f"{path}: not a readable JSON ground-effect model ({err})") from err
+    if not isinstance(document, dict) or document.get("format") != MODEL_FILE_FORMAT:
+        raise ModelError(f"{path}: not a ground-effect model (no \"format\": {MODEL_FILE_FORMAT!r})")
+    if document.get("version") != _VERSION:
+        raise ModelError(f"{path}: ground-effect model version {document.get('version')!r}; this tool reads {_VERSION}")
+    try:
+        model = str(document["model"])
+        params = document["params"]
+        names = PARAMETER_NAMES.get(model, tuple(params))
+        values = [float(params[n]) for n in names]
+        return FittedGroundEffect(model, tuple(names), np.array(values), float(document["rotor_radius_m"]),
+                                  float(document.get("min_height_ratio", 0.0)), str(document.get("source", "")))
+    except (KeyError, TypeError, ValueError) as err:
+        if isinstance(err, ModelError):
+            raise ModelError(f"{path}: {err}") from err
+        raise ModelError(f"{path}: ground-effect model field missing or not a number ({err!r})") from err
+
+
+def _finite(value: Any) -> Any:
+    """JSON has no NaN or infinity: write null."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    return value

@@ -1,0 +1,18 @@
+"""Time-domain verification: simulate an identified model on flights it was not fitted to.
+
+See :mod:`sysid.verify.engine` for the method (Tischler's VERIFY: bias and
+reference shift, RMS error and Theil inequality coefficient; chapter 3.5.3 of
+the dissertation for the wind correction of Table 3.6).
+"""
+
+from .engine import VerificationOptions, verify, verify_record
+from .logs import verify_logs
+from .records import DoubletRecords, doublet_records
+from .submodel import driven_part
+from .results import (OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, rms_error,
+                      theil_inequality)
+
+__all__ = ["VerificationOptions", "verify_record", "verify", "verify_logs", "driven_part", "doublet_records",
+           "DoubletRecords",
+           "OutputVerification", "RecordVerification", "OutputSummary", "WindCorrection", "Verification",
+           "rms_error", "theil_inequality"]

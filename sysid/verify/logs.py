@@ -1,0 +1,76 @@
+"""Verify a model on flight logs: read, condition, cut the doublets, simulate (what ``sysid validate`` runs)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from flightlogs.campaign import ingest_campaign
+from flightlogs.condition import ConditioningOptions
+from flightlogs.errors import DataError
+
+from ..statespace import DelayedStateSpace
+from .engine import VerificationOptions, verify
+from .records import doublet_records
+from .results import Verification
+
+__all__ = ["verify_logs"]
+
+
+def verify_logs(
+    model: DelayedStateSpace,
+    log_paths: Sequence[Path],
+    *,
+    wind_model: DelayedStateSpace | None = None,
+    wind_paths: Sequence[Path] = (),
+    conditioning: ConditioningOptions = ConditioningOptions(),
+    options: VerificationOptions = VerificationOptions(),
+    before_s: float = 0.5,
+    after_s: float = 1.0,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> Verification:
+    """Verify `model` (and `wind_model`) on every doublet of the logs.
+
+    Parameters
+    ----------
+    model : DelayedStateSpace
+        The model without the wind term (or the only one).
+    log_paths : sequence of Path
+        Flight logs with doublets not used in the fit.
+    wind_model : DelayedStateSpace, optional
+        The model with G_w; needs `wind_paths`.
+    wind_paths : sequence of Path, optional
+        Anemometer CSV files or folders of them.
+    conditioning : ConditioningOptions, optional
+        Alignment, rate and segment choices (as for ``sysid ingest``).
+    options : VerificationOptions, optional
+        Bias, reference shift, initial state and instability choices.
+    before_s, after_s : float, optional
+        Quiet stretch kept before and response after each doublet, s.
+    progress : callable, optional
+        ``progress(file_name, done, total)`` while reading, bytes.
+
+    Returns
+    -------
+    Verification
+
+    Raises
+    ------
+    DataError
+        If a wind model is given without wind, or no log holds a doublet on
+        an axis of the model (doublets on other axes are skipped).
+    """
+    if wind_model is not None and not wind_paths:
+        raise DataError("the model has wind terms but no anemometer file was given (--wind); "
+                        "without wind only the model without G_w can be verified")
+    campaign = ingest_campaign(list(log_paths), list(wind_paths), options=conditioning, progress=progress)
+    flights = [flight for flight in campaign.conditioned if flight is not None]
+    cut = doublet_records(flights, before_s=before_s, after_s=after_s)
+    kept = [k for k, name in enumerate(cut.excited) if name in model.inputs]  # axes the model does not have
+    if not kept:
+        names = ", ".join(Path(p).name for p in log_paths)
+        raise DataError(f"no doublet found in {names} on an axis of the model ({', '.join(model.inputs)}): "
+                        "validation needs doublets not used in the fit (give their times with --segments if "
+                        "they were not detected)")
+    return verify(model, [cut.records[k] for k in kept], wind_model=wind_model,
+                  excited=[cut.excited[k] for k in kept], options=options)

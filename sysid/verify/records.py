@@ -1,0 +1,72 @@
+"""The records to verify on: each doublet of a conditioned flight, with a little quiet before and after."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from flightlogs.condition import ConditionedFlight
+from flightlogs.record import Record
+
+__all__ = ["DoubletRecords", "doublet_records", "MIXER_INPUTS"]
+
+#: Mixer input excited by a maneuver on each axis.
+MIXER_INPUTS = {"lat": "delta_lat", "lon": "delta_lon", "yaw": "delta_yaw", "thr": "delta_thr"}
+
+
+@dataclass(frozen=True, slots=True)
+class DoubletRecords:
+    """Doublet records and the mixer input each excites.
+
+    Parameters
+    ----------
+    records : tuple of Record
+        One per doublet, cut from the flight's records.
+    excited : tuple of str
+        Per record, the mixer input of the doublet's axis (``"delta_lon"``).
+    """
+
+    records: tuple[Record, ...]
+    excited: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        if len(self.records) != len(self.excited):
+            raise ValueError(f"{len(self.records)} records but {len(self.excited)} excited inputs")
+
+
+def doublet_records(flights: Sequence[ConditionedFlight], *, before_s: float = 0.5, after_s: float = 1.0,
+                    kinds: tuple[str, ...] = ("doublet",)) -> DoubletRecords:
+    """Cut a record around every doublet of the flights.
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        Conditioned flights with their segments.
+    before_s : float, optional
+        Quiet stretch kept before each doublet, s (the initial state is fitted there).
+    after_s : float, optional
+        Response kept after each doublet, s. Keep records short: an open-loop
+        unstable model diverges over long ones.
+    kinds : tuple of str, optional
+        Segment kinds to take (``"3211"`` works as well).
+
+    Returns
+    -------
+    DoubletRecords
+        In flight and time order; doublets outside every record are skipped.
+    """
+    records: list[Record] = []
+    excited: list[str] = []
+    for flight in flights:
+        for segment in flight.segments:
+            if segment.kind not in kinds or segment.axis is None:
+                continue
+            for record in flight.records:
+                if record.start_s <= segment.start_s <= record.end_s:
+                    start = max(record.start_s, segment.start_s - before_s)
+                    end = min(record.end_s, segment.end_s + after_s)
+                    label = f"{flight.source.name} {segment.axis} {segment.kind} at {segment.start_s:.1f} s"
+                    records.append(record.between(start, end, label=label))
+                    excited.append(MIXER_INPUTS[segment.axis])
+                    break
+    return DoubletRecords(tuple(records), tuple(excited))

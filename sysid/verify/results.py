@@ -1,0 +1,333 @@
+"""What a time-domain verification returns: per output, per record, pooled, and the wind correction."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+
+import numpy as np
+
+__all__ = ["rms_error", "theil_inequality", "OutputVerification", "RecordVerification", "OutputSummary",
+           "WindCorrection", "Verification"]
+
+
+def rms_error(measured: np.ndarray, simulated: np.ndarray) -> float:
+    """Root-mean-square difference of two time series.
+
+    Parameters
+    ----------
+    measured, simulated : ndarray, shape (n_samples,)
+        The same signal measured and predicted, same unit.
+
+    Returns
+    -------
+    float
+        ``sqrt(mean((measured - simulated)**2))``, in the signal's unit.
+
+    Examples
+    --------
+    >>> rms_error(np.array([1.0, -1.0]), np.zeros(2))
+    1.0
+    """
+    return float(np.sqrt(np.mean((np.asarray(measured) - np.asarray(simulated)) ** 2)))
+
+
+def theil_inequality(measured: np.ndarray, simulated: np.ndarray) -> float:
+    """Theil inequality coefficient: 0 for a perfect prediction, 1 for the worst.
+
+    Parameters
+    ----------
+    measured, simulated : ndarray, shape (n_samples,)
+        The same signal measured and predicted, same unit.
+
+    Returns
+    -------
+    float
+        ``rms(measured - simulated) / (rms(measured) + rms(simulated))``; NaN
+        when both are zero.
+
+    Notes
+    -----
+    Tischler & Remple, section 15.3 (Jategaonkar 2006, eq. 11.12): TIC below
+    0.25-0.3 marks a model with good predictive accuracy.
+
+    Examples
+    --------
+    >>> theil_inequality(np.array([1.0, -1.0]), np.array([1.0, -1.0]))
+    0.0
+    >>> theil_inequality(np.array([1.0, -1.0]), -np.array([1.0, -1.0]))
+    1.0
+    """
+    measured, simulated = np.asarray(measured, dtype=float), np.asarray(simulated, dtype=float)
+    scale = np.sqrt(np.mean(measured**2)) + np.sqrt(np.mean(simulated**2))
+    return float(rms_error(measured, simulated) / scale) if scale > 0 else float("nan")
+
+
+def _vector(value: np.ndarray, name: str, n: int) -> np.ndarray:
+    array = np.asarray(value, dtype=float)
+    if array.shape != (n,):
+        raise ValueError(f"{name} has shape {array.shape}, expected ({n},) like time_s")
+    return array
+
+
+@dataclass(frozen=True, slots=True)
+class OutputVerification:
+    """One output of one record: measured against the model's simulation.
+
+    Parameters
+    ----------
+    name : str
+        Canonical signal name.
+    unit : str
+        Its unit (the record's).
+    measured : ndarray, shape (n_samples,)
+        Measured perturbation from trim.
+    simulated : ndarray, shape (n_samples,)
+        Model output from the measured inputs, bias and reference shifts applied.
+    bias : float
+        Estimated output bias, in `unit`.
+    rmse : float
+        RMS of ``measured - simulated``, in `unit`.
+    tic : float
+        Theil inequality coefficient.
+    predicted : ndarray, shape (n_samples,) or None, optional
+        One-step-ahead prediction (bias removed), when computed.
+    prediction_rmse, prediction_tic : float or None, optional
+        RMS error (in `unit`) and TIC of the one-step-ahead prediction.
+    """
+
+    name: str
+    unit: str
+    measured: np.ndarray
+    simulated: np.ndarray
+    bias: float
+    rmse: float
+    tic: float
+    predicted: np.ndarray | None = None
+    prediction_rmse: float | None = None
+    prediction_tic: float | None = None
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.measured)[0] if np.ndim(self.measured) == 1 else -1
+        if n < 1:
+            raise ValueError(f"{self.name}: measured must be a non-empty 1-D array")
+        object.__setattr__(self, "measured", _vector(self.measured, "measured", n))
+        object.__setattr__(self, "simulated", _vector(self.simulated, "simulated", n))
+        if self.predicted is not None:
+            object.__setattr__(self, "predicted", _vector(self.predicted, "predicted", n))
+
+
+@dataclass(frozen=True, slots=True)
+class RecordVerification:
+    """A model simulated over one record.
+
+    Parameters
+    ----------
+    label : str
+        The record's label.
+    source : Path
+        The log it came from.
+    time_s : ndarray, shape (n_samples,)
+        Sample times, s (log clock).
+    inputs : tuple of str
+        Model inputs used, in model order.
+    outputs : tuple of OutputVerification
+        One per model output found in the record.
+    reference_shifts : Mapping[str, float]
+        Estimated constant shift of each input (distinct names), in the input's unit.
+    rmse : float
+        Overall weighted RMS error J_rms (angles in deg, angular rates in
+        deg/s, other signals in SI).
+    tic : float
+        Overall Theil inequality coefficient on the same weighted signals.
+    growth : float
+        Open-loop growth ``exp(max(Re λ, 0) · duration)`` of the model over the record.
+    unstable : bool
+        True when `growth` exceeds the options' limit: the simulation may
+        diverge from small errors, and the one-step-ahead prediction error is
+        reported as well.
+    notice : str, optional
+        Why the record is flagged, for people; empty when it is not.
+    """
+
+    label: str
+    source: Path
+    time_s: np.ndarray
+    inputs: tuple[str, ...]
+    outputs: tuple[OutputVerification, ...]
+    reference_shifts: Mapping[str, float]
+    rmse: float
+    tic: float
+    growth: float
+    unstable: bool
+    notice: str = ""
+
+    def __post_init__(self) -> None:
+        time_s = np.asarray(self.time_s, dtype=float)
+        if time_s.ndim != 1:
+            raise ValueError(f"record {self.label!r}: time_s must be 1-D")
+        for output in self.outputs:
+            if output.measured.shape != time_s.shape:
+                raise ValueError(f"record {self.label!r}: output {output.name} has {output.measured.size} samples, "
+                                 f"time_s {time_s.size}")
+        object.__setattr__(self, "time_s", time_s)
+        object.__setattr__(self, "reference_shifts", MappingProxyType(dict(self.reference_shifts)))
+
+    def output(self, name: str) -> OutputVerification:
+        """The verification of one output.
+
+        Parameters
+        ----------
+        name : str
+            Canonical signal name.
+
+        Raises
+        ------
+        KeyError
+            If the output was not verified on this record.
+        """
+        for output in self.outputs:
+            if output.name == name:
+                return output
+        raise KeyError(f"record {self.label!r} has no verified output {name!r}")
+
+
+@dataclass(frozen=True, slots=True)
+class OutputSummary:
+    """One output pooled over every record that verified it.
+
+    Parameters
+    ----------
+    name : str
+        Canonical signal name.
+    unit : str
+        Its unit.
+    rmse : float
+        RMS error over all samples of all records, in `unit`.
+    tic : float
+        Theil inequality coefficient over the same samples.
+    n_records : int
+        Records pooled.
+    n_samples : int
+        Samples pooled.
+    prediction_rmse, prediction_tic : float or None, optional
+        The same for the one-step-ahead prediction, over the records where it was computed.
+    """
+
+    name: str
+    unit: str
+    rmse: float
+    tic: float
+    n_records: int
+    n_samples: int
+    prediction_rmse: float | None = None
+    prediction_tic: float | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class WindCorrection:
+    """What the wind term G_w buys on one output (dissertation Table 3.6).
+
+    Parameters
+    ----------
+    name : str
+        Canonical signal name.
+    unit : str
+        Its unit.
+    rmse_without : float
+        Pooled RMS error of the model without G_w, in `unit`.
+    rmse_with : float
+        Pooled RMS error of the model with G_w, in `unit`.
+
+    Attributes
+    ----------
+    reduction_percent : float
+        ``100 (1 - rmse_with / rmse_without)``: the dissertation's 13-16 % on
+        a_x and 7-15 % on a_z (Table 3.6); NaN when `rmse_without` is 0.
+
+    Examples
+    --------
+    >>> round(WindCorrection("ax", "m/s^2", 0.4129, 0.3480).reduction_percent, 1)  # Table 3.6, strong wind
+    15.7
+    """
+
+    name: str
+    unit: str
+    rmse_without: float
+    rmse_with: float
+    reduction_percent: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        reduction = 100.0 * (1.0 - self.rmse_with / self.rmse_without) if self.rmse_without > 0 else float("nan")
+        object.__setattr__(self, "reduction_percent", reduction)
+
+
+@dataclass(frozen=True, slots=True)
+class Verification:
+    """A model verified on records it was not fitted to.
+
+    Parameters
+    ----------
+    records : tuple of RecordVerification
+        The model verified, per record (the wind model when one was given).
+    summary : tuple of OutputSummary
+        Per output, pooled over `records`.
+    rmse : float
+        Overall weighted RMS error J_rms over every record and output.
+    tic : float
+        Overall Theil inequality coefficient on the same weighted signals.
+    without_wind : tuple of RecordVerification, optional
+        The model without G_w on the same records, when a wind model was given.
+    wind_correction : tuple of WindCorrection, optional
+        Per output common to both models.
+    """
+
+    records: tuple[RecordVerification, ...]
+    summary: tuple[OutputSummary, ...]
+    rmse: float
+    tic: float
+    without_wind: tuple[RecordVerification, ...] = ()
+    wind_correction: tuple[WindCorrection, ...] = ()
+
+    @property
+    def unstable(self) -> bool:
+        """True when any record's simulation is flagged as diverging open loop."""
+        return any(r.unstable for r in (*self.records, *self.without_wind))
+
+    def output(self, name: str) -> OutputSummary:
+        """The pooled verification of one output.
+
+        Parameters
+        ----------
+        name : str
+            Canonical signal name.
+
+        Raises
+        ------
+        KeyError
+            If no record verified that output.
+        """
+        for summary in self.summary:
+            if summary.name == name:
+                return summary
+        raise KeyError(f"no record verified output {name!r}")
+
+    def correction(self, name: str) -> WindCorrection:
+        """The wind correction of one output.
+
+        Parameters
+        ----------
+        name : str
+            Canonical signal name.
+
+        Raises
+        ------
+        KeyError
+            If there is no wind model or it does not share that output.
+        """
+        for correction in self.wind_correction:
+            if correction.name == name:
+                return correction
+        raise KeyError(f"no wind correction for output {name!r}")
