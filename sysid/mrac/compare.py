@@ -1,10 +1,12 @@
 """Take-off and landing steps flown by PID and both MRACs, as in Tables 2.6-2.8 and Fig. 2.12.
 
 For a height ratio inside ground effect (Z/R below ``out_of_ground_ratio``)
-the vehicle rests on the ground and takes off to the height that puts its
-rotors at that Z/R (Tables 2.6-2.8: 6.2, 4.2, 2.2 cm for Z/R = 4, 3, 2), then
-lands again. Out of ground effect it hovers at that Z/R and steps 6.2 cm up
-and back (Fig. 2.12: 0.5 m, Z/R = 22). Each controller engages at rest at the
+the vehicle rests on the ground, takes off and lands again. For the
+Crazyflie at Z/R = 4, 3, 2 it takes off to the heights section 2.7 flew,
+"6.2cm (Z/R ≈ 4), 4.2cm (Z/R ≈ 3) and 2.2cm (Z/R ≈ 2) above the ground";
+at any other ratio (or vehicle) to the height that puts its rotors at that
+Z/R. Out of ground effect it hovers at that Z/R and steps 6.2 cm up and
+back (Fig. 2.12: 0.5 m, Z/R = 22). Each controller engages at rest at the
 start (Theta_hat = 0; the integrator holds the trim, as Crazyflie's ROS
 controller seeds it with the lift-off thrust). Each phase lasts 40 s for the
 PID and 20 s for the MRACs, as in section 2.7. Trials differ by their noise
@@ -41,6 +43,8 @@ ControllerName = Literal["pid", "mrac_linear", "mrac_rbf"]
 Phase = Literal["takeoff", "landing"]
 #: Controller names, in report order.
 CONTROLLERS: tuple[ControllerName, ...] = ("pid", "mrac_linear", "mrac_rbf")
+#: Take-off heights of Tables 2.6-2.8 above the landed vehicle, m, by the Z/R that names them (section 2.7).
+_TABLE_HEIGHTS_M: tuple[tuple[float, float], ...] = ((4.0, 0.062), (3.0, 0.042), (2.0, 0.022))
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,7 +74,7 @@ class StepCase:
 
 
 def step_case(height_ratio: float, *, vehicle: AltitudeVehicle = CRAZYFLIE_ALTITUDE, out_of_ground_ratio: float = 10.0,
-              step_m: float = 0.062) -> StepCase:
+              step_m: float = 0.062, table_heights: bool = True) -> StepCase:
     """The experiment chapter 2 flew at `height_ratio`.
 
     Parameters
@@ -83,6 +87,11 @@ def step_case(height_ratio: float, *, vehicle: AltitudeVehicle = CRAZYFLIE_ALTIT
         Z/R from which the vehicle is out of ground effect (chapter 2's descent starts at 10).
     step_m : float, optional
         Step out of ground effect, m (Fig. 2.12: 6.2 cm).
+    table_heights : bool, optional
+        At Z/R = 4, 3, 2 take off to the heights section 2.7 states, 6.2, 4.2,
+        2.2 cm (the Crazyflie's rotors then sit at Z/R = 3.89, 3.0, 2.11),
+        rather than to ``Z/R R - gear`` (6.45, 4.2, 1.95 cm). Only meaningful
+        for the chapter 2 Crazyflie.
 
     Returns
     -------
@@ -96,8 +105,10 @@ def step_case(height_ratio: float, *, vehicle: AltitudeVehicle = CRAZYFLIE_ALTIT
     Examples
     --------
     >>> case = step_case(4.0)
-    >>> case.low_m, round(case.high_m, 4), case.in_ground_effect
-    (0.0, 0.0645, True)
+    >>> case.low_m, case.high_m, case.in_ground_effect
+    (0.0, 0.062, True)
+    >>> round(step_case(4.0, table_heights=False).high_m, 4)
+    0.0645
     >>> round(step_case(22.0).high_m - step_case(22.0).low_m, 3)
     0.062
     """
@@ -107,6 +118,9 @@ def step_case(height_ratio: float, *, vehicle: AltitudeVehicle = CRAZYFLIE_ALTIT
         raise DataError(f"height ratio Z/R = {height_ratio} is at or below the rotors' height on the ground "
                         f"(Z/R = {lowest:.2f}); choose a larger one")
     if height_ratio < out_of_ground_ratio:
+        table = dict(_TABLE_HEIGHTS_M)
+        if table_heights and height_ratio in table:
+            height = table[height_ratio]
         return StepCase(float(height_ratio), 0.0, height, True)
     return StepCase(float(height_ratio), height, height + step_m, False)
 
@@ -376,7 +390,7 @@ def compare_controllers(config: CompareConfig = CompareConfig(), *, vehicle: Alt
     """
     law: ThrustRatioModel = ground_effect if ground_effect is not None else GroundEffect("fitted_4rotor")
     label = ground_effect_label or ("eq. 2.5 (fitted, 4 rotors)" if ground_effect is None else type(law).__name__)
-    cases = [step_case(r, vehicle=vehicle) for r in config.height_ratios]
+    cases = [step_case(r, vehicle=vehicle, table_heights=vehicle == CRAZYFLIE_ALTITUDE) for r in config.height_ratios]
     lengths = [2 * int(round((config.pid_phase_s if c == "pid" else config.mrac_phase_s) * config.rate_hz))
                for c in config.controllers]
     total, done = sum(lengths), 0

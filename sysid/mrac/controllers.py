@@ -5,19 +5,33 @@ then ``step`` per control period with the measured height and climb rate,
 returning the PWM per rotor. They work on a batch of trials at once.
 
 The PID's output is the PWM of every rotor (Table 2.5's gains are in PWM
-counts). Its integrator starts at the PWM that holds the vehicle where the
-loop engages (Crazyflie's ROS controller sets it to the lift-off thrust) and
-stops integrating while the PWM is saturated in the direction of the error.
-The derivative acts on the measured climb rate (``de/dt = -v_z`` while the
-command is held), which keeps a step command from kicking the motors.
+counts; the thrust feedforward gain k_T = 1 of Table 2.4 passes T_c to the
+motors as PWM). Its integrator starts at the PWM that holds the vehicle where
+the loop engages (Crazyflie's ROS controller sets it to the lift-off thrust)
+and stops integrating while the PWM is saturated in the direction of the
+error. The derivative acts on the measured climb rate (``de/dt = -v_z`` while
+the command is held). Eq. 2.14 differentiates the error itself, which at a
+step adds one control period of ``K_d dz_c/dt``: at 200 Hz that saturates the
+PWM for 5 ms, lengthened every rise time in the simulator by 0.05-0.2 s and
+moved no MRAC/PID rise-time ratio by more than one point, so the kick is
+left out.
 
 The MRAC adds ``u_adp = -Theta_hat^T Phi(z)`` (eq. 2.17, total thrust in N,
-converted to PWM per rotor by ``n k_f``) with ``Theta_hat' = Gamma Phi e^T P B``
-(eq. 2.19), ``e = x - x_ref``, ``x = [z, v_z]`` and ``B = [0, 1/m]`` from the
-heave row of eq. 2.10 (thrust in N). The reference model runs from the
-height at which the loop engages (eq. 2.15 is linearised about hover), and
-the reference climb rate compared with the vehicle's is the rate of the
-reference height, ``z_ref'``, from the first row of eq. 2.20.
+converted to PWM per rotor by ``n k_f``, eq. 2.6) with
+``Theta_hat' = Gamma Phi e^T P B`` (eq. 2.19), ``B = [0, 1/m]`` from the heave
+row of eq. 2.10 (T is the total thrust; with Theta_hat in PWM counts and
+``Gamma = 1e-3`` the adaptive thrust would be ``n k_f`` = 8.3e-6 times weaker
+and the MRAC would do nothing), and the tracking error of eq. A.4,
+``e = x - x_ref`` with ``x = [z, v_z]`` and ``x_ref = [z_ref, v_z,ref]`` the
+two states of the reference model eq. 2.20 ("x = [z, v_z] and u_cmd = [z_c]",
+section 2.5.3). Eq. 2.20's second state is not the rate of its first (its
+first row is ``z' = v_z - 0.1145 z_c``): with a held command ``v_z,ref`` settles
+at ``0.1145 z_c``, so after a climb the law holds the vehicle about 2 % of
+the step above the command, against the PID's integrator, and on it after a
+descent to where the loop engaged, as the tables' take-off steady-state
+errors, larger than the landing ones, suggest.
+The reference model runs from the height at which the loop engages
+(eq. 2.15 is linearised about hover).
 """
 
 from __future__ import annotations
@@ -253,8 +267,7 @@ class MracAltitude:
         rate = np.asarray(climb_rate_m_s, dtype=np.float64)
         command = np.asarray(command_m, dtype=np.float64) - self._origin
         phi = self.regressor(height)
-        error = np.column_stack([height - (self._origin + self._x_ref[:, 0]),
-                                 rate - self.reference.height_rate(self._x_ref, command)])
+        error = np.column_stack([height - self._origin - self._x_ref[:, 0], rate - self._x_ref[:, 1]])  # eq. A.4
         adaptive = -np.einsum("nk,nk->n", self._theta, phi)
         pwm = self.pid.step(height, rate, command_m, dt_s, offset_pwm=adaptive / self.vehicle.thrust_per_pwm_n)
         self._log.append((self._theta, self._origin + self._x_ref[:, 0], adaptive))

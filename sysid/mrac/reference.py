@@ -67,7 +67,8 @@ class ReferenceModel:
     Eq. 2.20 was identified from hover steps flown with the PID loop out of
     ground effect. Its first row, ``z' = v_z - 0.1145 z_c``, makes ``v_z`` differ
     from the height rate while a command is held; :meth:`height_rate` gives
-    the rate itself. The DC gain is ``(6.273 - 7.027 * 0.1145) / 5.416 = 1.0097``
+    the rate itself. The MRAC compares the vehicle with the states themselves
+    (``e = x - x_ref``, eq. A.4). The DC gain is ``(6.273 - 7.027 * 0.1145) / 5.416 = 1.0097``
     and the poles are -0.881 and -6.146 rad/s.
     """
 

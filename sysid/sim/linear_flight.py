@@ -194,8 +194,8 @@ def simulate_hover(
     rate_hz : float, optional
         Log rate, Hz.
     substeps : int, optional
-        Integration steps per log sample (delays are whole integration steps); the
-        controller updates once per log sample and holds its command in between.
+        Integration and control steps per log sample (delays are whole integration
+        steps); the logged mixer input is the command averaged over the log interval.
     hover_height_m : float, optional
         Trim height above ground, m (the dissertation's 4.6 m, out of ground effect).
     seed : int, optional
@@ -224,17 +224,11 @@ def simulate_hover(
     w_thr_delay = int(round(terms.get("tau_w_thr", 0.0) / dt))
     for k in range(n_fine):
         # the controller holds ground velocity: airspeed plus the wind along each axis
-        # the flight controller runs at the log rate and holds its command between updates
-        # (zero-order hold), so the logged mixer input is exactly the input the airframe got
-        if k % substeps == 0:
-            feedback = {axis: states[axis].copy() for axis in _AXES}
-            feedback["lon"][0] += wind_ne[k, 0]
-            feedback["lat"][0] += wind_ne[k, 1]
-            for axis in _AXES:
-                history[axis][k] = -gains[axis] @ feedback[axis] + excitation[axis][k]
-        else:
-            for axis in _AXES:
-                history[axis][k] = history[axis][k - 1]
+        feedback = {axis: states[axis].copy() for axis in _AXES}
+        feedback["lon"][0] += wind_ne[k, 0]
+        feedback["lat"][0] += wind_ne[k, 1]
+        for axis in _AXES:
+            history[axis][k] = -gains[axis] @ feedback[axis] + excitation[axis][k]
         wind_lon_u = wind_ne[max(k - w_lon_delay, 0), 0]
         wind_lon_w = wind_ne[max(k - w_thr_delay, 0), 0]
         derivative_u = models["lon"][0][0] @ states["lon"] + terms.get("X_w_lon", 0.0) * wind_lon_u
@@ -255,8 +249,13 @@ def simulate_hover(
         states["thr"][0] += dt * terms.get("Z_w_lon", 0.0) * wind_lon_w
     pick = slice(0, n_fine, substeps)
     signals = {name: values[pick] for name, values in log.items()}
+    # the logger averages the fast command over each log interval, centred on the log instant (a boxcar
+    # anti-alias filter, zero phase): picking every `substeps`-th command instead would log the
+    # feedback's within-interval change as a timing error of a few ms, which the unstable open-loop
+    # pitch and roll modes amplify in any time-domain check
+    boxcar = np.ones(substeps) / substeps
     for axis in _AXES:
-        signals[f"delta_{axis}"] = history[axis][pick]
+        signals[f"delta_{axis}"] = np.convolve(history[axis], boxcar, mode="same")[pick]
     signals["vn"] = signals["u"] + wind_ne[pick, 0]
     signals["ve"] = signals["v"] + wind_ne[pick, 1]
     signals["vd"] = signals["w"]

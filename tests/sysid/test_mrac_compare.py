@@ -9,6 +9,7 @@ from sysid.mrac import (
     REFERENCE_EQ_2_20,
     CompareConfig,
     MracComparison,
+    Regressor,
     StepMetrics,
     compare_controllers,
     comparison_json,
@@ -56,10 +57,16 @@ def test_rise_time_ordering_pid_then_linear_then_rbf(comparison: MracComparison,
     assert linear <= 0.5 * pid
 
 
-@pytest.mark.xfail(strict=True, reason="chapter 2 reports a cut of at least 80 %; with Table 2.5's gains, "
-                   "Gamma = 1e-3, B = [0, 1/m] and eq. 2.5 this simulation cuts about 70 % (linear) and 78 % (RBF)")
+@pytest.mark.xfail(strict=True, reason=(
+    "chapter 2 reports a cut of at least 80 %; built as the text states (eqs. 2.14-2.26, A.4, Tables 2.1, 2.5, "
+    "eq. 2.5: B = [0, 1/m], Gamma = 1e-3, e = x - x_ref, steps 6.2/4.2/2.2 cm) this simulation cuts 67-73 % "
+    "(linear) and 77-81 % (RBF). The MRAC's integral action Gamma p12 |Phi|^2 / m is 3.5 |Phi|^2 times the "
+    "PID's Ki n k_f, so to first order the linear MRAC rises in 1 / 4.5 = 22 % of the PID's time plus the "
+    "reference model's own lag; the flown PID was slower than this one (its 40-s errors 0.26-1.03 cm against "
+    "0.03-0.16 cm here; test_mrac.py::test_eq_2_20_is_table_2_5s_pd_loop_with_a_lower_pwm_gain)"))
 @pytest.mark.parametrize("name", ["mrac_linear", "mrac_rbf"])
 def test_mrac_cuts_the_rise_time_by_80_percent(comparison: MracComparison, name: str) -> None:
+    """Issue 8: at least 80 % shorter rise than the PID at Z/R 4, 3, 2, take-off and landing (Tables 2.6-2.8)."""
     ratios = [_rise(comparison, name, r, p) / _rise(comparison, "pid", r, p) for r in IN_GROUND_EFFECT for p in PHASES]
     assert max(ratios) <= 0.2
 
@@ -95,11 +102,36 @@ def test_out_of_ground_effect_the_three_behave_alike(comparison: MracComparison,
             assert mismatch < 0.1  # the PID loop out of ground effect is close to eq. 2.20
     for name in ("mrac_linear", "mrac_rbf"):
         assert spread[4.0, name] > 2 * spread[22.0, name]
-    for name in ("pid", "mrac_linear", "mrac_rbf"):
-        result = comparison.result(22.0, name)
-        stats = comparison.statistics(name, height_ratio=22.0, phase=phase)  # type: ignore[arg-type]
-        sse = stats.steady_state_error_m.mean
-        assert sse < 0.02 * (result.case.high_m - result.case.low_m)
+    result = comparison.result(22.0, "pid")
+    stats = comparison.statistics("pid", height_ratio=22.0, phase=phase)  # type: ignore[arg-type]
+    sse = stats.steady_state_error_m.mean
+    assert sse < 0.02 * (result.case.high_m - result.case.low_m)  # the MRACs' offset: next test
+
+
+@pytest.mark.parametrize("ratio", (*IN_GROUND_EFFECT, 22.0))
+@pytest.mark.parametrize("name", ["mrac_linear", "mrac_rbf"])
+def test_mrac_settles_where_eqs_2_20_and_a4_put_it(comparison: MracComparison, ratio: float, name: str) -> None:
+    """e = x - x_ref (eq. A.4) with eq. 2.20's states: held at a step s, x_ref -> [1.0097 s, 0.1145 s] while the
+    vehicle's v_z -> 0, so the MRAC integrates towards z = z_ref + (p22/p12) 0.1145 s and the PID towards s. With
+    constant thrust, Ki n k_f (s - z) = k_a (z - 1.0097 s - (p22/p12) 0.1145 s), k_a = Gamma p12 |Phi|^2 / m, puts
+    the vehicle about 2 % of the step above the command after take-off and on the command after landing (the
+    tables' take-off steady-state errors, 0.15-0.27 cm, exceed the landing ones, 0.09-0.12 cm). Tolerance: the
+    1-s final mean scatters by about 0.3 mm per trial with the sensor noise; 0.5 mm is three standard errors of
+    the mean of three trials."""
+    result = comparison.result(ratio, name)
+    vehicle, case = CRAZYFLIE_ALTITUDE, result.case
+    step = case.high_m - case.low_m
+    p = REFERENCE_EQ_2_20.lyapunov(np.diag([100.0, 1.0]))
+    phi = Regressor("linear" if name == "mrac_linear" else "rbf")(np.array([case.high_m]))[0]
+    k_a = 1e-3 * p[0, 1] * float(phi @ phi) / vehicle.mass_kg
+    k_i = 8219.7 * vehicle.thrust_per_pwm_n
+    dc = REFERENCE_EQ_2_20.dc_gain()
+    offset = step * k_a * (dc[0] - 1.0 + p[1, 1] / p[0, 1] * dc[1]) / (k_i + k_a)
+    assert 0.019 * step < offset < 0.025 * step
+    n = result.run.time_s.size // 2
+    final = result.run.height_m[n - 200 : n].mean(axis=0)  # the last second of the take-off, at 200 Hz
+    assert np.mean(final) - case.high_m == pytest.approx(offset, abs=5e-4)
+    assert np.mean(result.run.height_m[-200:]) - case.low_m == pytest.approx(0.0, abs=5e-4)
 
 
 def test_adaptive_histories_are_kept(comparison: MracComparison) -> None:
@@ -127,8 +159,12 @@ def test_the_json_summary_has_the_documented_shape(comparison: MracComparison) -
 
 
 def test_step_cases_follow_the_dissertation() -> None:
-    case = step_case(2.0)
+    """Section 2.7: "6.2cm (Z/R ≈ 4), 4.2cm (Z/R ≈ 3) and 2.2cm (Z/R ≈ 2) above the ground"; other ratios put the
+    rotors (gear 25.5 mm above the ground, R = 22.5 mm) at Z/R."""
+    assert [step_case(r).high_m for r in IN_GROUND_EFFECT] == [0.062, 0.042, 0.022]
+    case = step_case(2.0, table_heights=False)
     assert case.low_m == 0.0 and case.high_m == pytest.approx(2 * 0.0225 - 0.0255)
+    assert step_case(2.5).high_m == pytest.approx(2.5 * 0.0225 - 0.0255)
     out = step_case(22.0)
     assert not out.in_ground_effect and out.low_m == pytest.approx(22 * 0.0225 - 0.0255)
     with pytest.raises(DataError, match="below the rotors' height on the ground"):
