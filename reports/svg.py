@@ -44,7 +44,7 @@ def new_figure(n_rows: int = 1, n_cols: int = 1, *, width_in: float = 7.5, heigh
     figure : matplotlib.figure.Figure
     axes : Axes or ndarray of Axes
     """
-    with plt.rc_context(_STYLE)  # type: ignore[arg-type]:
+    with plt.rc_context(_STYLE):  # type: ignore[arg-type]
         figure, axes = plt.subplots(n_rows, n_cols, figsize=(width_in, height_in), sharex=sharex, squeeze=True)
     return figure, axes
 
@@ -70,7 +70,7 @@ def figure_svg(figure: Figure) -> str:
     True
     """
     buffer = io.StringIO()
-    with plt.rc_context(_STYLE)  # type: ignore[arg-type]:
+    with plt.rc_context(_STYLE):  # type: ignore[arg-type]
         figure.savefig(buffer, format="svg", bbox_inches="tight", metadata={"Date": None})
     plt.close(figure)
     text = buffer.getvalue()
