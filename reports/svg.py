@@ -6,10 +6,7 @@ import io
 from typing import Any
 
 import matplotlib
-
-matplotlib.use("Agg")
-from matplotlib import pyplot as plt  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.figure import Figure
 
 __all__ = ["figure_svg", "new_figure"]
 
@@ -44,13 +41,15 @@ def new_figure(n_rows: int = 1, n_cols: int = 1, *, width_in: float = 7.5, heigh
     figure : matplotlib.figure.Figure
     axes : Axes or ndarray of Axes
     """
-    with plt.rc_context(_STYLE):  # type: ignore[arg-type]
-        figure, axes = plt.subplots(n_rows, n_cols, figsize=(width_in, height_in), sharex=sharex, squeeze=True)
+    # a bare Figure, never registered with pyplot: nothing to close, nothing kept alive
+    matplotlib.rcParams.update(_STYLE)  # type: ignore[arg-type]
+    figure = Figure(figsize=(width_in, height_in))
+    axes = figure.subplots(n_rows, n_cols, sharex=sharex, squeeze=True)
     return figure, axes
 
 
 def figure_svg(figure: Figure) -> str:
-    """The figure as an ``<svg>`` element to inline in HTML; the figure is closed.
+    """The figure as an ``<svg>`` element to inline in HTML.
 
     Parameters
     ----------
@@ -70,9 +69,8 @@ def figure_svg(figure: Figure) -> str:
     True
     """
     buffer = io.StringIO()
-    with plt.rc_context(_STYLE):  # type: ignore[arg-type]
-        figure.savefig(buffer, format="svg", bbox_inches="tight", metadata={"Date": None})
-    plt.close(figure)
+    matplotlib.rcParams.update(_STYLE)  # type: ignore[arg-type]
+    figure.savefig(buffer, format="svg", bbox_inches="tight", metadata={"Date": None})
     text = buffer.getvalue()
     start = text.index("<svg")
     svg = text[start:]

@@ -59,11 +59,18 @@ def cli(ctx: click.Context, debug: bool) -> None:
 
 
 def _register() -> None:
-    from . import demo, ingest, simulate
+    from . import demo, freqresp, ingest, simulate
 
     cli.add_command(ingest.ingest)
     cli.add_command(simulate.simulate)
     cli.add_command(demo.demo)
+    cli.add_command(freqresp.freqresp)
+    cli.add_command(__import__("sysid_cli.groundeffect", fromlist=["ground_effect"]).ground_effect)
+    cli.add_command(__import__("sysid_cli.validate", fromlist=["validate"]).validate)
+    cli.add_command(__import__("sysid_cli.mrac", fromlist=["mrac"]).mrac)
+    cli.add_command(__import__("sysid_cli.fit", fromlist=["fit"]).fit)
+    cli.add_command(__import__("sysid_cli.modes", fromlist=["modes"]).modes)
+    cli.add_command(__import__("sysid_cli.report", fromlist=["report"]).report)
 
 
 _register()

@@ -1,5 +1,23 @@
-"""Frequency responses: chirp-z spectra, composite windows, conditioning and gating."""
+"""Frequency responses: chirp-z spectra, composite windows, conditioning and gating.
 
+The public names live in small modules and are re-exported here:
+:mod:`~sysid.freqresp.options` (:class:`ResponseOptions`),
+:mod:`~sysid.freqresp.estimate` (:func:`frequency_responses`),
+:mod:`~sysid.freqresp.gating` (:func:`gate_responses`),
+:mod:`~sysid.freqresp.records` (:func:`maneuver_records`, :data:`DEFAULT_PAIRS`,
+:func:`flight_responses`) and :mod:`~sysid.freqresp.io` (HDF5).
+"""
+
+from .estimate import automatic_window_lengths, frequency_responses
+from .gating import DroppedResponse, GatingResult, fit_range, gate_responses
+from .io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
+from .options import ResponseOptions
+from .records import DEFAULT_PAIRS, FlightResponses, default_pairs, flight_responses, maneuver_records, parse_pairs
 from .response import FrequencyResponse
 
-__all__ = ["FrequencyResponse"]
+__all__ = [
+    "FrequencyResponse", "ResponseOptions", "frequency_responses", "automatic_window_lengths",
+    "DroppedResponse", "GatingResult", "gate_responses", "fit_range",
+    "write_responses", "read_responses", "RESPONSES_SCHEMA_VERSION",
+    "DEFAULT_PAIRS", "maneuver_records", "parse_pairs", "default_pairs", "FlightResponses", "flight_responses",
+]

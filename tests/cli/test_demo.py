@@ -1,27 +1,43 @@
-"""``sysid demo`` end to end, and ``sysid ingest`` with an anemometer."""
+"""``sysid demo`` end to end (simulate, ingest, fit, verify, report), and ``sysid ingest`` with an anemometer."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
 
 from flightlogs.store import read_dataset
+from reports.model_report import model_verdict
+from sysid.fit import read_model
+from sysid.sim.scenarios import write_demo_flight
+from sysid.verify_io import read_verification
 from sysid_cli.main import cli
 
 
 @pytest.fixture(scope="module")
-def demo_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def demo_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """The whole demo, once: its folder and what it printed."""
     out = tmp_path_factory.mktemp("demo")
     result = CliRunner().invoke(cli, ["demo", "-o", str(out)])
     assert result.exit_code == 0, result.output
-    assert f"dataset: {out / 'dataset.h5'}" in result.output
+    return out, result.output
+
+
+@pytest.fixture(scope="module")
+def demo_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The demo's flight files alone (what the ingest tests need), without running the demo."""
+    out = tmp_path_factory.mktemp("flight")
+    write_demo_flight(out)
     return out
 
 
-def test_demo_writes_the_flight_and_the_aligned_dataset(demo_dir: Path) -> None:
+@pytest.mark.slow
+def test_demo_writes_the_flight_and_the_aligned_dataset(demo_run: tuple[Path, str]) -> None:
+    demo_dir, output = demo_run
+    assert f"dataset: {demo_dir / 'dataset.h5'}" in output
     truth = json.loads((demo_dir / "truth.json").read_text())
     summary = json.loads((demo_dir / "ingest.json").read_text())
     alignment = summary["wind_alignment"]
@@ -36,6 +52,33 @@ def test_demo_writes_the_flight_and_the_aligned_dataset(demo_dir: Path) -> None:
     (record,) = flight.records
     assert record.time_s.size == summary["records"][0]["samples"]
     assert {"u", "v", "w", "wind_lon", "wind_lat"} <= set(record.signals)
+
+
+_FOOTER = re.compile(r"<footer>.*?</footer>", re.S)
+
+
+@pytest.mark.slow
+def test_demo_ends_with_the_report_and_sysid_report_rebuilds_it(demo_run: tuple[Path, str], tmp_path: Path) -> None:
+    """The last line is the report's path; the model, the verification and the page agree with each other."""
+    demo_dir, output = demo_run
+    page = demo_dir / "report.html"
+    assert output.rstrip().splitlines()[-1] == f"report: {page.resolve()}"
+    model = read_model(demo_dir / "model.json")
+    saved = read_verification(demo_dir / "validation.json")
+    assert model.structure_name == "hover-wind" and model.wind is not None
+    assert saved.model == "model.json" and saved.options["initial_state"] == "estimated"
+    assert {r.label.split()[1] for r in saved.verification.records} == {"lon", "lat", "yaw", "thr"}  # every doublet
+    assert saved.verification.wind_correction  # verified with and without G_w
+    verdict = model_verdict(model, saved.verification)
+    assert verdict.sentence in output
+    text = page.read_text()
+    assert '<p class="verdict ' in text and verdict.sentence in text
+    assert "ArduCopter" in text and 'id="verification"' in text
+    rebuilt = tmp_path / "rebuilt.html"
+    result = CliRunner().invoke(cli, ["report", str(demo_dir / "model.json"), str(demo_dir / "validation.json"),
+                                      "--ingest-summary", str(demo_dir / "ingest.json"), "-o", str(rebuilt), "-q"])
+    assert result.exit_code == 0, result.output
+    assert _FOOTER.sub("", rebuilt.read_text()) == _FOOTER.sub("", text)
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,114 @@
+"""Time ``sysid fit`` on one wind condition of the chapter 3 campaign flown by the linear model.
+
+    python benchmarks/bench_fit.py [--condition calm|light|strong] [--trials 5] [--folder DIR] [--threads 2]
+
+Simulates 5 sweeps per axis (4 axes, 20 ArduPilot logs with a ground
+anemometer) of the Table 3.3 model in the chosen wind (not timed), then
+times the whole ``sysid fit LOGS --wind DIR --model hover-wind`` command in a
+fresh process (read, condition, frequency responses, fit, reduction, wind
+step, model file): the target is under 20 s on 2 cores. It then times the
+stages in-process and, as baselines, the F/G_u fit with scipy's
+forward-difference Jacobian instead of the analytic one, and with 5
+starting points instead of 1. BLAS threads are pinned to ``--threads``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+SPEEDS = {"calm": 0.9, "light": 2.7, "strong": 5.4}
+
+
+def _scenario(condition: str, trials: int) -> str:
+    text = f"""
+[scenario]
+description = "bench: sweeps of the Table 3.3 linear model"
+vehicle = "linear-octo"
+formats = ["dataflash"]
+trials = {trials}
+seed = 1
+utc_start = "2024-05-01T10:00:00Z"
+margin_s = 3.0
+[anemometer]
+distance_m = 4.6
+rate_hz = 20.0
+clock_offset_s = 0.0
+[[condition]]
+name = "{condition}"
+mean_speed_m_s = {SPEEDS[condition]}
+direction_from_deg = 300.0
+turbulence_ratio = 0.2
+"""
+    for axis, amplitude in (("lat", 8.0), ("lon", 8.0), ("yaw", 10.0), ("thr", 4.0)):
+        text += f'[[maneuver]]\naxis = "{axis}"\nkind = "sweep"\namplitude = {amplitude}\nduration_s = 34.0\n'
+    return text
+
+
+def _timed(label: str, function, *args, **kwargs):  # type: ignore[no-untyped-def]
+    start = time.perf_counter()
+    result = function(*args, **kwargs)
+    elapsed = time.perf_counter() - start
+    print(f"  {label:<44} {elapsed:7.2f} s")
+    return result, elapsed
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--condition", choices=tuple(SPEEDS), default="light")
+    parser.add_argument("--trials", type=int, default=5)
+    parser.add_argument("--folder", type=Path, default=None, help="keep the logs here (default: a temporary folder)")
+    parser.add_argument("--threads", type=int, default=2)
+    args = parser.parse_args()
+    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ[name] = str(args.threads)
+
+    from flightlogs.campaign import ingest_campaign
+    from flightlogs.condition import ConditioningOptions
+    from sysid.fit import FitOptions, IdentifyOptions, fit_frequency_responses, identify_flights
+    from sysid.sim.campaign import run_scenario
+    from sysid.sim.scenario import read_scenario
+
+    folder = args.folder or Path(tempfile.mkdtemp(prefix="bench-fit-"))
+    folder.mkdir(parents=True, exist_ok=True)
+    logs_dir = folder / args.condition
+    if not any(logs_dir.glob("*.bin")):
+        (folder / "scenario.toml").write_text(_scenario(args.condition, args.trials))
+        start = time.perf_counter()
+        run_scenario(read_scenario(folder / "scenario.toml"), logs_dir)
+        print(f"simulated {args.trials} sweeps per axis in {args.condition} wind: {time.perf_counter() - start:.1f} s "
+              f"(not part of the timing)")
+    logs = sorted(str(p) for p in logs_dir.glob("*.bin"))
+    command = ["sysid", "fit", *logs, "--wind", str(logs_dir), "--wind-distance", "4.6", "--model", "hover-wind",
+               "-o", str(folder / "model.json"), "-q"]
+    start = time.perf_counter()
+    subprocess.run(command, check=True)
+    total = time.perf_counter() - start
+    print(f"sysid fit, {len(logs)} logs, {args.condition} wind, hover-wind: {total:.2f} s wall "
+          f"(target < 20 s on 2 cores) {'OK' if total < 20 else 'SLOW'}")
+
+    print("stages, in-process:")
+    campaign, _ = _timed("read + condition (ingest_campaign)", ingest_campaign, [Path(p) for p in logs], [logs_dir],
+                         options=ConditioningOptions(wind_distance_m=4.6))
+    flights = [c for c in campaign.conditioned if c is not None]
+    model, _ = _timed("responses + fit + reduction + wind step", identify_flights, flights, "hover-wind")
+    responses = model.responses
+    print("F/G_u fit on the same gated responses (with reduction):")
+    _, analytic = _timed("analytic Jacobian, 1 start", fit_frequency_responses, model.structure, responses)
+    _, numeric = _timed("forward-difference Jacobian, 1 start", fit_frequency_responses, model.structure, responses,
+                        options=FitOptions(jacobian="numeric"))
+    _, several = _timed("analytic Jacobian, 5 starts", fit_frequency_responses, model.structure, responses,
+                        options=FitOptions(starts=5))
+    print(f"ratios: numeric / analytic = {numeric / analytic:.1f}x, 5 starts / 1 start = {several / analytic:.1f}x; "
+          f"J_ave = {model.cost.average:.1f}")
+    if IdentifyOptions().fit.starts != 1:  # pragma: no cover - a reminder if the default changes
+        print("note: the default number of starts is not 1", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

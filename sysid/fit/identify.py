@@ -1,0 +1,331 @@
+"""The whole identification: flights to frequency responses, gating, F/G_u fit, wind step, model.
+
+This is what ``sysid fit`` runs. Each mixer axis's sweeps give the
+responses of Table 3.4's pairs (conditioned on the structure's wind signals
+when the records carry them), gated by eq. 3.8; the structure's F and G_u
+parameters are fitted to them and reduced; its G_w parameters come from
+the time-domain residual of eq. 3.14.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+from scipy import linalg
+
+from flightlogs.condition import ConditionedFlight, ConditioningOptions
+from flightlogs.errors import FitError
+from flightlogs.record import Record
+from flightlogs.store import file_sha256
+
+from ..freqresp import FrequencyResponse, ResponseOptions, frequency_responses, gate_responses, maneuver_records
+from ..model.structure import ModelStructure
+from ..model.toml_format import load_structure
+from .engine import FitOptions, FrequencyFit, fit_frequency_responses
+from .reduce import ReductionStep
+from .result import IdentifiedModel, ParameterEstimate, Provenance
+from .wind import WindStepResult, fit_wind
+
+__all__ = ["FIT_PAIRS", "IdentifyOptions", "identify_flights", "identify_logs", "model_from_fit"]
+
+#: Outputs fitted per mixer axis (Table 3.4): the input is ``delta_<axis>``.
+FIT_PAIRS: Mapping[str, tuple[str, ...]] = MappingProxyType({
+    "lat": ("v", "p", "ay"), "lon": ("u", "w", "q", "ax"), "yaw": ("r",), "thr": ("az",),
+})
+_AXES = ("lat", "lon", "yaw", "thr")
+
+Progress = Callable[[str, int, int], None]
+
+
+@dataclass(frozen=True, slots=True)
+class IdentifyOptions:
+    """Choices of the whole identification.
+
+    Parameters
+    ----------
+    fit : FitOptions
+        Search, cost weights and reduction.
+    responses : ResponseOptions
+        Frequency grid and windows of the responses.
+    min_record_periods : float
+        Lowest frequency fitted: the longest record must hold this many of
+        its periods (Tischler's guideline, 4-5), so ``omega_min`` is raised
+        to ``2 pi min_record_periods / T_record`` (0.87 rad/s for the
+        dissertation's 36 s sweep records); below it, closed-loop responses
+        of short records are biased by leakage.
+    pairs : tuple of (str, str) or None
+        ``(output, input)`` pairs to fit; None for :data:`FIT_PAIRS` of every
+        axis flown (outputs the records or the structure lack are left out).
+    kind : str
+        Maneuvers the responses come from (``sweep``).
+    min_coherence : float
+        Gating threshold on gamma^2 (eq. 3.8).
+    min_decades : float
+        Shortest fit range, decades (eq. 3.8).
+    constants : Mapping[str, float] or None
+        Trim constants to use instead of the flights' trim (``U0``, ``theta0`` ...).
+    initial : Mapping[str, float] or None
+        Starting values overriding the structure's.
+    condition_on_wind : bool
+        Condition each response on the structure's wind signals when the
+        records carry them (partial coherence).
+    wind_outputs : tuple of str
+        Outputs whose eq. 3.14 residual the wind step fits.
+    wind_axes : tuple of str
+        Maneuvers whose records the wind step uses: those of the axes whose
+        outputs carry the wind terms (yaw sweeps turn the nose through the
+        wind and mix its components).
+    """
+
+    fit: FitOptions = field(default_factory=FitOptions)
+    responses: ResponseOptions = field(default_factory=ResponseOptions)
+    min_record_periods: float = 5.0
+    pairs: tuple[tuple[str, str], ...] | None = None
+    kind: str = "sweep"
+    min_coherence: float = 0.5
+    min_decades: float = 0.3
+    constants: Mapping[str, float] | None = None
+    initial: Mapping[str, float] | None = None
+    condition_on_wind: bool = True
+    wind_outputs: tuple[str, ...] = ("ax", "az")
+    wind_axes: tuple[str, ...] = ("lon", "thr")
+
+
+def _report(progress: Progress | None, stage: str, done: int, total: int) -> None:
+    if progress is not None:
+        progress(stage, done, total)
+
+
+def _axis_responses(structure: ModelStructure, records: list[Record], axis: str, options: IdentifyOptions
+                    ) -> tuple[FrequencyResponse, ...]:
+    control = f"delta_{axis}"
+    logged = set.intersection(*(set(r.signals) for r in records))
+    if options.pairs is not None:
+        outputs = [o for o, i in options.pairs if i == control]
+    else:
+        outputs = [o for o in FIT_PAIRS[axis] if o in structure.outputs]
+    outputs = [o for o in outputs if o in logged]
+    if not outputs or control not in logged:
+        return ()
+    winds = [s for s in dict.fromkeys(c.signal for c in structure.wind_inputs) if s in logged]
+    inputs = [control] + (winds if options.condition_on_wind else [])
+    longest = max(r.end_s - r.start_s for r in records)
+    lowest = max(options.responses.omega_min, 2.0 * np.pi * options.min_record_periods / longest)
+    grid = dataclasses.replace(options.responses, omega_min=min(lowest, options.responses.omega_max / 2.0))
+    found = frequency_responses(records, inputs, outputs, grid)
+    return tuple(r for r in found if r.input == control)
+
+
+def identify_flights(
+    flights: Sequence[ConditionedFlight],
+    structure: ModelStructure | str,
+    *,
+    options: IdentifyOptions = IdentifyOptions(),
+    files: Sequence[str | Path] = (),
+    progress: Progress | None = None,
+) -> IdentifiedModel:
+    """Identify a model structure from conditioned flights.
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        Flights with sweeps (and, for the wind step, air-relative velocities
+        and the wind in their records).
+    structure : ModelStructure or str
+        The structure, or a built-in name / structure file.
+    options : IdentifyOptions, optional
+        Choices.
+    files : sequence of str or Path, optional
+        Files the flights came from, hashed into the provenance.
+    progress : callable, optional
+        ``progress(stage, done, total)`` as the work advances.
+
+    Returns
+    -------
+    IdentifiedModel
+
+    Raises
+    ------
+    FitError
+        If no sweep gives a response that passes gating.
+    """
+    if isinstance(structure, str):
+        structure = load_structure(structure)
+    used: dict[str, list[Record]] = {}
+    responses: list[FrequencyResponse] = []
+    notes: list[str] = []
+    for k, axis in enumerate(_AXES):
+        _report(progress, f"responses {axis}", k, len(_AXES) + 2)
+        records = maneuver_records(flights, axis, kind=options.kind)
+        if records:
+            used[axis] = records
+            responses += _axis_responses(structure, records, axis, options)
+    if not responses:
+        names = ", ".join(f.source.name for f in flights) or "no flight"
+        raise FitError(f"no {options.kind} in {names} gives a response the model {structure.name} can be fitted to")
+    gated = gate_responses(responses, min_coherence=options.min_coherence, min_decades=options.min_decades)
+    notes += [d.reason for d in gated.dropped]
+    if not gated.kept:
+        raise FitError("no frequency response passed gating: " + " ".join(d.reason for d in gated.dropped))
+    trim = _mean_trim([r for records in used.values() for r in records])
+    constants = structure.constants_from_trim(trim) | dict(options.constants or {})
+    _report(progress, "fitting F, G_u", len(_AXES), len(_AXES) + 2)
+    fit = fit_frequency_responses(structure, gated.kept, constants=constants, initial=options.initial,
+                                  options=options.fit)
+    wind = None
+    if structure.wind_parameters:
+        _report(progress, "wind step", len(_AXES) + 1, len(_AXES) + 2)
+        signals = {c.signal for c in structure.wind_inputs}
+        records = [r for axis in options.wind_axes for r in used.get(axis, [])]
+        if any(signals <= set(r.signals) for r in records):
+            wind = fit_wind(structure, fit.values, constants, records, outputs=options.wind_outputs,
+                            reduce=options.fit.reduce, max_cr_percent=options.fit.max_cr_percent,
+                            max_insensitivity_percent=options.fit.max_insensitivity_percent)
+        else:
+            notes.append(f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give --wind)")
+    _report(progress, "done", len(_AXES) + 2, len(_AXES) + 2)
+    return model_from_fit(fit, wind, trim=trim, provenance=_provenance(files, options), notes=notes)
+
+
+def identify_logs(
+    log_paths: Sequence[str | Path],
+    structure: ModelStructure | str,
+    *,
+    wind_paths: Sequence[str | Path] = (),
+    conditioning: ConditioningOptions = ConditioningOptions(),
+    options: IdentifyOptions = IdentifyOptions(),
+    progress: Progress | None = None,
+) -> IdentifiedModel:
+    """Read, condition and identify: ``sysid fit LOGS... --wind CSV``.
+
+    Parameters
+    ----------
+    log_paths : sequence of str or Path
+        Flight logs with sweeps (any supported format).
+    structure : ModelStructure or str
+        The structure, or a built-in name / structure file.
+    wind_paths : sequence of str or Path, optional
+        Anemometer CSV files or folders.
+    conditioning : ConditioningOptions, optional
+        Wind alignment and resampling choices.
+    options : IdentifyOptions, optional
+        Identification choices.
+    progress : callable, optional
+        ``progress(stage, done, total)``.
+
+    Returns
+    -------
+    IdentifiedModel
+
+    Raises
+    ------
+    LogFormatError, DataError
+        On logs or wind files that cannot be used.
+    FitError
+        If nothing can be fitted.
+    """
+    from flightlogs.campaign import expand_wind_paths, ingest_campaign
+
+    def reading(name: str, done: int, total: int) -> None:
+        _report(progress, f"reading {name}", done, total)
+
+    campaign = ingest_campaign([Path(p) for p in log_paths], [Path(p) for p in wind_paths], options=conditioning,
+                               progress=reading)
+    flights = [c for c in campaign.conditioned if c is not None]
+    winds = expand_wind_paths([Path(p) for p in wind_paths])
+    return identify_flights(flights, structure, options=options, files=[*log_paths, *winds], progress=progress)
+
+
+def _mean_trim(records: Sequence[Record]) -> dict[str, float]:
+    names = dict.fromkeys(name for r in records for name in r.trim)
+    return {name: float(np.mean([r.trim[name] for r in records if name in r.trim])) for name in names}
+
+
+def _jsonable(value: Any) -> Any:
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, Mapping):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value if isinstance(value, (str, int, float, bool)) or value is None else str(value)
+
+
+def _provenance(files: Sequence[str | Path], options: IdentifyOptions) -> Provenance:
+    from importlib.metadata import PackageNotFoundError, version
+
+    versions = {}
+    for package in ("flight-sysid", "numpy", "scipy", "control"):
+        try:
+            versions[package] = version(package)
+        except PackageNotFoundError:
+            versions[package] = "unknown"
+    paths = [str(p) for p in files]
+    return Provenance(tuple(paths), {p: file_sha256(p) for p in paths}, _jsonable(options), versions,
+                      datetime.now(timezone.utc).isoformat(timespec="seconds"))
+
+
+def model_from_fit(fit: FrequencyFit, wind: WindStepResult | None = None, *, trim: Mapping[str, float] | None = None,
+                   provenance: Provenance = Provenance(), notes: Sequence[str] = ()) -> IdentifiedModel:
+    """Assemble an :class:`IdentifiedModel` from the two steps' results.
+
+    Parameters
+    ----------
+    fit : FrequencyFit
+        Step 1 (F, G_u).
+    wind : WindStepResult or None, optional
+        Step 2 (G_w, wind delays); None leaves the wind parameters out (set
+        to their drop values, logged as a reduction step).
+    trim : Mapping[str, float], optional
+        Trim of the flights.
+    provenance : Provenance, optional
+        Files, options, versions.
+    notes : sequence of str, optional
+        Remarks (responses dropped by gating ...).
+
+    Returns
+    -------
+    IdentifiedModel
+    """
+    structure = fit.structure
+    units = {r.input: r.input_unit for r in fit.responses if r.input_unit}
+    estimates = []
+    reduction = list(fit.reduction) + (list(wind.reduction) if wind is not None else [])
+    cr = dict(zip(fit.accuracy.names, fit.accuracy.cramer_rao_percent.tolist()))
+    ins = dict(zip(fit.accuracy.names, fit.accuracy.insensitivity_percent.tolist()))
+    if wind is not None:
+        cr |= dict(zip(wind.accuracy.names, wind.accuracy.cramer_rao_percent.tolist()))
+        ins |= dict(zip(wind.accuracy.names, wind.accuracy.insensitivity_percent.tolist()))
+    for p in structure.parameters:
+        unit = p.unit
+        for signal, text in units.items():
+            unit = unit.replace("{" + signal + "}", text)
+        if p.name in fit.status:
+            status, value, stage = fit.status[p.name], fit.values[p.name], "frequency"
+        elif wind is not None:
+            status, value, stage = wind.status[p.name], wind.values[p.name], "wind"
+        else:
+            status, value, stage = "dropped", p.drop_value, "wind"
+            reduction.append(ReductionStep(len(reduction) + 1, p.name, "dropped", value, math.nan, math.nan,
+                                           math.nan, "no wind record to fit it", fit.cost.average, fit.cost.average))
+        estimated = status == "estimated"
+        estimates.append(ParameterEstimate(p.name, float(value), cr[p.name] if estimated else math.nan,
+                                           ins[p.name] if estimated else math.nan, status, unit, stage))  # type: ignore[arg-type]
+    reduction = [dataclasses.replace(step, step=k + 1) for k, step in enumerate(reduction)]
+    names = fit.accuracy.names + (wind.accuracy.names if wind is not None else ())
+    blocks = [fit.accuracy.correlation] + ([wind.accuracy.correlation] if wind is not None else [])
+    correlation = linalg.block_diag(*blocks) if names else np.zeros((0, 0))
+    return IdentifiedModel(
+        structure.name, structure.text, tuple(estimates), names, correlation.reshape(len(names), len(names)), fit.cost,
+        fit.responses, MappingProxyType(dict(trim or {})), fit.constants, tuple(reduction), provenance,
+        None if wind is None else wind.fit, units, tuple(notes))

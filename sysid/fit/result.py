@@ -1,0 +1,241 @@
+"""The identified model: structure, estimates with their accuracy, costs, data used and provenance."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any, Literal
+
+import numpy as np
+
+from flightlogs.errors import ModelError
+
+from ..freqresp import FrequencyResponse
+from ..model.assemble import Assembler
+from ..model.structure import ModelStructure
+from ..model.toml_format import parse_structure
+from ..statespace import DelayedStateSpace
+from .cost import CostSummary
+from .reduce import ReductionStep
+
+__all__ = ["ParameterEstimate", "WindFit", "Provenance", "IdentifiedModel"]
+
+
+@dataclass(frozen=True, slots=True)
+class ParameterEstimate:
+    """One parameter of an identified model.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name (``X_u``, ``tau_lon``, ``X_w_lon``).
+    value : float
+        Final value, in `unit`.
+    cr_percent : float
+        Cramér–Rao bound as % of ``|value|`` (NaN unless estimated).
+    insensitivity_percent : float
+        Insensitivity as % of ``|value|`` (NaN unless estimated).
+    status : {"estimated", "fixed", "dropped"}
+        Estimated, held at a given value, or removed by structure reduction
+        (set to its drop value, normally 0).
+    unit : str
+        Unit, with control derivatives per unit of the logged input
+        (``rad/s^2 per normalised (-1..1)``).
+    stage : {"frequency", "wind"}
+        Fitted to the frequency responses (F, G_u) or in the wind step
+        (G_w and wind delays, eq. 3.14).
+    """
+
+    name: str
+    value: float
+    cr_percent: float = math.nan
+    insensitivity_percent: float = math.nan
+    status: Literal["estimated", "fixed", "dropped"] = "estimated"
+    unit: str = ""
+    stage: Literal["frequency", "wind"] = "frequency"
+
+    def __post_init__(self) -> None:
+        if self.status not in ("estimated", "fixed", "dropped"):
+            raise ValueError(f"status={self.status!r} must be 'estimated', 'fixed' or 'dropped'")
+        if self.stage not in ("frequency", "wind"):
+            raise ValueError(f"stage={self.stage!r} must be 'frequency' or 'wind'")
+
+    @property
+    def fixed(self) -> bool:
+        """Held at a value, not estimated."""
+        return self.status == "fixed"
+
+    @property
+    def dropped(self) -> bool:
+        """Removed by structure reduction."""
+        return self.status == "dropped"
+
+    @property
+    def cramer_rao(self) -> float:
+        """Cramér–Rao bound in the parameter's unit."""
+        return abs(self.value) * self.cr_percent / 100.0
+
+
+@dataclass(frozen=True, slots=True)
+class WindFit:
+    """How well the wind terms explain the one-step-prediction residual of eq. 3.14.
+
+    Parameters
+    ----------
+    outputs : tuple of str
+        Outputs whose residual was fitted (``ax``, ``az``).
+    rms_before : tuple of float
+        RMS of each residual without the wind terms, output units.
+    rms_after : tuple of float
+        RMS with them.
+    samples : int
+        Samples used.
+    """
+
+    outputs: tuple[str, ...]
+    rms_before: tuple[float, ...]
+    rms_after: tuple[float, ...]
+    samples: int
+
+    def __post_init__(self) -> None:
+        if not len(self.outputs) == len(self.rms_before) == len(self.rms_after):
+            raise ValueError("outputs, rms_before and rms_after must have one entry per output")
+
+
+@dataclass(frozen=True, slots=True)
+class Provenance:
+    """Where an identified model came from.
+
+    Parameters
+    ----------
+    files : tuple of str
+        Logs and anemometer files read.
+    sha256 : Mapping[str, str]
+        SHA-256 of each file, by path.
+    options : Mapping[str, Any]
+        Options of the identification (JSON-compatible values).
+    versions : Mapping[str, str]
+        Versions of flight-sysid, numpy, scipy.
+    created_utc : str
+        ISO 8601 time of the identification.
+    """
+
+    files: tuple[str, ...] = ()
+    sha256: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    options: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    versions: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    created_utc: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class IdentifiedModel:
+    """A fitted model structure with everything needed to use, judge and re-plot it.
+
+    Parameters
+    ----------
+    structure_name : str
+        Name of the structure (``hover``).
+    structure_text : str
+        The structure's TOML source.
+    parameters : tuple of ParameterEstimate
+        Every parameter of the structure.
+    correlation_names : tuple of str
+        Parameters of the correlation matrix, in order (the estimated ones).
+    correlation : ndarray, shape (n_estimated, n_estimated)
+        Correlation matrix (F/G_u block, then the wind block; no
+        correlation across the two steps is estimated).
+    cost : CostSummary
+        J_ave and per-pair costs (eq. 3.9).
+    responses : tuple of FrequencyResponse
+        The gated responses fitted.
+    trim : Mapping[str, float]
+        Trim of the flight (means removed from the records), SI / as logged.
+    constants : Mapping[str, float]
+        Trim constants the matrices were built with (``g U0 W0 theta0`` ...).
+    reduction : tuple of ReductionStep
+        Structure-reduction log.
+    provenance : Provenance
+        Files, hashes, options and versions.
+    wind : WindFit or None
+        Outcome of the wind step, when one was run.
+    input_units : Mapping[str, str]
+        Unit of each logged input signal (``delta_lon``: ``normalised (-1..1)``).
+    notes : tuple of str
+        Remarks of the identification (responses dropped by gating and why).
+    """
+
+    structure_name: str
+    structure_text: str
+    parameters: tuple[ParameterEstimate, ...]
+    correlation_names: tuple[str, ...]
+    correlation: np.ndarray
+    cost: CostSummary
+    responses: tuple[FrequencyResponse, ...] = ()
+    trim: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+    constants: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+    reduction: tuple[ReductionStep, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+    wind: WindFit | None = None
+    input_units: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
+    notes: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        n = len(self.correlation_names)
+        if np.shape(self.correlation) != (n, n):
+            raise ValueError(f"correlation has shape {np.shape(self.correlation)}, expected ({n}, {n})")
+        names = [p.name for p in self.parameters]
+        if len(set(names)) != len(names):
+            raise ValueError("parameter names must be unique")
+        for name in ("trim", "constants", "input_units"):
+            object.__setattr__(self, name, MappingProxyType(dict(getattr(self, name))))
+
+    @property
+    def structure(self) -> ModelStructure:
+        """The structure, parsed again from `structure_text`."""
+        return parse_structure(self.structure_text, source=self.structure_name)
+
+    @property
+    def values(self) -> dict[str, float]:
+        """Every parameter's value, by name."""
+        return {p.name: p.value for p in self.parameters}
+
+    def parameter(self, name: str) -> ParameterEstimate:
+        """The estimate of parameter `name`.
+
+        Parameters
+        ----------
+        name : str
+            Parameter name.
+
+        Raises
+        ------
+        ModelError
+            If the model has no such parameter.
+        """
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise ModelError(f"model {self.structure_name} has no parameter {name!r}")
+
+    def linear_model(self, *, include_wind: bool = True) -> DelayedStateSpace:
+        """The identified model as a :class:`DelayedStateSpace`.
+
+        Parameters
+        ----------
+        include_wind : bool, optional
+            Keep the wind inputs (``G_w``, named by their signal, e.g.
+            ``wind_lon`` twice when it enters u and w with different delays);
+            False for the model of F and G_u alone.
+
+        Returns
+        -------
+        DelayedStateSpace
+            States, inputs and outputs named as in the structure; `trim`
+            holds the flight's trim.
+        """
+        structure = self.structure
+        assembler = Assembler(structure, free=(), fixed=self.values, constants=self.constants,
+                              include_wind=include_wind)
+        return assembler.state_space(np.zeros(0), trim=self.trim)

@@ -1,0 +1,74 @@
+"""Machine-readable summaries of identified models and modes (what ``sysid fit/modes --json`` print)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from ..modes import Mode, modes
+from .result import IdentifiedModel
+
+__all__ = ["mode_summary", "fit_summary"]
+
+
+def _num(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def mode_summary(found: Sequence[Mode]) -> list[dict[str, Any]]:
+    """One JSON object per mode.
+
+    Parameters
+    ----------
+    found : sequence of Mode
+        Modes, e.g. from :func:`sysid.modes.modes`.
+
+    Returns
+    -------
+    list of dict
+        ``real``, ``imag`` (1/s, rad/s), ``damping``, ``natural_frequency_rad_s``,
+        ``time_to_double_s``, ``time_to_half_s`` (None when infinite),
+        ``mode``, ``stability``.
+    """
+    return [{"real": m.real, "imag": m.imag, "damping": _num(m.damping),
+             "natural_frequency_rad_s": m.natural_frequency_rad_s, "time_to_double_s": _num(m.time_to_double_s),
+             "time_to_half_s": _num(m.time_to_half_s), "mode": m.mode, "stability": m.stability} for m in found]
+
+
+def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
+    """The JSON summary of an identification.
+
+    Parameters
+    ----------
+    model : IdentifiedModel
+        The model.
+
+    Returns
+    -------
+    dict
+        ``model`` (structure name); ``parameters.NAME`` with ``value``,
+        ``cr_percent``, ``insensitivity_percent`` (None unless estimated),
+        ``status``, ``unit``, ``stage``; ``cost`` with ``average`` and
+        ``responses``; ``eigenvalues`` (see :func:`mode_summary`);
+        ``dropped`` (names of dropped parameters); ``reduction`` (the log);
+        ``wind`` (residual RMS before/after, or None); ``notes``.
+    """
+    return {
+        "model": model.structure_name,
+        "parameters": {p.name: {"value": p.value, "cr_percent": _num(p.cr_percent),
+                                "insensitivity_percent": _num(p.insensitivity_percent), "status": p.status,
+                                "unit": p.unit, "stage": p.stage} for p in model.parameters},
+        "cost": {"average": model.cost.average, "responses": dict(model.cost.responses)},
+        "eigenvalues": mode_summary(modes(model.linear_model())),
+        "dropped": [p.name for p in model.parameters if p.dropped],
+        "reduction": [{"step": s.step, "parameter": s.parameter, "action": s.action, "value": s.value,
+                       "reason": s.reason, "cost_average": _num(s.cost_average),
+                       "cost_average_after": _num(s.cost_average_after)} for s in model.reduction],
+        "wind": None if model.wind is None else {
+            "outputs": list(model.wind.outputs), "rms_before": list(model.wind.rms_before),
+            "rms_after": list(model.wind.rms_after), "samples": model.wind.samples},
+        "trim": dict(model.trim),
+        "input_units": dict(model.input_units),
+        "notes": list(model.notes),
+    }

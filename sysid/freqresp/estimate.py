@@ -1,0 +1,209 @@
+"""Composite, conditioned frequency responses from records (Tischler's FRESPID, MISOSA, COMPOSITE)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from flightlogs.errors import DataError, MissingSignalError
+from flightlogs.record import Record
+
+from ._composite import composite_pair
+from ._spectra import WindowSpectra, window_spectra
+from .options import ResponseOptions
+from .response import FrequencyResponse
+
+__all__ = ["frequency_responses", "automatic_window_lengths"]
+
+_N_AUTOMATIC_WINDOWS = 5
+_MIN_WINDOW_SAMPLES = 16
+_RATE_TOLERANCE = 1e-6
+
+
+def frequency_responses(
+    records: Sequence[Record],
+    inputs: Sequence[str],
+    outputs: Sequence[str],
+    options: ResponseOptions = ResponseOptions(),
+) -> tuple[FrequencyResponse, ...]:
+    """Composite frequency responses of every output to every input.
+
+    Parameters
+    ----------
+    records : sequence of Record
+        Pieces of flight on one uniform time base (the same rate), trim
+        removed; several trials of the same maneuver are combined in the
+        spectral sense: windows never straddle two records, and the spectra
+        are averaged over all windows of all records.
+    inputs : sequence of str
+        Input signal names (``delta_lon``, ``wind_lon`` ...). With more than
+        one, each response is conditioned on the other inputs (MISO).
+    outputs : sequence of str
+        Output signal names (``q``, ``ax`` ...).
+    options : ResponseOptions, optional
+        Grid, windows, overlap, taper.
+
+    Returns
+    -------
+    tuple of FrequencyResponse
+        For each output, for each input, in the order given. ``coherence`` is
+        the partial coherence when conditioned; the spectra stored are then
+        the conditioned ones (so that ``response = cross / input`` and
+        ``coherence = |cross|^2 / (input output)`` hold for every response).
+
+    Raises
+    ------
+    MissingSignalError
+        If a record lacks a signal named.
+    DataError
+        If the records differ in rate, hold NaNs, are shorter than every
+        window, an input never varies, or the grid exceeds the Nyquist frequency.
+
+    Notes
+    -----
+    Per window length: every window of every record is mean-removed, tapered
+    and Fourier transformed at the grid frequencies (chirp-z on an evenly
+    spaced grid, a matrix product on a log grid), the auto and cross spectra
+    averaged (Welch). The window lengths are then combined per frequency with
+    weights ``1 / eps_r^2``, ``eps_r = sqrt(1 - g^2) / (|g| sqrt(2 n_d))``
+    (Bendat & Piersol), ``n_d`` the overlap-corrected number of averages
+    (less one per conditioning input), see :mod:`sysid.freqresp._composite`.
+    Grid points below ``2 pi min_cycles / T`` of the longest window ``T`` are
+    left out.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from pathlib import Path
+    >>> t = np.arange(6000) / 100.0
+    >>> x = np.random.default_rng(0).normal(size=t.size)
+    >>> table = pd.DataFrame({"delta_lon": x, "q": 2.0 * x}, index=t)
+    >>> record = Record(table, {"delta_lon": "%", "q": "rad/s"}, {}, Path("sim"))
+    >>> (h,) = frequency_responses([record], ["delta_lon"], ["q"])
+    >>> h.pair, bool(np.allclose(h.response, 2.0)), bool(np.all(h.coherence > 0.999))
+    ('q/delta_lon', True, True)
+    """
+    inputs, outputs = tuple(inputs), tuple(outputs)
+    _check_names(inputs, outputs)
+    if not records:
+        raise DataError("no records to compute frequency responses from")
+    dt = _common_step(records)
+    if options.omega_max > np.pi / dt:
+        raise DataError(f"omega_max={options.omega_max:g} rad/s is above the Nyquist frequency "
+                        f"{np.pi / dt:.1f} rad/s of the {1 / dt:g} Hz records")
+    channels = inputs + outputs
+    data = [_channels(record, channels) for record in records]
+    for k, name in enumerate(inputs):
+        if all(np.ptp(block[k]) == 0 for block in data):
+            raise DataError(f"input {name} does not vary in any record: nothing excites the responses")
+    lengths = _window_samples(data, dt, options)
+    omega = _grid(options, dt, lengths)
+    windows = [_spectra(data, dt, n, omega, options) for n in lengths]
+    units = _units(records, channels)
+    found = []
+    for o, output in enumerate(outputs):
+        for j, name in enumerate(inputs):
+            estimate = composite_pair(windows, omega, list(range(len(inputs))), j, len(inputs) + o)
+            found.append(FrequencyResponse(
+                input=name, output=output, omega=omega.copy(), response=estimate.response,
+                coherence=estimate.coherence, random_error=estimate.random_error,
+                input_autospectrum=estimate.input_autospectrum, output_autospectrum=estimate.output_autospectrum,
+                cross_spectrum=estimate.cross_spectrum, windows_s=estimate.windows_s,
+                conditioned_on=tuple(other for other in inputs if other != name),
+                input_unit=units[name], output_unit=units[output],
+            ))
+    return tuple(found)
+
+
+def automatic_window_lengths(longest_record_s: float, omega_min: float) -> tuple[float, ...]:
+    """Five window lengths, s: geometric from ``2 pi / (5 omega_min)`` to half the longest record.
+
+    The shortest is capped at a quarter of the longest (Tischler: window
+    lengths from about ``1 / (5 f_min)`` up to half the record).
+
+    Parameters
+    ----------
+    longest_record_s : float
+        Duration of the longest record, s.
+    omega_min : float
+        Lowest frequency of interest, rad/s.
+
+    Returns
+    -------
+    tuple of float
+        Increasing lengths, s.
+
+    Examples
+    --------
+    >>> [round(t, 2) for t in automatic_window_lengths(34.0, 0.5)]
+    [2.51, 4.05, 6.54, 10.54, 17.0]
+    """
+    longest = longest_record_s / 2.0
+    shortest = min(2.0 * np.pi / (5.0 * omega_min), longest / 4.0)
+    return tuple(float(t) for t in np.geomspace(shortest, longest, _N_AUTOMATIC_WINDOWS))
+
+
+def _check_names(inputs: tuple[str, ...], outputs: tuple[str, ...]) -> None:
+    if not inputs or not outputs:
+        raise DataError(f"need at least one input and one output, got inputs={inputs}, outputs={outputs}")
+    doubled = sorted({n for n in inputs + outputs if (inputs + outputs).count(n) > 1})
+    if doubled:
+        raise DataError(f"signal(s) {', '.join(doubled)} named twice among the inputs and outputs")
+
+
+def _common_step(records: Sequence[Record]) -> float:
+    steps = [(r.end_s - r.start_s) / (r.time_s.size - 1) for r in records]
+    if max(steps) - min(steps) > _RATE_TOLERANCE * min(steps):
+        rates = ", ".join(f"{r.label or r.source.name}: {1 / s:.3f} Hz" for r, s in zip(records, steps))
+        raise DataError(f"the records are not all at one rate ({rates}); resample them to one time base")
+    return float(np.mean(steps))
+
+
+def _channels(record: Record, channels: tuple[str, ...]) -> np.ndarray:
+    missing = [name for name in channels if name not in record.signals]
+    if missing:
+        raise MissingSignalError(
+            f"{record.source.name}: record {record.label!r} has no signal {', '.join(missing)} "
+            f"(it has {', '.join(record.signals)})")
+    block = np.ascontiguousarray(np.vstack([record[name] for name in channels]))
+    bad = [name for name, row in zip(channels, block) if not np.all(np.isfinite(row))]
+    if bad:
+        raise DataError(f"{record.source.name}: record {record.label!r} has NaN or infinite values in {', '.join(bad)}")
+    return block
+
+
+def _window_samples(data: Sequence[np.ndarray], dt: float, options: ResponseOptions) -> list[int]:
+    longest = max(block.shape[1] for block in data)
+    lengths_s = options.window_lengths_s or automatic_window_lengths((longest - 1) * dt, options.omega_min)
+    samples = sorted({int(round(t / dt)) for t in lengths_s})
+    too_short = [n * dt for n in samples if n < _MIN_WINDOW_SAMPLES]
+    if too_short:
+        raise DataError(f"window of {too_short[0]:g} s holds fewer than {_MIN_WINDOW_SAMPLES} samples at {1 / dt:g} Hz")
+    too_long = [n * dt for n in samples if n > longest]
+    if too_long:
+        raise DataError(f"a window of {too_long[0]:g} s is longer than every record (the longest lasts "
+                        f"{(longest - 1) * dt:.2f} s)")
+    return samples
+
+
+def _grid(options: ResponseOptions, dt: float, lengths: Sequence[int]) -> np.ndarray:
+    omega = options.grid()
+    lowest = 2.0 * np.pi * options.min_cycles / (max(lengths) * dt)
+    kept = omega[omega >= lowest * (1.0 - 1e-12)]
+    if kept.size < 2:
+        raise DataError(f"the longest window ({max(lengths) * dt:.2f} s) resolves nothing below "
+                        f"{lowest:.3g} rad/s, at or above omega_max={options.omega_max:g} rad/s")
+    return kept
+
+
+def _spectra(data: Sequence[np.ndarray], dt: float, n_window: int, omega: np.ndarray,
+             options: ResponseOptions) -> WindowSpectra:
+    found = window_spectra(data, dt, n_window, omega, overlap=options.overlap, taper=options.taper,
+                           min_cycles=options.min_cycles, spacing=options.spacing)
+    assert found is not None  # every length fits the longest record (checked in _window_samples)
+    return found
+
+
+def _units(records: Sequence[Record], channels: tuple[str, ...]) -> dict[str, str]:
+    return {name: records[0].units.get(name, "") for name in channels}

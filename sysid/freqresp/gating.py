@@ -1,0 +1,153 @@
+"""Which responses, over which frequencies, a model may be fitted to (dissertation eq. 3.8)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .response import FrequencyResponse
+
+__all__ = ["DroppedResponse", "GatingResult", "gate_responses", "fit_range"]
+
+#: Dips below the threshold spanning at most this are bridged, decades (a few noisy points do not split a range).
+BRIDGE_DECADES = 0.05
+
+
+@dataclass(frozen=True, slots=True)
+class DroppedResponse:
+    """A response left out of the fit, and why.
+
+    Parameters
+    ----------
+    input : str
+        Input name.
+    output : str
+        Output name.
+    reason : str
+        One sentence.
+    """
+
+    input: str
+    output: str
+    reason: str
+
+    @property
+    def pair(self) -> str:
+        """``output/input``."""
+        return f"{self.output}/{self.input}"
+
+
+@dataclass(frozen=True, slots=True)
+class GatingResult:
+    """Responses kept (with their fit range set) and those dropped.
+
+    Parameters
+    ----------
+    kept : tuple of FrequencyResponse
+        Responses passing the coherence and span rules, ``fit_range`` set, in the order given.
+    dropped : tuple of DroppedResponse
+        The others, with the reason, in the order given.
+    """
+
+    kept: tuple[FrequencyResponse, ...]
+    dropped: tuple[DroppedResponse, ...]
+
+
+def fit_range(omega: np.ndarray, coherence: np.ndarray, min_coherence: float) -> tuple[float, float] | None:
+    """Widest frequency range (in decades) over which the coherence stays at or above `min_coherence`.
+
+    Dips narrower than :data:`BRIDGE_DECADES` are bridged.
+
+    Parameters
+    ----------
+    omega : ndarray, shape (n_freq,)
+        Frequency, rad/s, increasing.
+    coherence : ndarray, shape (n_freq,)
+        gamma^2.
+    min_coherence : float
+        Threshold on gamma^2.
+
+    Returns
+    -------
+    tuple of float or None
+        ``(omega_lo, omega_hi)``, rad/s, or None if no point passes.
+
+    Examples
+    --------
+    >>> omega = np.geomspace(1, 100, 9)
+    >>> lo, hi = fit_range(omega, np.array([0.2, 0.9, 0.9, 0.9, 0.3, 0.1, 0.8, 0.9, 0.2]), 0.5)
+    >>> round(lo, 3), round(hi, 3)
+    (1.778, 5.623)
+    """
+    good = np.asarray(coherence) >= min_coherence
+    if not good.any():
+        return None
+    index = np.flatnonzero(good)
+    log_omega = np.log10(np.asarray(omega, dtype=float))
+    runs: list[list[int]] = [[int(index[0]), int(index[0])]]
+    for k in index[1:]:
+        last = runs[-1][1]
+        if k == last + 1 or log_omega[k - 1] - log_omega[last + 1] <= BRIDGE_DECADES:  # the dip's own width
+            runs[-1][1] = int(k)
+        else:
+            runs.append([int(k), int(k)])
+    lo, hi = max(runs, key=lambda run: log_omega[run[1]] - log_omega[run[0]])
+    return float(omega[lo]), float(omega[hi])
+
+
+def gate_responses(
+    responses: Sequence[FrequencyResponse], *, min_coherence: float = 0.5, min_decades: float = 0.3
+) -> GatingResult:
+    """Keep the responses with a fit range of gamma^2 >= `min_coherence` spanning `min_decades`.
+
+    Parameters
+    ----------
+    responses : sequence of FrequencyResponse
+        Responses to gate.
+    min_coherence : float, optional
+        Threshold on gamma^2 (dissertation eq. 3.8: 0.5; 0.6 is the stricter choice for noisy data).
+    min_decades : float, optional
+        Shortest acceptable ``log10(omega_max / omega_min)`` (eq. 3.8: 0.3).
+
+    Returns
+    -------
+    GatingResult
+        Kept responses with ``fit_range`` set (via :func:`dataclasses.replace`), dropped ones with a reason.
+
+    Examples
+    --------
+    >>> omega = np.geomspace(1.0, 10.0, 11)
+    >>> gamma2 = np.where(omega < 4.0, 0.9, 0.2)
+    >>> h = FrequencyResponse("delta_lon", "q", omega, np.ones(11, complex), gamma2, np.zeros(11),
+    ...                       np.ones(11), np.ones(11), np.ones(11, complex), (2.0,))
+    >>> result = gate_responses([h])
+    >>> result.kept[0].fit_range
+    (1.0, 3.981071705534973)
+    >>> print(gate_responses([h], min_decades=0.7).dropped[0].reason)
+    q/delta_lon: coherence reaches 0.5 over only 0.60 decade (1-3.98 rad/s), less than the 0.7 decade required.
+    """
+    if not 0.0 < min_coherence < 1.0:
+        raise ValueError(f"{min_coherence=} must lie in (0, 1)")
+    if not min_decades > 0:
+        raise ValueError(f"{min_decades=} must be > 0")
+    kept: list[FrequencyResponse] = []
+    dropped: list[DroppedResponse] = []
+    for response in responses:
+        span = fit_range(response.omega, response.coherence, min_coherence)
+        if span is None:
+            best = float(np.nanmax(response.coherence)) if np.any(np.isfinite(response.coherence)) else 0.0
+            dropped.append(DroppedResponse(response.input, response.output,
+                                           f"{response.pair}: coherence never reaches {min_coherence:g} "
+                                           f"(at most {best:.2f})."))
+            continue
+        decades = float(np.log10(span[1] / span[0]))
+        if decades < min_decades:
+            dropped.append(DroppedResponse(response.input, response.output,
+                                           f"{response.pair}: coherence reaches {min_coherence:g} over only "
+                                           f"{decades:.2f} decade ({span[0]:.3g}-{span[1]:.3g} rad/s), less than "
+                                           f"the {min_decades:g} decade required."))
+            continue
+        kept.append(replace(response, fit_range=span))
+    return GatingResult(tuple(kept), tuple(dropped))

@@ -1,0 +1,155 @@
+"""Frequency responses to and from HDF5, with units and a schema version.
+
+Layout (schema version 1)::
+
+    /                         attrs: schema, schema_version, software, created_utc
+    /responses/<nnn>/         attrs: input, output, input_unit, output_unit, windows_s,
+                                     conditioned_on (JSON list), fit_range (2 floats; absent before gating)
+    /responses/<nnn>/omega                 float64 (n_freq,), attrs unit = "rad/s"
+    /responses/<nnn>/response              complex128 (n_freq,), attrs unit = "<output>/<input>"
+    /responses/<nnn>/coherence             float64 (n_freq,), unit "1"
+    /responses/<nnn>/random_error          float64 (n_freq,), unit "1" (fraction of the magnitude)
+    /responses/<nnn>/input_autospectrum    float64 (n_freq,), unit "<input>^2/(rad/s)"
+    /responses/<nnn>/output_autospectrum   float64 (n_freq,), unit "<output>^2/(rad/s)"
+    /responses/<nnn>/cross_spectrum        complex128 (n_freq,), unit "<input>*<output>/(rad/s)"
+
+``<nnn>`` is the zero-padded position, so the order written is the order read.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from datetime import datetime, timezone
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from flightlogs.atomic import atomic_output
+from flightlogs.errors import LogFormatError
+
+from .response import FrequencyResponse
+
+__all__ = ["write_responses", "read_responses", "RESPONSES_SCHEMA_VERSION"]
+
+_SCHEMA = "flight-sysid frequency responses"
+#: Layout version written by :func:`write_responses`.
+RESPONSES_SCHEMA_VERSION = 1
+_ARRAYS = ("omega", "response", "coherence", "random_error", "input_autospectrum", "output_autospectrum",
+           "cross_spectrum")
+
+
+def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) -> None:
+    """Write responses to an HDF5 file, atomically (the file appears only once complete).
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination ``.h5``; its folder must exist.
+    responses : sequence of FrequencyResponse
+        Responses to store, gated (``fit_range`` set) or not.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> omega = np.array([1.0, 2.0])
+    >>> h = FrequencyResponse("delta_lon", "q", omega, np.array([1 + 1j, 2j]), np.array([0.9, 0.8]),
+    ...                       np.array([0.01, 0.02]), np.ones(2), np.ones(2), np.ones(2, complex), (4.0,),
+    ...                       input_unit="%", output_unit="rad/s")
+    >>> target = Path(tempfile.mkdtemp()) / "fr.h5"
+    >>> write_responses(target, [h])
+    >>> (back,) = read_responses(target)
+    >>> back.pair, back.input_unit, bool(np.array_equal(back.response, h.response))
+    ('q/delta_lon', '%', True)
+    """
+    with atomic_output(path) as tmp, h5py.File(tmp, "w") as h5:
+        h5.attrs["schema"] = _SCHEMA
+        h5.attrs["schema_version"] = RESPONSES_SCHEMA_VERSION
+        h5.attrs["software"] = f"flight-sysid {_version()}"
+        h5.attrs["created_utc"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        group = h5.create_group("responses")
+        width = max(3, len(str(len(responses))))
+        for k, response in enumerate(responses):
+            _write_one(group.create_group(f"{k:0{width}d}"), response)
+
+
+def read_responses(path: str | Path) -> tuple[FrequencyResponse, ...]:
+    """Read responses written by :func:`write_responses`, in the order written.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.h5`` file.
+
+    Returns
+    -------
+    tuple of FrequencyResponse
+
+    Raises
+    ------
+    LogFormatError
+        If the file is not a responses file of this schema, or of a newer version.
+    """
+    path = Path(path)
+    try:
+        h5 = h5py.File(path, "r")
+    except (OSError, ValueError) as err:
+        raise LogFormatError(f"{path}: not an HDF5 file ({err}).") from err
+    with h5:
+        if h5.attrs.get("schema") != _SCHEMA:
+            raise LogFormatError(f"{path}: HDF5 file holds no flight-sysid frequency responses.")
+        version = int(h5.attrs["schema_version"])
+        if version > RESPONSES_SCHEMA_VERSION:
+            raise LogFormatError(f"{path}: responses schema version {version} is newer than this software reads "
+                                 f"({RESPONSES_SCHEMA_VERSION}); upgrade flight-sysid.")
+        group = h5["responses"]
+        return tuple(_read_one(group[key]) for key in sorted(group))
+
+
+def _write_one(group: h5py.Group, response: FrequencyResponse) -> None:
+    group.attrs["input"] = response.input
+    group.attrs["output"] = response.output
+    group.attrs["input_unit"] = response.input_unit
+    group.attrs["output_unit"] = response.output_unit
+    group.attrs["windows_s"] = np.asarray(response.windows_s, dtype=np.float64)
+    group.attrs["conditioned_on"] = json.dumps(list(response.conditioned_on))
+    if response.fit_range is not None:
+        group.attrs["fit_range"] = np.asarray(response.fit_range, dtype=np.float64)
+    units = _units(response)
+    for name in _ARRAYS:
+        dataset = group.create_dataset(name, data=np.asarray(getattr(response, name)))
+        dataset.attrs["unit"] = units[name]
+
+
+def _units(response: FrequencyResponse) -> dict[str, str]:
+    x, y = response.input_unit or "input", response.output_unit or "output"
+    return {"omega": "rad/s", "response": f"({y})/({x})", "coherence": "1", "random_error": "1",
+            "input_autospectrum": f"({x})^2/(rad/s)", "output_autospectrum": f"({y})^2/(rad/s)",
+            "cross_spectrum": f"({x})*({y})/(rad/s)"}
+
+
+def _read_one(group: h5py.Group) -> FrequencyResponse:
+    arrays = {name: group[name][()] for name in _ARRAYS}
+    fit = group.attrs.get("fit_range")
+    return FrequencyResponse(
+        input=_text(group.attrs["input"]), output=_text(group.attrs["output"]),
+        windows_s=tuple(float(t) for t in np.atleast_1d(group.attrs["windows_s"])),
+        conditioned_on=tuple(json.loads(_text(group.attrs["conditioned_on"]))),
+        input_unit=_text(group.attrs["input_unit"]), output_unit=_text(group.attrs["output_unit"]),
+        fit_range=None if fit is None else (float(fit[0]), float(fit[1])),
+        **arrays,
+    )
+
+
+def _text(value: object) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("flight-sysid")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        return "unknown"

@@ -1,0 +1,230 @@
+"""From conditioned flights to the records and pairs a set of responses is computed on."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import numpy as np
+
+from flightlogs.condition import ConditionedFlight
+from flightlogs.errors import DataError
+from flightlogs.record import Record
+from flightlogs.segments import AXES
+
+from .estimate import frequency_responses
+from .options import ResponseOptions
+from .response import FrequencyResponse
+
+__all__ = ["DEFAULT_PAIRS", "maneuver_records", "parse_pairs", "default_pairs", "FlightResponses", "flight_responses"]
+
+#: Outputs per mixer axis, after the chapter 3 model (eqs. 3.10-3.13, accelerations by eq. 3.7); inputs ``delta_<axis>``.
+DEFAULT_PAIRS: Mapping[str, tuple[str, ...]] = MappingProxyType({
+    "lon": ("q", "ax", "theta", "u"),
+    "lat": ("p", "ay", "phi", "v"),
+    "yaw": ("r", "psi"),
+    "thr": ("az", "w"),
+})
+_MIN_PIECE_SAMPLES = 16
+
+
+def maneuver_records(
+    flights: Sequence[ConditionedFlight], axis: str, *, kind: str = "sweep", margin_s: float = 1.0
+) -> list[Record]:
+    """The record pieces covering each maneuver of `kind` on `axis`, flight by flight, in time order.
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        Conditioned flights (records and segments on the log clock).
+    axis : {"lat", "lon", "yaw", "thr"}
+        Mixer axis excited.
+    kind : str, optional
+        Maneuver kind (``"sweep"``, ``"doublet"``, ``"3211"``, ``"multisine"``).
+    margin_s : float, optional
+        Trim flight kept before and after each maneuver, s, never reaching
+        into another maneuver: the response to the last of a sweep outlasts
+        it, and windows ending on the sweep's top frequencies would taper it
+        away (default 1 s).
+
+    Returns
+    -------
+    list of Record
+        One piece per maneuver and record it overlaps (a maneuver cut by a
+        gap gives two pieces); pieces under 16 samples are left out.
+
+    Raises
+    ------
+    DataError
+        If `axis` is not a mixer axis or `margin_s` is negative.
+    """
+    if axis not in AXES:
+        raise DataError(f"axis {axis!r} is not a mixer axis ({', '.join(AXES)})")
+    if not margin_s >= 0:
+        raise DataError(f"margin_s={margin_s} must be >= 0")
+    pieces: list[Record] = []
+    for flight in flights:
+        maneuvers = [s for s in flight.segments if s.kind != "hover"]
+        for segment in maneuvers:
+            if segment.axis != axis or segment.kind != kind:
+                continue
+            before = max([s.end_s for s in maneuvers if s.end_s <= segment.start_s], default=-np.inf)
+            after = min([s.start_s for s in maneuvers if s.start_s >= segment.end_s], default=np.inf)
+            first = max(segment.start_s - margin_s, before)
+            last = min(segment.end_s + margin_s, after)
+            for record in flight.records:
+                start, end = max(first, record.start_s), min(last, record.end_s)
+                if end <= start or record.table.loc[start:end].shape[0] < _MIN_PIECE_SAMPLES:
+                    continue
+                label = f"{flight.source.name} {axis} {kind} {segment.start_s:.2f}-{segment.end_s:.2f} s"
+                pieces.append(record.between(start, end, label=label))
+    return pieces
+
+
+def parse_pairs(text: str) -> tuple[tuple[str, str], ...]:
+    """``"q/delta_lon,ax/delta_lon"`` -> ``(("q", "delta_lon"), ("ax", "delta_lon"))`` (output, input).
+
+    Parameters
+    ----------
+    text : str
+        Comma-separated ``output/input`` pairs.
+
+    Returns
+    -------
+    tuple of (str, str)
+        ``(output, input)`` in the order given, duplicates removed.
+
+    Raises
+    ------
+    ValueError
+        If an item is not ``output/input``.
+
+    Examples
+    --------
+    >>> parse_pairs("q/delta_lon, ax/delta_lon")
+    (('q', 'delta_lon'), ('ax', 'delta_lon'))
+    """
+    pairs: list[tuple[str, str]] = []
+    for item in text.split(","):
+        output, sep, input_ = (part.strip() for part in item.partition("/"))
+        if not sep or not output or not input_ or "/" in input_:
+            raise ValueError(f"{item.strip()!r} is not OUTPUT/INPUT (e.g. q/delta_lon)")
+        if (output, input_) not in pairs:
+            pairs.append((output, input_))
+    return tuple(pairs)
+
+
+def default_pairs(flights: Sequence[ConditionedFlight], *, kind: str = "sweep") -> tuple[tuple[str, str], ...]:
+    """``DEFAULT_PAIRS[axis]`` against ``delta_<axis>`` for every axis with a maneuver of `kind`.
+
+    Outputs not logged in every piece are left out.
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        Conditioned flights.
+    kind : str, optional
+        Maneuver kind.
+
+    Returns
+    -------
+    tuple of (str, str)
+        ``(output, input)`` pairs, axes in canonical order.
+    """
+    pairs: list[tuple[str, str]] = []
+    for axis in AXES:
+        pieces = maneuver_records(flights, axis, kind=kind)
+        if not pieces:
+            continue
+        logged = set.intersection(*(set(piece.signals) for piece in pieces))
+        pairs.extend((output, f"delta_{axis}") for output in DEFAULT_PAIRS[axis] if output in logged)
+    return tuple(pairs)
+
+
+@dataclass(frozen=True, slots=True)
+class FlightResponses:
+    """Responses computed from flights, with what they were computed on.
+
+    Parameters
+    ----------
+    responses : tuple of FrequencyResponse
+        One per pair asked for, in that order.
+    pieces : Mapping[str, int]
+        Number of record pieces used per axis.
+    """
+
+    responses: tuple[FrequencyResponse, ...]
+    pieces: Mapping[str, int]
+
+
+def flight_responses(
+    flights: Sequence[ConditionedFlight],
+    pairs: Sequence[tuple[str, str]] | None = None,
+    *,
+    axis: str | None = None,
+    kind: str = "sweep",
+    options: ResponseOptions = ResponseOptions(),
+) -> FlightResponses:
+    """Frequency responses of the pairs on the maneuvers of their axis.
+
+    Pairs are grouped by axis: the axis of a mixer input ``delta_<axis>``, or
+    `axis` for every pair when given. Within an axis all inputs named are
+    computed together, so an output paired with two inputs (``ax/delta_lon``
+    and ``ax/wind_lon``) gets responses conditioned on the other input.
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        Conditioned flights.
+    pairs : sequence of (str, str), optional
+        ``(output, input)``; default :func:`default_pairs`.
+    axis : {"lat", "lon", "yaw", "thr"}, optional
+        Maneuvers to use for every pair (needed when an input is not a mixer input).
+    kind : str, optional
+        Maneuver kind.
+    options : ResponseOptions, optional
+        Grid and windows.
+
+    Returns
+    -------
+    FlightResponses
+
+    Raises
+    ------
+    DataError
+        If no pair is given or found, a pair's axis cannot be told, or an axis has no maneuver of `kind`.
+    MissingSignalError
+        If a record lacks a signal named.
+    """
+    chosen = tuple(pairs) if pairs is not None else default_pairs(flights, kind=kind)
+    if not chosen:
+        raise DataError(f"no {kind} on any axis in {_names(flights)}: nothing to compute responses from")
+    groups: dict[str, list[tuple[str, str]]] = {}
+    for output, input_ in chosen:
+        groups.setdefault(axis or _axis_of(input_, chosen), []).append((output, input_))
+    found: dict[tuple[str, str], FrequencyResponse] = {}
+    pieces: dict[str, int] = {}
+    for group_axis, group in groups.items():
+        records = maneuver_records(flights, group_axis, kind=kind)
+        if not records:
+            raise DataError(f"no {kind} on axis {group_axis} in {_names(flights)}")
+        inputs = list(dict.fromkeys(input_ for _, input_ in group))
+        outputs = list(dict.fromkeys(output for output, _ in group))
+        for response in frequency_responses(records, inputs, outputs, options):
+            found[(response.output, response.input)] = response
+        pieces[group_axis] = len(records)
+    return FlightResponses(tuple(found[pair] for pair in chosen), MappingProxyType(pieces))
+
+
+def _axis_of(input_: str, pairs: Sequence[tuple[str, str]]) -> str:
+    if input_.startswith("delta_") and input_[6:] in AXES:
+        return input_[6:]
+    axes = {i[6:] for _, i in pairs if i.startswith("delta_") and i[6:] in AXES}
+    if len(axes) == 1:
+        return axes.pop()
+    raise DataError(f"cannot tell which maneuvers to use for input {input_}: give the axis (lat, lon, yaw or thr)")
+
+
+def _names(flights: Sequence[ConditionedFlight]) -> str:
+    return ", ".join(flight.source.name for flight in flights) or "no flight"

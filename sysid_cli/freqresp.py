@@ -1,0 +1,181 @@
+"""``sysid freqresp``: composite frequency responses of the sweeps, gated by coherence."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ._common import emit_json, json_option, progress_bar
+
+__all__ = ["freqresp"]
+
+_EPILOG = """\b
+Examples:
+  sysid freqresp flight.h5 --json -
+  sysid freqresp flight.h5 --pairs q/delta_lon,ax/delta_lon -o fr.h5 --plot fr.svg
+  sysid freqresp sweeps/*.bin --wind mast.csv --wind-distance 4.6 --pairs ax/delta_lon,ax/wind_lon -o fr.h5
+  sysid freqresp flight.h5 --windows 2,4,8,12,17 --overlap 0.5 --min-coherence 0.6 --omega-min 1 --omega-max 60
+"""
+
+
+def _floats(_ctx: click.Context, _param: click.Parameter, value: str | None) -> tuple[float, ...] | None:
+    if not value:
+        return None
+    try:
+        return tuple(float(part) for part in value.split(","))
+    except ValueError:
+        raise click.BadParameter(f"{value!r} is not a comma-separated list of seconds (e.g. 2,4,8,12,17)") from None
+
+
+def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> tuple[tuple[str, str], ...] | None:
+    from sysid.freqresp import parse_pairs
+
+    if not value:
+        return None
+    try:
+        return parse_pairs(value)
+    except ValueError as err:
+        raise click.BadParameter(str(err)) from None
+
+
+@click.command(epilog=_EPILOG)
+@click.argument("sources", metavar="DATASET|LOG...", nargs=-1, required=True,
+                type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--wind", "wind_paths", multiple=True, type=click.Path(exists=True, path_type=Path),
+              help="Anemometer CSV or folder (with logs; aligned by UTC as in `sysid ingest`).")
+@click.option("--wind-distance", type=click.FloatRange(min=0, min_open=True), metavar="M",
+              help="Anemometer-to-vehicle distance, m (with --wind; see `sysid ingest` for the other choices).")
+@click.option("--wind-offset", type=float, metavar="S", help="Anemometer clock minus UTC, s (with --wind).")
+@click.option("--pairs", callback=_pairs, metavar="OUT/IN,...",
+              help="Responses to compute, e.g. q/delta_lon,ax/delta_lon (default: the chapter 3 outputs of "
+                   "every axis with a sweep).")
+@click.option("--axis", type=click.Choice(["lat", "lon", "yaw", "thr"]),
+              help="Use this axis's maneuvers for every pair (needed for inputs such as wind_lon alone).")
+@click.option("--kind", default="sweep", show_default=True,
+              type=click.Choice(["sweep", "multisine", "3211", "doublet"]), help="Maneuvers to use.")
+@click.option("--omega-min", type=click.FloatRange(min=0, min_open=True), default=0.5, show_default=True,
+              help="Lowest frequency, rad/s.")
+@click.option("--omega-max", type=click.FloatRange(min=0, min_open=True), default=70.0, show_default=True,
+              help="Highest frequency, rad/s.")
+@click.option("--n-freq", type=click.IntRange(min=2), default=150, show_default=True,
+              help="Points of the log-spaced grid.")
+@click.option("--windows", callback=_floats, metavar="S,S,...",
+              help="Window lengths, s (default: five from 2π/(5·omega-min) to half the longest record).")
+@click.option("--overlap", type=click.FloatRange(0.0, 0.95, max_open=True), default=0.8, show_default=True,
+              help="Window overlap, fraction.")
+@click.option("--min-coherence", type=click.FloatRange(0.0, 1.0, min_open=True, max_open=True), default=0.5,
+              show_default=True, help="Coherence γ² a fit range must keep (0.6 for noisy data).")
+@click.option("--min-decades", type=click.FloatRange(min=0, min_open=True), default=0.3, show_default=True,
+              help="Shortest fit range, decades.")
+@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+              help="Write the responses (fit range set on those kept) to this HDF5 file.")
+@click.option("--plot", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+              help="Write Bode and coherence plots to this SVG file.")
+@json_option
+@click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
+def freqresp(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_distance: float | None,
+             wind_offset: float | None, pairs: tuple[tuple[str, str], ...] | None,
+             axis: str | None, kind: str, omega_min: float, omega_max: float, n_freq: int,
+             windows: tuple[float, ...] | None, overlap: float, min_coherence: float, min_decades: float,
+             out: Path | None, plot: Path | None, json_path: str | None, quiet: bool) -> None:
+    """Compute composite (multi-window, chirp-z) frequency responses from the maneuvers of a DATASET
+    (`sysid ingest -o`) or of LOGs ingested on the fly, gate them by coherence, and write them."""
+    from sysid.freqresp import ResponseOptions, flight_responses, gate_responses, write_responses
+
+    try:
+        options = ResponseOptions(omega_min=omega_min, omega_max=omega_max, n_freq=n_freq, window_lengths_s=windows,
+                                  overlap=overlap, min_coherence=min_coherence, min_decades=min_decades)
+    except ValueError as err:
+        raise click.UsageError(str(err)) from None
+    flights = _flights(sources, wind_paths, wind_distance, wind_offset, quiet=quiet)
+    computed = flight_responses(flights, pairs, axis=axis, kind=kind, options=options)
+    gated = gate_responses(computed.responses, min_coherence=min_coherence, min_decades=min_decades)
+    kept = {response.pair: response for response in gated.kept}
+    ordered = [kept.get(response.pair, response) for response in computed.responses]
+    if plot is not None:
+        from reports.bode import write_bode_svg
+
+        write_bode_svg(plot, ordered, min_coherence=min_coherence)
+    if out is not None:
+        write_responses(out, ordered)
+    summary = _summary(ordered, gated.dropped, dict(computed.pieces), options, out, plot)
+    if not quiet:
+        _print_summary(summary, to_stderr=json_path == "-")
+    emit_json(summary, json_path)
+
+
+def _flights(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_distance: float | None,
+             wind_offset: float | None, *, quiet: bool) -> list[Any]:
+    from flightlogs.condition import ConditioningOptions
+    from flightlogs.errors import DataError
+
+    datasets = [p for p in sources if p.suffix.lower() in (".h5", ".hdf5")]
+    if datasets and len(datasets) != len(sources):
+        raise click.UsageError("give either datasets (.h5 from `sysid ingest -o`) or logs, not both")
+    if datasets:
+        from flightlogs.store import read_dataset
+
+        if wind_paths or wind_distance is not None or wind_offset is not None:
+            raise click.UsageError("--wind options go with logs; a dataset already holds its aligned wind")
+        flights = [flight for path in datasets for flight in read_dataset(path).conditioned]
+        if not flights:
+            raise DataError(f"{', '.join(p.name for p in datasets)}: no conditioned flight in the dataset")
+        return flights
+    from flightlogs.campaign import ingest_campaign
+
+    with progress_bar("reading", quiet=quiet) as bar:
+        campaign = ingest_campaign(list(sources), list(wind_paths),
+                                   options=ConditioningOptions(wind_distance_m=wind_distance, wind_offset_s=wind_offset),
+                                   progress=lambda _n, done, total: bar(done, total))
+    flights = [flight for flight in campaign.conditioned if flight is not None]
+    if not flights:
+        reasons = "; ".join(note for notes in campaign.notes for note in notes)
+        raise DataError(f"no log could be conditioned ({reasons})")
+    return flights
+
+
+def _summary(responses: list[Any], dropped: tuple[Any, ...], pieces: dict[str, int], options: Any,
+             out: Path | None, plot: Path | None) -> dict[str, Any]:
+    import numpy as np
+
+    reasons = {d.pair: d.reason for d in dropped}
+    entries = []
+    for response in responses:
+        entry: dict[str, Any] = {
+            "pair": response.pair, "input": response.input, "output": response.output,
+            "kept": response.fit_range is not None, "fit_range_rad_s": None, "mean_coherence": None,
+            "reason": reasons.get(response.pair), "windows_s": [round(t, 4) for t in response.windows_s],
+            "conditioned_on": list(response.conditioned_on),
+        }
+        if response.fit_range is not None:
+            lo, hi = response.fit_range
+            inside = (response.omega >= lo) & (response.omega <= hi)
+            entry["fit_range_rad_s"] = [lo, hi]
+            entry["mean_coherence"] = float(np.mean(response.coherence[inside]))
+        entries.append(entry)
+    return {
+        "responses": entries, "pieces": pieces,
+        "options": {"omega_min": options.omega_min, "omega_max": options.omega_max, "n_freq": options.n_freq,
+                    "overlap": options.overlap, "min_coherence": options.min_coherence,
+                    "min_decades": options.min_decades},
+        "output": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
+    }
+
+
+def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
+    def say(text: str) -> None:
+        click.echo(text, err=to_stderr)
+
+    for axis, count in summary["pieces"].items():
+        say(f"{axis}: {count} maneuver piece(s)")
+    for entry in summary["responses"]:
+        if entry["kept"]:
+            lo, hi = entry["fit_range_rad_s"]
+            say(f"  {entry['pair']:<20} kept     {lo:7.2f}-{hi:6.2f} rad/s  mean γ² {entry['mean_coherence']:.2f}")
+        else:
+            say(f"  {entry['pair']:<20} dropped  {entry['reason']}")
+    for key in ("output", "plot"):
+        if summary[key]:
+            say(f"wrote {summary[key]}")

@@ -1,0 +1,114 @@
+"""``sysid fit`` end to end on simulator logs: exit codes, JSON fields, the model file it writes."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from scipy import io as sio
+
+from sysid.fit import read_model
+from sysid.sim.campaign import run_scenario
+from sysid.sim.scenario import read_scenario
+from sysid_cli.main import cli
+
+SCENARIO = """
+[scenario]
+description = "one sweep per axis of the Table 3.3 linear model"
+vehicle = "linear-octo"
+formats = ["dataflash"]
+trials = 1
+seed = 5
+utc_start = "2024-05-01T10:00:00Z"
+margin_s = 3.0
+[anemometer]
+distance_m = 4.6
+rate_hz = 20.0
+clock_offset_s = 0.0
+[[condition]]
+name = "calm"
+mean_speed_m_s = 0.9
+direction_from_deg = 300.0
+turbulence_ratio = 0.2
+""" + "".join(f"""
+[[maneuver]]
+axis = "{axis}"
+kind = "sweep"
+amplitude = {amplitude}
+duration_s = 34.0
+""" for axis, amplitude in (("lat", 8.0), ("lon", 8.0), ("yaw", 10.0), ("thr", 4.0)))
+
+
+@pytest.fixture(scope="module")
+def flights(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("fit-cli")
+    (folder / "calm.toml").write_text(SCENARIO)
+    run_scenario(read_scenario(folder / "calm.toml"), folder / "calm")
+    return folder / "calm"
+
+
+def test_fit_writes_a_model_and_the_summary(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
+    out, mat = tmp_path / "model.json", tmp_path / "model.mat"
+    logs = [str(p) for p in sorted(flights.glob("*.bin"))]
+    result = runner.invoke(cli, ["fit", *logs, "--wind", str(flights), "--wind-distance", "4.6", "--model", "hover",
+                                 "-o", str(out), "--mat", str(mat), "--json", "-"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    model = read_model(out)
+    for p in model.parameters:
+        entry = summary["parameters"][p.name]
+        assert entry["value"] == p.value
+        assert (entry["cr_percent"] is None) == (p.status != "estimated")
+    assert summary["cost"]["average"] == model.cost.average and summary["cost"]["responses"]
+    assert {"real", "imag", "damping", "natural_frequency_rad_s", "mode"} <= set(summary["eigenvalues"][0])
+    assert "N_r" in summary["dropped"] and summary["output"] == str(out)
+    assert "J_ave" in result.stderr and "per normalised (-1..1)" in result.stderr  # the table went to stderr
+    assert sio.loadmat(mat)["A"].shape == model.linear_model().a.shape
+    assert len(model.provenance.files) == 8 and model.provenance.options["fit"]["starts"] == 1
+
+
+def test_report_option(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
+    report = tmp_path / "fit.html"
+    logs = [str(p) for p in sorted(flights.glob("*lon*.bin"))]
+    result = runner.invoke(cli, ["fit", *logs, "--report", str(report), "-q"])
+    assert result.exit_code == 0, result.output
+    if importlib.util.find_spec("reports.model_report") is None:
+        assert "not available" in result.stderr and not report.exists()
+    else:
+        assert report.exists()
+
+
+def test_fit_reads_an_ingested_dataset(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
+    dataset = tmp_path / "set.h5"
+    logs = [str(p) for p in sorted(flights.glob("*lon*.bin"))]
+    ingested = runner.invoke(cli, ["ingest", *logs, "--wind", str(flights), "--wind-distance", "4.6", "-o",
+                                   str(dataset), "-q"])
+    assert ingested.exit_code == 0, ingested.output
+    result = runner.invoke(cli, ["fit", str(dataset), "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert set(summary["cost"]["responses"]) >= {"q/delta_lon", "ax/delta_lon"}
+    assert summary["parameters"]["M_lon"]["status"] == "estimated"
+    assert summary["parameters"]["L_lat"]["status"] == "fixed"  # no lateral sweep in the dataset
+
+
+@pytest.mark.parametrize(("extra", "code", "message"), [
+    (["--kind", "multisine"], 1, "no multisine"),
+    (["--model", "hovre"], 1, "neither a built-in structure"),
+    (["--set", "X_u"], 2, "NAME=VALUE"),
+    (["--set", "X_v=1"], 1, "no parameter 'X_v'"),
+    (["--starts", "0"], 2, "0"),
+])
+def test_fit_errors(runner: CliRunner, flights: Path, extra: list[str], code: int, message: str) -> None:
+    log = str(sorted(flights.glob("*lon*.bin"))[0])
+    result = runner.invoke(cli, ["fit", log, "-q", *extra])
+    assert result.exit_code == code, result.output
+    assert message in result.output
+
+
+def test_help_has_an_example(runner: CliRunner) -> None:
+    result = runner.invoke(cli, ["fit", "--help"])
+    assert result.exit_code == 0 and "sysid fit sweeps/*.bin" in result.output

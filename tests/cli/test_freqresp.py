@@ -1,0 +1,100 @@
+"""``sysid freqresp`` on the simulator's demo flight (sweeps and doublets on every axis, light wind)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from sysid.freqresp import DEFAULT_PAIRS, read_responses
+from sysid.sim.scenarios import write_demo_flight
+from sysid_cli.main import cli
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    folder = tmp_path_factory.mktemp("freqresp-demo")
+    files = write_demo_flight(folder)
+    dataset = folder / "dataset.h5"
+    result = CliRunner().invoke(cli, ["ingest", str(files.log), "-o", str(dataset), "-q"])
+    assert result.exit_code == 0, result.output
+    return {"log": files.log, "wind": files.wind_csv, "dataset": dataset}
+
+
+def test_default_pairs_from_a_dataset_with_outputs_reopened(demo: dict[str, Path], tmp_path: Path) -> None:
+    out, plot = tmp_path / "fr.h5", tmp_path / "fr.svg"
+    result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), "-o", str(out), "--plot", str(plot),
+                                      "--json", "-"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    expected = [f"{output}/delta_{axis}" for axis in ("lat", "lon", "yaw", "thr") for output in DEFAULT_PAIRS[axis]]
+    assert [entry["pair"] for entry in summary["responses"]] == expected
+    assert summary["pieces"] == {"lat": 1, "lon": 1, "yaw": 1, "thr": 1}
+    responses = read_responses(out)
+    assert [r.pair for r in responses] == expected
+    by_pair = {r.pair: r for r in responses}
+    for entry in summary["responses"]:
+        response = by_pair[entry["pair"]]
+        if entry["kept"]:
+            assert response.fit_range is not None
+            assert response.fit_range == pytest.approx(tuple(entry["fit_range_rad_s"]))
+            lo, hi = response.fit_range
+            inside = (response.omega >= lo) & (response.omega <= hi)
+            assert entry["mean_coherence"] == pytest.approx(float(np.mean(response.coherence[inside])))
+            assert np.log10(hi / lo) >= 0.3 and entry["reason"] is None
+        else:
+            assert response.fit_range is None and entry["reason"].startswith(entry["pair"])
+    for pair in ("q/delta_lon", "p/delta_lat", "r/delta_yaw", "az/delta_thr"):  # on-axis rates and accelerations
+        lo, hi = by_pair[pair].fit_range or (1.0, 1.0)
+        assert np.log10(hi / lo) > 1.0, pair
+    assert "q/delta_lon" in plot.read_text() and "kept" in result.stderr
+
+
+def test_logs_are_ingested_on_the_fly_and_wind_inputs_conditioned(demo: dict[str, Path]) -> None:
+    result = CliRunner().invoke(cli, ["freqresp", str(demo["log"]), "--wind", str(demo["wind"]), "--wind-distance",
+                                      "4.6", "--wind-offset", "1.5", "--pairs", "ax/delta_lon,ax/wind_lon",
+                                      "--min-coherence", "0.6", "--windows", "4,8,16", "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    control, wind = summary["responses"]
+    assert (control["pair"], control["conditioned_on"]) == ("ax/delta_lon", ["wind_lon"])
+    assert (wind["pair"], wind["conditioned_on"]) == ("ax/wind_lon", ["delta_lon"])
+    assert control["kept"] and control["windows_s"] == [4.0, 8.0, 16.0]
+    assert summary["options"]["min_coherence"] == 0.6 and summary["output"] is None
+
+
+@pytest.mark.parametrize(("args", "fragment"), [
+    (["--pairs", "q/delta_lon,zz/delta_lon"], "has no signal zz"),
+    (["--kind", "multisine"], "no multisine on any axis"),
+    (["--pairs", "q/delta_lon", "--kind", "3211"], "no 3211 on axis lon"),
+    (["--windows", "90"], "longer than every record"),
+    (["--omega-max", "400"], "above the Nyquist frequency"),
+])
+def test_bad_data_is_exit_1_with_one_sentence_and_no_file(demo: dict[str, Path], tmp_path: Path, args: list[str],
+                                                           fragment: str) -> None:
+    out, plot = tmp_path / "fr.h5", tmp_path / "fr.svg"
+    result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), "-o", str(out), "--plot", str(plot), *args])
+    assert result.exit_code == 1, result.output
+    assert fragment in result.stderr and "Traceback" not in result.output
+    assert result.stderr.count("\n") == 1
+    assert not out.exists() and not plot.exists()
+
+
+@pytest.mark.parametrize(("args", "fragment"), [
+    (["--pairs", "q"], "OUTPUT/INPUT"),
+    (["--windows", "2,x"], "comma-separated list of seconds"),
+    (["--omega-min", "50", "--omega-max", "10"], "omega_min < omega_max"),
+    (["--wind-distance", "4.6"], "go with logs"),
+])
+def test_usage_errors_are_exit_2(demo: dict[str, Path], args: list[str], fragment: str) -> None:
+    result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), *args])
+    assert result.exit_code == 2, result.output
+    assert fragment in result.stderr
+
+
+def test_help_has_an_example() -> None:
+    result = CliRunner().invoke(cli, ["freqresp", "--help"])
+    assert result.exit_code == 0 and "sysid freqresp flight.h5 --pairs q/delta_lon" in result.output

@@ -1,0 +1,185 @@
+"""``sysid report`` rebuilds the model report from the saved files; saved verifications round-trip.
+
+(The verification file, :mod:`sysid.verify_io`, is tested here with the command that reads it.)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import json
+import re
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from flightlogs.errors import DataError
+from reports.model_report import model_report_html
+from sysid.fit import IdentifiedModel, write_model
+from sysid.verify import Verification
+from sysid.verify_io import read_verification, verification_to_dict, write_verification
+from sysid_cli.main import cli
+from sysid_cli.report import ingest_card
+
+_TESTS = Path(__file__).resolve().parents[1] / "reports"
+
+
+def _load(name: str, file: str) -> Any:
+    spec = importlib.util.spec_from_file_location(name, _TESTS / file)
+    assert spec is not None and spec.loader is not None
+    module = sys.modules.setdefault(spec.name, importlib.util.module_from_spec(spec))
+    spec.loader.exec_module(module)
+    return module
+
+
+browser = _load("_report_browser", "browser.py")
+fixtures = _load("_model_report_tests", "test_model_report.py")
+_FOOTER = re.compile(r"<footer>.*?</footer>", re.S)
+INGEST = {"path": "/data/flight.bin", "log_format": "dataflash", "autopilot": "ardupilot",
+          "vehicle": "ArduCopter V4.5.7 <octo>", "duration_s": 204.0, "utc_start": "2024-05-01T10:00:00+00:00",
+          "wind_alignment": {"clock_offset_s": 1.5003, "clock_offset_source": "estimated", "transport_delay_s": 1.7374,
+                             "transport_delay_source": "geometry", "turbulence_ratio": 0.2046}}
+
+
+@pytest.fixture(scope="module")
+def saved(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, IdentifiedModel, Verification]:
+    folder = tmp_path_factory.mktemp("saved")
+    model = fixtures.small_model(files=("flight.bin", "anemometer.csv"))
+    verification = browser.sample_verification()
+    write_model(folder / "model.json", model)
+    write_verification(folder / "validation.json", verification, model="model.json",
+                       options={"initial_state": "estimated", "after_s": 1.0})
+    return folder / "model.json", folder / "validation.json", model, verification
+
+
+def _arrays(verification: Verification) -> list[np.ndarray]:
+    found = []
+    for record in (*verification.records, *verification.without_wind):
+        found.append(record.time_s)
+        for o in record.outputs:
+            found.extend([o.measured, o.simulated] + ([o.predicted] if o.predicted is not None else []))
+    return found
+
+
+def test_a_saved_verification_reads_back_exactly(saved: tuple[Path, Path, IdentifiedModel, Verification]) -> None:
+    _, path, _, verification = saved
+    loaded = read_verification(path)
+    assert loaded.model == "model.json" and dict(loaded.options) == {"initial_state": "estimated", "after_s": 1.0}
+    assert verification_to_dict(loaded.verification) == verification_to_dict(verification)
+    for before, after in zip(_arrays(verification), _arrays(loaded.verification), strict=True):
+        np.testing.assert_array_equal(before, after)  # every digit kept: the report redraws the same
+    assert [c.reduction_percent for c in loaded.verification.wind_correction] == [
+        c.reduction_percent for c in verification.wind_correction]
+
+
+def test_report_rebuilds_the_same_page_from_the_saved_files(
+        saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path) -> None:
+    model_path, validation_path, model, verification = saved
+    out = tmp_path / "report.html"
+    result = CliRunner().invoke(cli, ["report", str(model_path), str(validation_path), "-o", str(out),
+                                      "--json", "-"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert summary["report"] == str(out) and summary["verdict"] == "good"
+    direct = model_report_html(model, verification=verification, verification_options={
+        "initial_state": "estimated", "after_s": 1.0})
+    assert _FOOTER.sub("", out.read_text()) == _FOOTER.sub("", direct)
+
+
+def test_without_a_verification_the_default_output_sits_beside_the_model(
+        saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path) -> None:
+    model_path, _, _, _ = saved
+    copy = tmp_path / "m.json"
+    copy.write_text(model_path.read_text())
+    result = CliRunner().invoke(cli, ["report", str(copy), "--ingest-summary", _ingest(tmp_path)])
+    assert result.exit_code == 0, result.output
+    page = (tmp_path / "m.html").read_text()
+    assert 'id="verification"' not in page
+    assert "ArduCopter V4.5.7 &lt;octo&gt;" in page and "transport delay 1.74 s (geometry)" in page
+    assert result.output.strip().endswith(f"wrote {tmp_path / 'm.html'}")
+
+
+def _ingest(folder: Path) -> str:
+    path = folder / "ingest.json"
+    path.write_text(json.dumps(INGEST))
+    return str(path)
+
+
+def test_ingest_card_reads_what_ingest_writes() -> None:
+    card = ingest_card(INGEST)
+    assert card["vehicle"] == "ArduCopter V4.5.7 <octo>"
+    assert card["flight"] == "flight.bin: ardupilot dataflash log, 204 s from 2024-05-01T10:00:00+00:00"
+    assert card["wind alignment"] == ("anemometer clock offset +1.50 s (estimated), transport delay 1.74 s "
+                                      "(geometry), turbulence 20 %")
+    with pytest.raises(DataError, match="sysid ingest --json"):
+        ingest_card({"records": []})
+
+
+def _bad_files(folder: Path, saved: tuple[Path, Path, IdentifiedModel, Verification]) -> dict[str, tuple[list[str], str]]:
+    model_path, validation_path, _, _ = saved
+    (folder / "broken.json").write_text('{"schema": "flight-sysid/identified-model", ')
+    newer = json.loads(model_path.read_text()) | {"schema_version": 99}
+    (folder / "newer.json").write_text(json.dumps(newer))
+    (folder / "summary.json").write_text(json.dumps({"model": "m.json", "records": [], "summary": {},
+                                                     "overall": {"rmse": 1.0, "tic": 0.1}}))
+    damaged = json.loads(validation_path.read_text())
+    del damaged["records"][0]["time_s"]
+    (folder / "damaged.json").write_text(json.dumps(damaged))
+    (folder / "not-ingest.json").write_text("[1, 2]")
+    return {
+        "model not JSON": ([str(folder / "broken.json")], "cannot read the model file"),
+        "model too new": ([str(folder / "newer.json")], "schema version 99"),
+        "a validate summary": ([str(model_path), str(folder / "summary.json")], "sysid validate --json"),
+        "damaged verification": ([str(model_path), str(folder / "damaged.json")], "incomplete or damaged"),
+        "model as verification": ([str(model_path), str(model_path)], "not a flight-sysid verification file"),
+        "not an ingest summary": ([str(model_path), "--ingest-summary", str(folder / "not-ingest.json")],
+                                  "sysid ingest --json"),
+    }
+
+
+@pytest.mark.parametrize("case", ["model not JSON", "model too new", "a validate summary", "damaged verification",
+                                  "model as verification", "not an ingest summary"])
+def test_bad_input_is_exit_1_and_writes_nothing(case: str, saved: tuple[Path, Path, IdentifiedModel, Verification],
+                                                tmp_path: Path) -> None:
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    arguments, fragment = _bad_files(inputs, saved)[case]
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    result = CliRunner().invoke(cli, ["report", *arguments, "-o", str(out_dir / "r.html")])
+    assert result.exit_code == 1, result.output
+    assert fragment in result.stderr and "Traceback" not in result.output
+    assert list(out_dir.iterdir()) == []
+
+
+def test_a_missing_model_is_a_usage_error(tmp_path: Path) -> None:
+    result = CliRunner().invoke(cli, ["report", str(tmp_path / "nope.json")])
+    assert result.exit_code == 2 and "does not exist" in result.stderr
+
+
+def test_fit_report_hook_writes_the_model_report(saved: tuple[Path, Path, IdentifiedModel, Verification],
+                                                 tmp_path: Path) -> None:
+    """``sysid fit --report`` goes through the same function (its hook, without running a fit)."""
+    from sysid_cli.fit import _write_report
+
+    _, _, model, _ = saved
+    assert _write_report(tmp_path / "fit.html", model) is None
+    assert _FOOTER.sub("", (tmp_path / "fit.html").read_text()) == _FOOTER.sub("", model_report_html(model))
+
+
+def test_report_help_has_an_example() -> None:
+    result = CliRunner().invoke(cli, ["report", "--help"])
+    assert result.exit_code == 0 and "sysid report model.json validation.json" in result.output
+
+
+def test_saved_verification_keeps_a_one_record_model_without_wind(tmp_path: Path) -> None:
+    verification = browser.sample_verification()
+    plain = dataclasses.replace(verification, without_wind=(), wind_correction=())
+    path = write_verification(tmp_path / "v.json", plain)
+    loaded = read_verification(path).verification
+    assert loaded.without_wind == () and loaded.wind_correction == ()
+    assert [r.label for r in loaded.records] == [r.label for r in plain.records]

@@ -1,0 +1,89 @@
+"""Bode and coherence figures."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from matplotlib.patches import Polygon, Rectangle
+
+from reports.bode import bode_figure, write_bode_svg
+from reports.svg import figure_svg
+from sysid.freqresp import FrequencyResponse
+
+OMEGA = np.geomspace(0.5, 50.0, 60)
+
+
+def _lag(output: str = "q", *, fit_range: tuple[float, float] | None = None, delay_s: float = 0.0) -> FrequencyResponse:
+    h = np.exp(-1j * OMEGA * delay_s) / (1j * OMEGA * 0.2 + 1)
+    n = OMEGA.size
+    return FrequencyResponse("delta_lon", output, OMEGA, h, np.full(n, 0.9), np.full(n, 0.02), np.ones(n), np.ones(n),
+                             np.ones(n, complex), (2.0, 8.0), input_unit="%", output_unit="rad/s", fit_range=fit_range)
+
+
+def _y(line: Any) -> np.ndarray:
+    return np.asarray(line.get_ydata(), dtype=float)
+
+
+def _visible(figure: Any) -> list[Any]:
+    return [ax for ax in figure.axes if ax.get_visible()]
+
+
+def test_three_panels_per_response_with_data_in_db_and_degrees() -> None:
+    response = _lag(delay_s=0.05)
+    figure = bode_figure([response])
+    magnitude, phase, coherence = figure.axes
+    np.testing.assert_allclose(_y(magnitude.lines[0]), response.magnitude_db)
+    np.testing.assert_allclose(_y(phase.lines[0]), response.phase_deg)
+    np.testing.assert_allclose(_y(coherence.lines[0]), response.coherence)
+    assert magnitude.get_xscale() == "log" and coherence.get_xlabel() == "frequency, rad/s"
+    assert magnitude.get_title() == "q/delta_lon"
+
+
+def test_blocks_fill_two_columns_and_unused_panels_are_hidden() -> None:
+    figure = bode_figure([_lag("q"), _lag("ax"), _lag("theta")])
+    assert len(figure.axes) == 12 and len(_visible(figure)) == 9
+    assert [ax.get_title() for ax in _visible(figure) if ax.get_title()] == ["q/delta_lon", "ax/delta_lon",
+                                                                             "theta/delta_lon"]
+    assert len(bode_figure([_lag("q"), _lag("ax")], n_cols=1).axes) == 6
+
+
+def test_fit_range_is_shaded_on_every_panel() -> None:
+    figure = bode_figure([_lag(fit_range=(1.0, 20.0))])
+    for ax in figure.axes:
+        spans = [p for p in ax.patches if isinstance(p, (Polygon, Rectangle))]
+        assert len(spans) == 1
+        xs = spans[0].get_xy()[:, 0] if isinstance(spans[0], Polygon) else [spans[0].get_x()]
+        assert min(xs) == pytest.approx(1.0)
+    assert all(not ax.patches for ax in bode_figure([_lag()]).axes)
+
+
+def test_model_overlay_from_an_array_or_a_function_on_the_data_phase_branch() -> None:
+    response = _lag()
+    exact = 1 / (1j * OMEGA * 0.2 + 1)
+    for model in (exact, lambda w: 1 / (1j * w * 0.2 + 1)):
+        magnitude, phase, _ = bode_figure([response], models={"q/delta_lon": model}).axes
+        assert len(magnitude.lines) == 2 and magnitude.get_legend() is not None
+        np.testing.assert_allclose(_y(phase.lines[1]), _y(phase.lines[0]), atol=1e-9)
+    shifted = dataclasses.replace(response, response=response.response * np.exp(2j * np.pi))  # same phase
+    _, phase, _ = bode_figure([shifted], models={"q/delta_lon": exact}).axes
+    assert abs(_y(phase.lines[1])[0] - _y(phase.lines[0])[0]) < 1e-6
+    assert len(bode_figure([response], models={"ax/delta_lon": exact}).axes[0].lines) == 1
+
+
+def test_bad_arguments_are_refused() -> None:
+    with pytest.raises(ValueError, match="no response"):
+        bode_figure([])
+    with pytest.raises(ValueError, match="shape"):
+        bode_figure([_lag()], models={"q/delta_lon": np.ones(3)})
+
+
+def test_standalone_svg_file(tmp_path: Path) -> None:
+    target = tmp_path / "fr.svg"
+    write_bode_svg(target, [_lag(fit_range=(1.0, 20.0)), _lag("ax")], min_coherence=0.6)
+    text = target.read_text()
+    assert text.startswith("<?xml") and "<svg" in text and "q/delta_lon" in text and "ax/delta_lon" in text
+    assert figure_svg(bode_figure([_lag()])) == figure_svg(bode_figure([_lag()]))  # deterministic
