@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.ndimage import binary_dilation, median_filter, uniform_filter1d
-from scipy.signal import fftconvolve
+from scipy.fft import irfft, next_fast_len, rfft
 from scipy.stats import spearmanr
 
 __all__: list[str] = []
@@ -120,19 +120,27 @@ def _trend(x: np.ndarray, width: int) -> np.ndarray:
     """
     trend = median_filter(x, size=width, mode="reflect")
     half = width // 2
-    kernels = [(-np.arange(-half, half + 1) / half) ** k for k in range(5)]
+    n_fft = next_fast_len(x.size + 2 * half, real=True)
+    kernels = rfft((-np.arange(-half, half + 1) / half) ** np.arange(5)[:, None], n_fft)  # moving moments 0-4
+
+    def moving(signal: np.ndarray, k: int) -> list[np.ndarray]:  # its first k moving moments, as fftconvolve "same"
+        return list(irfft(rfft(signal, n_fft) * kernels[:k], n_fft)[:, half : half + x.size])
+
     idx = np.arange(x.size)
     for _ in range(3):
         resid = x - trend
         r = resid / (4.685 * max(_robust_std(resid, 0.25), 1e-12 * (1.0 + float(np.max(np.abs(x))))))
         w = np.where(np.abs(r) < 1, (1 - r * r) ** 2, 0.0)
-        m = [fftconvolve(w, k, mode="same") for k in kernels]
-        b = np.stack([fftconvolve(w * x, k, mode="same") for k in kernels[:3]], axis=-1)
-        a = np.stack([np.stack(m[i : i + 3], axis=-1) for i in range(3)], axis=-2)
-        good = (m[0] > 0.2 * half) & (np.abs(np.linalg.det(a)) > 1e-6 * m[0] ** 3)
+        m0, m1, m2, m3, m4 = moving(w, 5)
+        b0, b1, b2 = moving(w * x, 3)
+        # normal equations [[m0 m1 m2] [m1 m2 m3] [m2 m3 m4]] c = b; the trend is c0 (Cramer's rule)
+        minor = m2 * m4 - m3 * m3
+        det = m0 * minor - m1 * (m1 * m4 - m3 * m2) + m2 * (m1 * m3 - m2 * m2)
+        good = (m0 > 0.2 * half) & (np.abs(det) > 1e-6 * m0**3)
         if good.sum() < 2:
             break
-        trend = np.interp(idx, idx[good], np.linalg.solve(a[good], b[good][..., None])[:, 0, 0])
+        c0 = (b0 * minor - m1 * (b1 * m4 - m3 * b2) + m2 * (b1 * m3 - m2 * b2))[good] / det[good]
+        trend = np.interp(idx, idx[good], c0)
     return trend
 
 
@@ -271,7 +279,8 @@ def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float)
     """(kind, f_min_hz, f_max_hz[, (first, last)]) of the maneuver on samples [lo, hi], or None.
 
     Doublets come with refined bounds: the first and last sample of their two
-    lobes that stand out of the noise, since their edges are steps.
+    lobes that stand out of the noise (and above 3 % of their peak), since
+    their edges are steps.
     """
     x, h = act.detrended[lo : hi + 1], threshold * act.sigma
     lobes = _lobes(x, t[lo : hi + 1], h)
@@ -303,9 +312,18 @@ def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float)
 
 
 def _loud_span(x: np.ndarray, t: np.ndarray, lo: int, first: tuple, second: tuple, h: float) -> tuple[int, int]:
-    """Absolute indices of the first and last sample above `h` in magnitude from lobe `first` to `second`."""
+    """Absolute indices of the first and last sample from lobe `first` to `second` that are loud.
+
+    Loud: above `h` in magnitude and above twice the relative floor of the
+    peak, as for the edges (a trace almost free of noise may still drift by
+    a fraction of a percent before its first step).
+    """
     local = t[lo : lo + x.size]
-    inside = np.flatnonzero((local >= first[1]) & (local <= second[2]) & (np.abs(x) > h))
+    span = (local >= first[1]) & (local <= second[2])
+    if not span.any():
+        return _span(t, lo, first[1], second[2])
+    level = max(h, 2 * _RELATIVE_FLOOR * float(np.max(np.abs(x[span]))))
+    inside = np.flatnonzero(span & (np.abs(x) > level))
     if inside.size == 0:
         return _span(t, lo, first[1], second[2])
     return lo + int(inside[0]), lo + int(inside[-1])

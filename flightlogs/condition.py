@@ -421,7 +421,7 @@ def _segments(log: FlightLog, time_base: np.ndarray, values: dict[str, np.ndarra
         quiet[start:stop] = True
     detected: list[Segment] = []
     for _ in range(2):  # fit the feedback where nothing is excited, detect, refit without what was found
-        excitation = estimate_excitation(inputs, values, quiet & ~_near(time_base, detected, 2.0))
+        excitation = estimate_excitation(inputs, values, quiet & ~_near(time_base, detected, 2.0), time_s=time_base)
         detected = [
             segment
             for start, stop in pieces

@@ -4,10 +4,13 @@ An ArduPilot DataFlash log (IMU, ATT, RATE, CTUN, RCOU, BAT, GPS, XKF1, and
 SIDS/SIDD for System ID sweeps), the CSV of a ground anemometer on its own
 clock upstream of the vehicle, and a truth JSON.
 
-The vehicle hovers over a fixed point (``vehicle_position_deg``); its GPS
-position wanders about it as a position hold would let it: the horizontal
-velocity, its mean removed, through a leaky integrator of time constant
-2 s (about ±1 m in the demo's light wind, a few millimetres of mean offset).
+The vehicle hovers over a fixed point (``vehicle_position_deg``). Its GPS
+logs the path flown where the simulator knows it (the nonlinear simulator's
+``pn pe``, as an autopilot logs its GNSS fix); for the linear model, which
+has no position, it wanders about the point as a position hold would let
+it: the horizontal velocity, its mean removed, through a leaky integrator of
+time constant 2 s (about ±1 m in the demo's light wind, a few millimetres of
+mean offset).
 """
 
 from __future__ import annotations
@@ -104,7 +107,8 @@ def write_ardupilot_log(
         UTC of the first sample (aware).
     vehicle_position_deg : tuple of (float, float), optional
         The point the vehicle hovers over, latitude and longitude, deg; the
-        GPS (5 Hz, 3-D fix) logs it plus the position hold's wander.
+        GPS (5 Hz, 3-D fix) logs it plus the path flown (or the position
+        hold's wander, see the module notes).
 
     Returns
     -------
@@ -141,13 +145,15 @@ def write_ardupilot_log(
 
 
 def _gps_track(flight: SimulatedFlight, hover_deg: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
-    """Latitude and longitude, deg, of the hover point plus the position hold's wander (see the module notes)."""
-    dt = float(np.median(np.diff(flight.time_s)))
-    keep = np.exp(-dt / _HOLD_S)
-    wander = []
-    for name in ("vn", "ve"):
-        velocity = flight.signals[name] - flight.signals[name].mean()
-        wander.append(sps.lfilter([dt], [1.0, -keep], velocity))
+    """Latitude and longitude, deg, of the hover point plus the path flown, or the wander (see the module notes)."""
+    truth = getattr(flight, "truth", {})
+    if "pn" in truth and "pe" in truth:
+        wander = [np.asarray(truth["pn"], dtype=np.float64), np.asarray(truth["pe"], dtype=np.float64)]
+    else:
+        dt = float(np.median(np.diff(flight.time_s)))
+        keep = np.exp(-dt / _HOLD_S)
+        wander = [sps.lfilter([dt], [1.0, -keep], flight.signals[name] - flight.signals[name].mean())
+                  for name in ("vn", "ve")]
     lat0 = np.radians(hover_deg[0])
     lat = hover_deg[0] + np.degrees(wander[0] / _EARTH_RADIUS_M)
     lng = hover_deg[1] + np.degrees(wander[1] / (_EARTH_RADIUS_M * np.cos(lat0)))

@@ -131,6 +131,18 @@ def test_a_3211_and_a_multisine_are_told_apart() -> None:
     assert abs(maneuvers[1].start_s - 50.0) <= 0.3 and abs(maneuvers[1].end_s - 70.0) <= 0.3
 
 
+def test_a_clean_doublet_on_a_slight_drift_is_bounded_at_its_steps() -> None:
+    """Almost free of noise (as the excitation recovered from a closed loop), a bump of 0.4 % of the
+    doublet just before it stands out of the noise yet is not the doublet: its bounds are its steps."""
+    rng = np.random.default_rng(11)
+    t = np.arange(1200) / RATE_HZ
+    drift = 4e-4 * np.exp(-(((t - 4.8) / 0.3) ** 2))
+    inputs = {"lat": 0.1 * _doublet(t - 5.0) + drift + 1e-5 * rng.standard_normal(t.size)}
+    (found,) = [s for s in detect_segments(t, inputs) if s.kind != "hover"]
+    assert (found.axis, found.kind) == ("lat", "doublet")
+    assert abs(found.start_s - 5.0) <= 1 / RATE_HZ + 1e-9 and abs(found.end_s - 7.0) <= 1 / RATE_HZ + 1e-9
+
+
 @pytest.mark.parametrize(
     ("inputs", "time_s", "fragment"),
     [
