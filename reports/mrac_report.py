@@ -8,7 +8,7 @@ from typing import Any, Literal
 import numpy as np
 from matplotlib.figure import Figure
 
-from sysid.mrac import CONTROLLERS, MracComparison, MetricStatistics, Statistic, StepCase
+from sysid.mrac import CONTROLLERS, ControllerResult, MracComparison, MetricStatistics, Statistic, StepCase
 
 from .html import render_html, write_html
 from .svg import figure_svg, new_figure
@@ -19,6 +19,7 @@ _COLOURS = {"pid": "#7f7f7f", "mrac_linear": "#1f4e79", "mrac_rbf": "#c0392b"}
 _LABELS = {"pid": "PID", "mrac_linear": "MRAC, linear", "mrac_rbf": "MRAC, RBF"}
 _REFERENCE = "#2e8b57"
 _PHASES: tuple[Literal["takeoff", "landing"], ...] = ("takeoff", "landing")
+_PHASE_LABELS = {"takeoff": "take-off", "landing": "landing"}
 _INDICES = (("rise_time_s", "rise time (s)", 1.0), ("steady_state_error_m", "SSE (mm)", 1e3),
             ("mse_m2", "MSE to reference (mm²)", 1e6), ("overshoot_percent", "overshoot (%)", 1.0),
             ("settling_time_s", "settling time (s)", 1.0))
@@ -27,6 +28,13 @@ _INDICES = (("rise_time_s", "rise time (s)", 1.0), ("steady_state_error_m", "SSE
 def _every(n_samples: int, most: int = 600) -> slice:
     """A stride that keeps at most about `most` points of a trace (figures stay small)."""
     return slice(None, None, max(1, n_samples // most))
+
+
+def _phase_axis(result: ControllerResult, phase: str) -> tuple[np.ndarray, slice, slice]:
+    """Time from the step command (s), the rows of `phase` (two equal phases, take-off first), the plot stride."""
+    n = result.run.time_s.size // 2
+    every = _every(n)
+    return result.run.time_s[:n][every], slice(0, n) if phase == "takeoff" else slice(n, 2 * n), every
 
 
 def _title(case: StepCase) -> str:
@@ -57,23 +65,18 @@ def height_figure(comparison: MracComparison, height_ratio: float) -> Figure:
     longest = max(results, key=lambda r: r.phase_s)
     for phase, ax in zip(_PHASES, axes):
         for result in results:
-            n = result.run.time_s.size // 2
-            every = _every(n)
-            height = 100 * (result.run.height_m[:n] if phase == "takeoff" else result.run.height_m[n:])[every]
+            t, rows, every = _phase_axis(result, phase)
+            height = 100 * result.run.height_m[rows][every]
             mean, std = height.mean(axis=1), height.std(axis=1)
             colour = _COLOURS[result.controller]
-            t = result.run.time_s[:n][every]
             ax.fill_between(t, mean - std, mean + std, color=colour, alpha=0.2, linewidth=0)
             ax.plot(t, mean, color=colour, linewidth=1.3, label=_LABELS[result.controller])
-        n = longest.run.time_s.size // 2
-        every = _every(n)
-        first = 0 if phase == "takeoff" else n
-        t = longest.run.time_s[:n][every]
-        ax.plot(t, 100 * longest.reference_m[first : first + n][every], color=_REFERENCE, linestyle="--",
+        t, rows, every = _phase_axis(longest, phase)
+        ax.plot(t, 100 * longest.reference_m[rows][every], color=_REFERENCE, linestyle="--",
                 linewidth=1.1, label="reference (2.20)")
-        ax.plot(t, 100 * longest.run.command_m[first : first + n, 0][every], color="#222222", linestyle=":",
+        ax.plot(t, 100 * longest.run.command_m[rows, 0][every], color="#222222", linestyle=":",
                 linewidth=1.0, label="command")
-        ax.set_title("take-off" if phase == "takeoff" else "landing")
+        ax.set_title(_PHASE_LABELS[phase])
         ax.set_xlabel("time from the step (s)")
         ax.set_ylabel("height above ground (cm)")
     axes[0].legend(loc="lower right", fontsize=7.5)
@@ -161,7 +164,7 @@ def _checks(comparison: MracComparison) -> list[dict[str, Any]]:
         for phase in _PHASES:
             stats = {n: comparison.statistics(n, height_ratio=case.height_ratio, phase=phase) for n in names}
             row: dict[str, Any] = {"case": f"{case.height_ratio:g}", "in_ground_effect": case.in_ground_effect,
-                                   "phase": "take-off" if phase == "takeoff" else "landing"}
+                                   "phase": _PHASE_LABELS[phase]}
             pid = stats["pid"].rise_time_s.mean if "pid" in stats else float("nan")
             for n in ("mrac_linear", "mrac_rbf"):
                 row[n] = stats[n].rise_time_s.mean / pid if n in stats else float("nan")
@@ -195,7 +198,7 @@ def render_mrac_report(comparison: MracComparison, *,
             "title": _title(case), "case": case, "analysis": analysis,
             "height_svg": figure_svg(height_figure(comparison, case.height_ratio)),
             "theta_svg": figure_svg(theta) if theta is not None else None,
-            "phases": [{"name": "take-off" if p == "takeoff" else "landing",
+            "phases": [{"name": _PHASE_LABELS[p],
                         "rows": _table({n: comparison.statistics(n, height_ratio=case.height_ratio, phase=p)
                                         for n in names})} for p in _PHASES],
         })

@@ -20,6 +20,8 @@ from flightlogs.atomic import atomic_output
 from flightlogs.errors import ModelError
 
 from ..freqresp import FrequencyResponse
+from ._json import finite_or_none as _num
+from ._json import parameter_entry
 from .cost import CostSummary
 from .reduce import ReductionStep
 from .result import IdentifiedModel, ParameterEstimate, Provenance, WindFit
@@ -28,10 +30,6 @@ __all__ = ["SCHEMA", "SCHEMA_VERSION", "model_to_dict", "model_from_dict", "writ
 
 SCHEMA = "flight-sysid/identified-model"
 SCHEMA_VERSION = 1
-
-
-def _num(value: float) -> float | None:
-    return None if not math.isfinite(value) else float(value)
 
 
 def _float(value: Any) -> float:
@@ -61,9 +59,7 @@ def model_to_dict(model: IdentifiedModel) -> dict[str, Any]:
     return {
         "schema": SCHEMA, "schema_version": SCHEMA_VERSION,
         "structure": {"name": model.structure_name, "text": model.structure_text},
-        "parameters": {p.name: {"value": _num(p.value), "cr_percent": _num(p.cr_percent),
-                                "insensitivity_percent": _num(p.insensitivity_percent), "status": p.status,
-                                "unit": p.unit, "stage": p.stage} for p in model.parameters},
+        "parameters": {p.name: parameter_entry(p) | {"value": _num(p.value)} for p in model.parameters},
         "correlation": {"names": list(model.correlation_names), "matrix": _array(model.correlation)},
         "cost": {"average": _num(model.cost.average), "responses": {k: _num(v) for k, v in model.cost.responses.items()}},
         "trim": {k: _num(v) for k, v in model.trim.items()},

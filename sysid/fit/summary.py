@@ -2,18 +2,15 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
 from ..modes import Mode, modes
+from ._json import finite_or_none as _num
+from ._json import parameter_entry
 from .result import IdentifiedModel
 
 __all__ = ["mode_summary", "fit_summary"]
-
-
-def _num(value: float) -> float | None:
-    return float(value) if math.isfinite(value) else None
 
 
 def mode_summary(found: Sequence[Mode]) -> list[dict[str, Any]]:
@@ -56,9 +53,7 @@ def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
     """
     return {
         "model": model.structure_name,
-        "parameters": {p.name: {"value": p.value, "cr_percent": _num(p.cr_percent),
-                                "insensitivity_percent": _num(p.insensitivity_percent), "status": p.status,
-                                "unit": p.unit, "stage": p.stage} for p in model.parameters},
+        "parameters": {p.name: parameter_entry(p) for p in model.parameters},
         "cost": {"average": model.cost.average, "responses": dict(model.cost.responses)},
         "eigenvalues": mode_summary(modes(model.linear_model())),
         "dropped": [p.name for p in model.parameters if p.dropped],

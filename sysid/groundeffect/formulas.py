@@ -13,6 +13,7 @@ import numpy as np
 __all__ = [
     "cheeseman_bennett",
     "corrected",
+    "corrected_denominator",
     "exponential",
     "piecewise_linear",
     "FITTED_2ROTOR_RHO",
@@ -49,8 +50,7 @@ def cheeseman_bennett(height_ratio: np.ndarray) -> np.ndarray:
     >>> float(cheeseman_bennett(np.array(1.0)))
     1.0666666666666667
     """
-    x = np.asarray(height_ratio, dtype=np.float64)
-    return 1.0 / (1.0 - (1.0 / (4.0 * x)) ** 2)
+    return corrected(height_ratio, 1.0)
 
 
 def corrected(height_ratio: np.ndarray, rho: float) -> np.ndarray:
@@ -73,8 +73,31 @@ def corrected(height_ratio: np.ndarray, rho: float) -> np.ndarray:
     >>> round(float(corrected(np.array(2.0), FITTED_2ROTOR_RHO)), 4)  # "5 % at twice the radius"
     1.0546
     """
+    return 1.0 / corrected_denominator(height_ratio, rho)
+
+
+def corrected_denominator(height_ratio: np.ndarray, rho: float) -> np.ndarray:
+    """The denominator of eq. 2.2, 1 - rho (R/4Z)^2: F0/F, which reaches 0 where the law diverges.
+
+    Parameters
+    ----------
+    height_ratio : ndarray, any shape
+        Z/R.
+    rho : float
+        Correction coefficient (1 for eq. 2.1).
+
+    Returns
+    -------
+    ndarray
+        F0/F under eq. 2.2, same shape (<= 0 below Z/R = sqrt(rho)/4).
+
+    Examples
+    --------
+    >>> float(corrected_denominator(np.array(1.0), 1.0))  # 1 - 1/16
+    0.9375
+    """
     x = np.asarray(height_ratio, dtype=np.float64)
-    return 1.0 / (1.0 - rho * (1.0 / (4.0 * x)) ** 2)
+    return 1.0 - rho * (1.0 / (4.0 * x)) ** 2
 
 
 def exponential(height_ratio: np.ndarray, a: float, b: float) -> np.ndarray:

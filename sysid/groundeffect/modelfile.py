@@ -126,7 +126,7 @@ def fit_summary(fit: GroundEffectFit) -> dict[str, Any]:
         models[m.name] = {
             "params": m.params,
             "stderr": {n: float(v) for n, v in zip(m.param_names, m.stderr)},
-            "ci": {n: [float(lo), float(hi)] for n, lo, hi in zip(m.param_names, m.ci_low, m.ci_high)},
+            "ci": m.intervals,
             "n_free": m.n_free, "rmse": m.rmse, "r2": m.r2, "aicc": m.aicc, "bic": m.bic,
             "delta": fit.delta(m.name), "notes": list(m.notes),
         }

@@ -5,7 +5,7 @@ See :mod:`sysid.groundeffect.fitting` for how they are fitted and chosen.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -34,6 +34,13 @@ PARAMETER_NAMES: dict[str, tuple[str, ...]] = {
     "piecewise_linear": ("slope", "intercept", "breakpoint"),
 }
 Criterion = Literal["aicc", "bic"]
+#: The formula of each family, called as ``law(height_ratio, *values)``.
+_LAWS: dict[str, Callable[..., np.ndarray]] = {
+    "cheeseman_bennett": formulas.cheeseman_bennett,
+    "corrected": formulas.corrected,
+    "exponential": formulas.exponential,
+    "piecewise_linear": formulas.piecewise_linear,
+}
 
 
 def evaluate_model(name: str, values: Sequence[float] | np.ndarray, height_ratio: np.ndarray) -> np.ndarray:
@@ -63,14 +70,8 @@ def evaluate_model(name: str, values: Sequence[float] | np.ndarray, height_ratio
         raise ValueError(f"unknown ground-effect model {name!r}; choose from {MODEL_NAMES}")
     if len(p) != len(PARAMETER_NAMES[name]):
         raise ValueError(f"{name} takes {len(PARAMETER_NAMES[name])} parameters {PARAMETER_NAMES[name]}, got {len(p)}")
-    x = np.asarray(height_ratio, dtype=np.float64)
-    if name == "cheeseman_bennett":
-        return formulas.cheeseman_bennett(x)
-    if name == "corrected":
-        return formulas.corrected(x, p[0])
-    if name == "exponential":
-        return formulas.exponential(x, p[0], p[1])
-    return formulas.piecewise_linear(x, p[0], p[1], p[2])
+    return _LAWS[name](np.asarray(height_ratio, dtype=np.float64), *p)
+
 
 @dataclass(frozen=True, slots=True)
 class ModelFit:
@@ -132,6 +133,11 @@ class ModelFit:
     def params(self) -> dict[str, float]:
         """Parameter name to estimate."""
         return {n: float(v) for n, v in zip(self.param_names, self.values)}
+
+    @property
+    def intervals(self) -> dict[str, list[float]]:
+        """Parameter name to its confidence interval ``[low, high]``, in the parameter's unit."""
+        return {n: [float(lo), float(hi)] for n, lo, hi in zip(self.param_names, self.ci_low, self.ci_high)}
 
     def ratio(self, height_ratio: np.ndarray) -> np.ndarray:
         """F/F0 of this fit at `height_ratio`.

@@ -218,10 +218,8 @@ def spacing_summary(study: SpacingStudy) -> dict[str, Any]:
     """
     sets = []
     for spacing, fit, chosen in zip(study.spacings_m, study.fits, study.chosen):
-        models = {m.name: {"params": m.params,
-                           "ci": {n: [float(lo), float(hi)] for n, lo, hi in zip(m.param_names, m.ci_low, m.ci_high)},
-                           "rmse": m.rmse, "r2": m.r2, "aicc": m.aicc, "bic": m.bic}
-                  for m in fit.models}
+        models = {m.name: {"params": m.params, "ci": m.intervals, "rmse": m.rmse, "r2": m.r2, "aicc": m.aicc,
+                           "bic": m.bic} for m in fit.models}
         sets.append({"spacing_mm": float(spacing) * 1e3, "source": fit.data.source, "n_points": fit.data.n_points,
                      "chosen": chosen, "best": fit.best, "models": models})
     return {

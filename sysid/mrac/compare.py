@@ -346,10 +346,10 @@ def _fly(name: str, cases: list[StepCase], config: CompareConfig, vehicle: Altit
         cols = slice(j * n_t, (j + 1) * n_t)
         height = run.height_m[:, cols]
         reference = REFERENCE_EQ_2_20.response(run.time_s, command[:, j * n_t] - case.low_m)[:, 0] + case.low_m
-        takeoff = tuple(step_metrics(t, height[:n_phase, i], reference[:n_phase], before_m=case.low_m,
-                                     after_m=case.high_m) for i in range(n_t))
-        landing = tuple(step_metrics(t, height[n_phase:, i], reference[n_phase:], before_m=case.high_m,
-                                     after_m=case.low_m) for i in range(n_t))
+        takeoff, landing = (tuple(step_metrics(t, height[rows, i], reference[rows], before_m=before, after_m=after)
+                                  for i in range(n_t))
+                            for rows, before, after in ((slice(None, n_phase), case.low_m, case.high_m),
+                                                        (slice(n_phase, None), case.high_m, case.low_m)))
         adaptive = None if history is None else AdaptiveHistory(
             history.theta[:, cols], history.reference_height_m[:, cols], history.adaptive_thrust_n[:, cols],
             history.labels)

@@ -79,7 +79,7 @@ def thrust_ratio(
         return _laws.cheeseman_bennett(x)
     if model in ("corrected", "fitted_2rotor"):
         factor = _laws.FITTED_2ROTOR_RHO if model == "fitted_2rotor" else rho
-        if np.any(1.0 - factor * (1.0 / (4.0 * x)) ** 2 <= 0.05):
+        if np.any(_laws.corrected_denominator(x, factor) <= 0.05):
             raise ValueError(f"eq. 2.2 with rho={factor} diverges near Z/R={min_height_ratio}: raise min_height_ratio")
         return _laws.corrected(x, factor)
     if model == "exponential":

@@ -1,0 +1,49 @@
+"""JSON pieces shared by the model file (:mod:`sysid.fit.model_file`) and the CLI summary (:mod:`sysid.fit.summary`)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .result import ParameterEstimate
+
+__all__ = ["finite_or_none", "parameter_entry"]
+
+
+def finite_or_none(value: float) -> float | None:
+    """`value` as a float, or None (JSON ``null``) when it is NaN or infinite.
+
+    Parameters
+    ----------
+    value : float
+        Any number, in its own unit.
+
+    Returns
+    -------
+    float or None
+
+    Examples
+    --------
+    >>> finite_or_none(2), finite_or_none(float("nan"))
+    (2.0, None)
+    """
+    return float(value) if math.isfinite(value) else None
+
+
+def parameter_entry(p: ParameterEstimate) -> dict[str, Any]:
+    """One parameter as JSON: ``value``, ``cr_percent``, ``insensitivity_percent``, ``status``, ``unit``, ``stage``.
+
+    ``value`` is as held (NaN stays NaN); the two bounds are None unless finite.
+
+    Parameters
+    ----------
+    p : ParameterEstimate
+        The estimate (value in its `unit`, bounds in % of ``|value|``).
+
+    Returns
+    -------
+    dict
+    """
+    return {"value": p.value, "cr_percent": finite_or_none(p.cr_percent),
+            "insensitivity_percent": finite_or_none(p.insensitivity_percent), "status": p.status, "unit": p.unit,
+            "stage": p.stage}
