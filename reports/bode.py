@@ -8,8 +8,9 @@ from pathlib import Path
 from typing import Any, Union
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.ticker import LogLocator, NullFormatter
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter, NullLocator
 
 from flightlogs.atomic import atomic_output
 from sysid.freqresp import FrequencyResponse
@@ -37,7 +38,10 @@ def bode_figure(
 
     Each response gets a column block of three stacked panels; blocks fill a
     grid of `n_cols` columns. The fit range is shaded when set; a model
-    overlay is drawn where `models` has the response's pair.
+    overlay is drawn where `models` has the response's pair, its phase moved
+    by whole turns onto the data's branch (360° apart is the same phase), so
+    the two curves are compared where they lie. Frequency ticks are plain
+    numbers (0.5 1 2 5 10 ...), labelled once under each column.
 
     Parameters
     ----------
@@ -81,15 +85,23 @@ def bode_figure(
     figure, axes = new_figure(3 * block_rows, columns, width_in=width_in, height_in=height_in)
     grid = np.asarray(axes, dtype=object).reshape(3 * block_rows, columns)
     _layout(grid, width_in, height_in)
+    legend = True
     for k, response in enumerate(responses):
         row, col = divmod(k, columns)
         panels = grid[3 * row : 3 * row + 3, col]
         model = _model_values(models, response)
         _draw(panels, response, model, min_coherence)
+        if model is not None and legend:  # one legend per figure: the same two lines in every block
+            panels[0].legend(loc="best", fontsize=7, frameon=False)
+            legend = False
     for k in range(len(responses), block_rows * columns):
         row, col = divmod(k, columns)
         for ax in grid[3 * row : 3 * row + 3, col]:
             ax.set_visible(False)
+    for k in range(len(responses)):
+        row, col = divmod(k, columns)
+        if k + columns < len(responses):  # another block below shares the frequency axis: label it once
+            _hide_frequency_labels(grid[3 * row + 2, col])
     return figure
 
 
@@ -112,7 +124,8 @@ def write_bode_svg(path: str | Path, responses: Sequence[FrequencyResponse], **o
 
 
 _PANEL_IN = (1.15, 0.95, 0.7)  # magnitude, phase, coherence heights, inch
-_GAP_IN, _BLOCK_GAP_IN, _TOP_IN, _BOTTOM_IN, _LEFT_IN, _RIGHT_IN, _COLUMN_GAP_IN = 0.1, 0.75, 0.3, 0.45, 0.75, 0.1, 0.8
+# between blocks only the next block's title: the frequency axis is labelled under the last block of a column
+_GAP_IN, _BLOCK_GAP_IN, _TOP_IN, _BOTTOM_IN, _LEFT_IN, _RIGHT_IN, _COLUMN_GAP_IN = 0.1, 0.4, 0.3, 0.45, 0.75, 0.1, 0.8
 
 
 def _figure_height(block_rows: int) -> float:
@@ -142,6 +155,30 @@ def _layout(grid: np.ndarray, width_in: float, height_in: float) -> None:
             top = bottom
 
 
+def _frequency_label(value: float, _position: float) -> str:
+    return f"{value:g}"
+
+
+def _hide_frequency_labels(ax: Axes) -> None:
+    ax.set_xlabel("")
+    ax.tick_params(axis="x", which="both", labelbottom=False)
+
+
+def _nearest_branch(data: np.ndarray, model: np.ndarray) -> np.ndarray:
+    """The model's phase moved by whole turns onto the data's branch, point by point (median of 9 points).
+
+    Where the data's phase wraps (a zero near the jω axis, noise at low
+    coherence) the model follows it to the nearer branch; the running median
+    keeps one noisy point from moving the model.
+    """
+    turns = np.round((data - model) / 360.0)
+    turns = np.where(np.isfinite(turns), turns, 0.0)
+    half = 4
+    padded = np.pad(turns, half, mode="edge")
+    steady = np.array([np.median(padded[k : k + 2 * half + 1]) for k in range(turns.size)])
+    return model + 360.0 * np.round(steady)
+
+
 def _model_values(models: Mapping[str, ModelResponse] | None, response: FrequencyResponse) -> np.ndarray | None:
     if not models or response.pair not in models:
         return None
@@ -160,13 +197,11 @@ def _draw(panels: np.ndarray, response: FrequencyResponse, model: np.ndarray | N
     phase.semilogx(omega, response.phase_deg, color=_DATA, lw=1.2)
     coherence.semilogx(omega, response.coherence, color=_DATA, lw=1.2)
     if model is not None:
-        model_phase = np.degrees(np.unwrap(np.angle(model)))
-        # put the model's phase on the data's branch at the lowest frequency: 360° apart is the same phase
-        model_phase += 360.0 * np.round((response.phase_deg[0] - model_phase[0]) / 360.0)
+        model_phase = _nearest_branch(np.asarray(response.phase_deg, dtype=float),
+                                      np.degrees(np.unwrap(np.angle(model))))
         magnitude.semilogx(omega, 20 * np.log10(np.maximum(np.abs(model), 1e-300)), color=_MODEL, lw=1.2,
                            ls="--", label="model")
         phase.semilogx(omega, model_phase, color=_MODEL, lw=1.2, ls="--")
-        magnitude.legend(loc="best", fontsize=7, frameon=False)
     if response.fit_range is not None:
         for ax in panels:
             ax.axvspan(*response.fit_range, color=_RANGE, alpha=0.12, lw=0)
@@ -182,7 +217,9 @@ def _draw(panels: np.ndarray, response: FrequencyResponse, model: np.ndarray | N
     coherence.set_xlabel("frequency, rad/s")
     for ax in panels:
         ax.set_xlim(omega[0], omega[-1])
-        ax.xaxis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))  # fewer ticks: a dozen blocks draw in half the time
+        ax.xaxis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(FuncFormatter(_frequency_label))
+        ax.xaxis.set_minor_locator(NullLocator())  # few ticks: a dozen blocks draw in half the time
         ax.xaxis.set_minor_formatter(NullFormatter())
     for ax in panels[:2]:
-        ax.tick_params(labelbottom=False)
+        _hide_frequency_labels(ax)

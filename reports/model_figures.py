@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from typing import cast
 
 import numpy as np
-from matplotlib import colormaps, ticker
+from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
@@ -116,7 +116,7 @@ def response_figures(model: IdentifiedModel, *, min_coherence: float | None = No
         for r in responses:
             if r.output in linear.outputs and signal in linear.inputs:
                 overlays[r.pair] = pair_response(linear, r.output, signal, r.omega)
-        figure = _tidy_bode(bode_figure(responses, models=overlays, min_coherence=min_coherence))
+        figure = bode_figure(responses, models=overlays, min_coherence=min_coherence)
         axis = INPUT_AXES.get(signal, signal)
         conditioned = sorted({name for r in responses for name in r.conditioned_on})
         caption = (f"Responses to {signal} ({axis} mixer input): flight data (solid) and identified model "
@@ -130,45 +130,6 @@ def response_figures(model: IdentifiedModel, *, min_coherence: float | None = No
             caption += f"; no model overlay for {', '.join(missing)}"
         found.append((figure, caption + "."))
     return found
-
-
-def _frequency_label(value: float, _position: float) -> str:
-    return f"{value:g}"
-
-
-def _nearest_branch(data: np.ndarray, model: np.ndarray) -> np.ndarray:
-    """The model's phase moved by whole turns onto the data's branch, point by point (median of 9 points)."""
-    turns = np.round((data - model) / 360.0)
-    turns = np.where(np.isfinite(turns), turns, 0.0)
-    half = 4
-    padded = np.pad(turns, half, mode="edge")
-    steady = np.array([np.median(padded[k : k + 2 * half + 1]) for k in range(turns.size)])
-    return model + 360.0 * np.round(steady)
-
-
-def _tidy_bode(figure: Figure) -> Figure:
-    """Plain frequency ticks (0.5 1 2 5 10 ...), labels only under each block, model phase on the data's branch."""
-    shown = [ax for ax in figure.axes if ax.get_visible() and ax.get_xscale() == "log"]
-    columns: dict[float, list[Axes]] = {}
-    for ax in shown:
-        columns.setdefault(round(ax.get_position().x0, 2), []).append(ax)
-    bottom = {id(min(group, key=lambda a: a.get_position().y0)) for group in columns.values()}
-    for ax in shown:
-        ax.xaxis.set_major_locator(ticker.LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
-        ax.xaxis.set_major_formatter(ticker.FuncFormatter(_frequency_label))
-        ax.xaxis.set_minor_formatter(ticker.NullFormatter())
-        if id(ax) not in bottom:  # the panels of a figure share one frequency axis: label it once per column
-            ax.set_xlabel("")
-            ax.tick_params(axis="x", which="both", labelbottom=False)
-        lines = ax.get_lines()
-        if ax.get_ylabel().startswith("phase") and len(lines) >= 2 and lines[1].get_linestyle() == "--":
-            data, model = (np.asarray(line.get_ydata(), dtype=float) for line in lines[:2])
-            if data.shape == model.shape:
-                lines[1].set_ydata(_nearest_branch(data, model))
-                ax.relim()
-                ax.autoscale_view(scalex=False)
-    figure.tight_layout(h_pad=0.8, w_pad=2.0)
-    return figure
 
 
 def correlation_figure(names: Sequence[str], correlation: np.ndarray, *, threshold: float = 0.9) -> Figure:

@@ -28,11 +28,11 @@ from sysid.verify import Verification
 from .html import render_html, write_html
 from .model_figures import correlation_figure, pole_map_figure, response_figures
 from .svg import figure_svg
-from .validate_report import TIC_ACCEPTABLE, TIC_GOOD
-from .verify_figures import display_scale, verification_figures
+from .verify_section import TIC_ACCEPTABLE, TIC_GOOD, sized_svg, verification_context
 
 __all__ = ["J_AVE_GOOD", "J_AVE_ACCEPTABLE", "J_RESPONSE_MAX", "CR_MAX_PERCENT", "INSENSITIVITY_MAX_PERCENT",
-           "CORRELATION_FLAG", "Check", "Verdict", "model_verdict", "model_report_html", "write_model_report"]
+           "CORRELATION_FLAG", "TIC_GOOD", "TIC_ACCEPTABLE", "Check", "Verdict", "model_verdict",
+           "model_report_html", "write_model_report"]
 
 #: J_ave of a good fit (eq. 3.9; Tischler & Remple).
 J_AVE_GOOD = 100.0
@@ -142,7 +142,7 @@ def _verification_check(verification: Verification) -> Check | None:
     shown = f"{tic:.2f}" if round(tic, 2) not in (TIC_GOOD, TIC_ACCEPTABLE) else f"{tic:.3f}"
     problem = "" if grade == "good" else (f"the worst doublet prediction has TIC {shown} ({worst.name}), above "
                                           f"{TIC_GOOD:g}" + ("" if grade == "acceptable" else f"-{TIC_ACCEPTABLE:g}"))
-    return Check("prediction of doublets, worst output TIC", f"{shown} ({worst.name})",
+    return Check("prediction of doublets, worst on-axis output TIC", f"{shown} ({worst.name})",
                  f"≤ {TIC_GOOD:g}-{TIC_ACCEPTABLE:g}", grade, problem)
 
 
@@ -152,7 +152,9 @@ def model_verdict(model: IdentifiedModel, verification: Verification | None = No
     J_ave ≤ 100 is good and ≤ 150 acceptable; any single response cost
     above 200, or an estimated parameter with CR% > 20 or I% > 10, makes the
     model at best acceptable; when verified, the worst output's Theil
-    inequality coefficient must be ≤ 0.25 (good) or ≤ 0.3 (acceptable).
+    inequality coefficient must be ≤ 0.25 (good) or ≤ 0.3 (acceptable); only
+    the on-axis outputs of each doublet are judged (the off-axis ones are
+    shown for information).
 
     Parameters
     ----------
@@ -224,19 +226,17 @@ def _card(model: IdentifiedModel, verification: Verification | None,
     facts.setdefault("parameters", f"{counts['estimated']} estimated, {counts['fixed']} fixed, "
                                    f"{counts['dropped']} dropped by structure reduction")
     if verification is not None:
-        facts.setdefault("verification", f"{len(verification.records)} doublet records, overall TIC "
-                                         f"{verification.tic:.2f}, J_rms {verification.rmse:.3g}")
+        sources = ", ".join(dict.fromkeys(r.source.name for r in verification.records))
+        facts.setdefault("verification", f"{len(verification.records)} doublet records from {sources}, each judged "
+                                         f"on the outputs of its axis: overall TIC {verification.tic:.2f}, "
+                                         f"J_rms {verification.rmse:.3g}")
     facts.setdefault("identified", model.provenance.created_utc or "unknown")
     return list(facts.items())
 
 
 def _shown(figure: Any, caption: str) -> tuple[str, str, float]:
     """SVG, caption and width (% of the 7.5 in column), so every figure's text prints at one size."""
-    svg = figure_svg(figure)
-    head = svg[: svg.index(">")]
-    view = head.split('viewBox="', 1)[1].split('"', 1)[0].split() if 'viewBox="' in head else []
-    width_in = float(view[2]) / 72.0 if len(view) == 4 else 7.5
-    return svg, caption, round(min(100.0, 100.0 * width_in / 7.6), 1)
+    return sized_svg(figure_svg(figure), caption)
 
 
 @dataclass(frozen=True, slots=True)
@@ -262,18 +262,6 @@ class _CostRow:
     decades: float
     coherence: float
     conditioned: str
-
-
-@dataclass(frozen=True, slots=True)
-class _OutputRow:
-    name: str
-    unit: str
-    rmse: float
-    tic: float
-    grade: str
-    prediction_rmse: float | None
-    prediction_tic: float | None
-    n_records: int
 
 
 def _parameter_rows(model: IdentifiedModel) -> list[_ParameterRow]:
@@ -323,17 +311,6 @@ def _correlated(names: Sequence[str], matrix: Any) -> list[tuple[str, str, float
     return sorted(pairs, key=lambda item: -abs(item[2]))
 
 
-def _output_rows(verification: Verification) -> list[_OutputRow]:
-    rows = []
-    for s in verification.summary:
-        scale, unit = display_scale(s.unit)
-        grade = "good" if s.tic <= TIC_GOOD else "warn" if s.tic <= TIC_ACCEPTABLE else "bad"
-        rows.append(_OutputRow(s.name, unit, s.rmse * scale, s.tic, grade,
-                               None if s.prediction_rmse is None else s.prediction_rmse * scale, s.prediction_tic,
-                               s.n_records))
-    return rows
-
-
 def _flatten(options: Mapping[str, Any], prefix: str = "") -> list[tuple[str, str]]:
     rows: list[tuple[str, str]] = []
     for key, value in options.items():
@@ -343,21 +320,6 @@ def _flatten(options: Mapping[str, Any], prefix: str = "") -> list[tuple[str, st
         else:
             rows.append((name, value if isinstance(value, str) else json.dumps(value, default=str)))
     return rows
-
-
-def _verification_context(verification: Verification | None) -> dict[str, Any]:
-    if verification is None:
-        return {"verification": None}
-    return {
-        "verification": verification, "output_rows": _output_rows(verification),
-        "wind_rows": [(c.name, display_scale(c.unit)[1], c.rmse_without * display_scale(c.unit)[0],
-                       c.rmse_with * display_scale(c.unit)[0], c.reduction_percent)
-                      for c in verification.wind_correction],
-        "verification_figures": verification_figures(verification),
-        "notices": [f"{r.label}: {r.notice}" for r in verification.records if r.notice],
-        "offsets": [(r.label, dict(r.reference_shifts), {o.name: o.bias * display_scale(o.unit)[0] for o in r.outputs})
-                    for r in verification.records],
-    }
 
 
 def model_report_html(model: IdentifiedModel, *, verification: Verification | None = None, title: str | None = None,
@@ -416,7 +378,7 @@ def model_report_html(model: IdentifiedModel, *, verification: Verification | No
         "constants": [(k, v) for k, v in model.constants.items()],
         "data_text": ", ".join(Path(f).name for f in model.provenance.files) or "flight data not recorded in the file",
     }
-    context.update(_verification_context(verification))
+    context.update(verification_context(verification))
     if generated_utc is not None:
         context["generated_utc"] = generated_utc
     return render_html("model.html", **context)

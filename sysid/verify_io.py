@@ -29,7 +29,8 @@ __all__ = ["VERIFICATION_SCHEMA", "VERIFICATION_SCHEMA_VERSION", "SavedVerificat
            "verification_from_dict", "write_verification", "read_verification"]
 
 VERIFICATION_SCHEMA = "flight-sysid/verification"
-VERIFICATION_SCHEMA_VERSION = 1
+VERIFICATION_SCHEMA_VERSION = 2
+_READABLE_VERSIONS = (1, 2)  # version 1 had no excited input, off-axis outputs or off-axis summary
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,12 +91,12 @@ def _record_to_dict(r: RecordVerification) -> dict[str, Any]:
             "outputs": [_output_to_dict(o) for o in r.outputs],
             "reference_shifts": {k: _num(v) for k, v in r.reference_shifts.items()},
             "rmse": _num(r.rmse), "tic": _num(r.tic), "growth": _num(r.growth), "unstable": bool(r.unstable),
-            "notice": r.notice}
+            "notice": r.notice, "excited": r.excited, "off_axis": list(r.off_axis)}
 
 
 def verification_to_dict(verification: Verification, *, model: str = "", options: Mapping[str, Any] | None = None,
                          created_utc: str = "") -> dict[str, Any]:
-    """The JSON document of a verification (schema ``flight-sysid/verification`` version 1).
+    """The JSON document of a verification (schema ``flight-sysid/verification`` version 2).
 
     Parameters
     ----------
@@ -114,13 +115,17 @@ def verification_to_dict(verification: Verification, *, model: str = "", options
         JSON-compatible (non-finite numbers as None).
     """
     v = verification
+
+    def summaries(rows: tuple[OutputSummary, ...]) -> list[dict[str, Any]]:
+        return [{"name": s.name, "unit": s.unit, "rmse": _num(s.rmse), "tic": _num(s.tic), "n_records": s.n_records,
+                 "n_samples": s.n_samples, "prediction_rmse": _num(s.prediction_rmse),
+                 "prediction_tic": _num(s.prediction_tic)} for s in rows]
+
     return {
         "schema": VERIFICATION_SCHEMA, "schema_version": VERIFICATION_SCHEMA_VERSION,
         "model": model, "options": dict(options or {}), "created_utc": created_utc,
         "rmse": _num(v.rmse), "tic": _num(v.tic),
-        "summary": [{"name": s.name, "unit": s.unit, "rmse": _num(s.rmse), "tic": _num(s.tic),
-                     "n_records": s.n_records, "n_samples": s.n_samples, "prediction_rmse": _num(s.prediction_rmse),
-                     "prediction_tic": _num(s.prediction_tic)} for s in v.summary],
+        "summary": summaries(v.summary), "off_axis": summaries(v.off_axis),
         "records": [_record_to_dict(r) for r in v.records],
         "without_wind": [_record_to_dict(r) for r in v.without_wind],
         "wind_correction": [{"name": c.name, "unit": c.unit, "rmse_without": _num(c.rmse_without),
@@ -140,7 +145,13 @@ def _record_from_dict(d: Mapping[str, Any]) -> RecordVerification:
         d["label"], Path(d["source"]), _array(d["time_s"]), tuple(d["inputs"]),
         tuple(_output_from_dict(o) for o in d["outputs"]),
         {k: _float(v) for k, v in d["reference_shifts"].items()}, _float(d["rmse"]), _float(d["tic"]),
-        _float(d["growth"]), bool(d["unstable"]), d.get("notice", ""))
+        _float(d["growth"]), bool(d["unstable"]), d.get("notice", ""), d.get("excited"),
+        tuple(d.get("off_axis", ())))
+
+
+def _summary_from_dict(s: Mapping[str, Any]) -> OutputSummary:
+    return OutputSummary(s["name"], s["unit"], _float(s["rmse"]), _float(s["tic"]), int(s["n_records"]),
+                         int(s["n_samples"]), _optional(s.get("prediction_rmse")), _optional(s.get("prediction_tic")))
 
 
 def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> SavedVerification:
@@ -168,19 +179,18 @@ def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") ->
                             "histories; give a verification saved with its time histories (schema "
                             f"{VERIFICATION_SCHEMA})")
         raise DataError(f"{source}: not a flight-sysid verification file (schema {doc.get('schema')!r})")
-    if doc.get("schema_version") != VERIFICATION_SCHEMA_VERSION:
+    if doc.get("schema_version") not in _READABLE_VERSIONS:
         raise DataError(f"{source}: verification schema version {doc.get('schema_version')!r} is not supported "
-                        f"(this version reads {VERIFICATION_SCHEMA_VERSION})")
+                        f"(this version reads {', '.join(map(str, _READABLE_VERSIONS))})")
     try:
         verification = Verification(
             tuple(_record_from_dict(r) for r in doc["records"]),
-            tuple(OutputSummary(s["name"], s["unit"], _float(s["rmse"]), _float(s["tic"]), int(s["n_records"]),
-                                int(s["n_samples"]), _optional(s.get("prediction_rmse")),
-                                _optional(s.get("prediction_tic"))) for s in doc["summary"]),
+            tuple(_summary_from_dict(s) for s in doc["summary"]),
             _float(doc["rmse"]), _float(doc["tic"]),
             tuple(_record_from_dict(r) for r in doc.get("without_wind", [])),
             tuple(WindCorrection(c["name"], c["unit"], _float(c["rmse_without"]), _float(c["rmse_with"]))
-                  for c in doc.get("wind_correction", [])))
+                  for c in doc.get("wind_correction", [])),
+            tuple(_summary_from_dict(s) for s in doc.get("off_axis", [])))
         return SavedVerification(verification, str(doc.get("model", "")), dict(doc.get("options") or {}),
                                  str(doc.get("created_utc", "")))
     except (KeyError, TypeError, ValueError, AttributeError) as err:

@@ -17,6 +17,7 @@ Examples:
   sysid freqresp flight.h5 --pairs q/delta_lon,ax/delta_lon -o fr.h5 --plot fr.svg
   sysid freqresp sweeps/*.bin --wind mast.csv --wind-distance 4.6 --pairs ax/delta_lon,ax/wind_lon -o fr.h5
   sysid freqresp flight.h5 --windows 2,4,8,12,17 --overlap 0.5 --min-coherence 0.6 --omega-min 1 --omega-max 60
+  sysid freqresp px4_sweeps/*.ulg --reference none --no-whole-record -o fr.h5
 """
 
 
@@ -69,6 +70,13 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
               show_default=True, help="Coherence γ² a fit range must keep (0.6 for noisy data).")
 @click.option("--min-decades", type=click.FloatRange(min=0, min_open=True), default=0.3, show_default=True,
               help="Shortest fit range, decades.")
+@click.option("--reference", default="auto", show_default=True, metavar="auto|none|SIGNAL",
+              help="Injected excitation used as the mixer input's instrument, H = G_ry/G_rx: 'auto' uses the "
+                   "logged `excitation` (ArduPilot SIDD) where every piece of an axis carries it, else the mixer "
+                   "input (PX4); 'none' never; or a signal name on every axis.")
+@click.option("--whole-record/--no-whole-record", default=True, show_default=True,
+              help="Add the records' whole-length transforms to the composite (free of the windows' resolution "
+                   "bias; needs more maneuver pieces than inputs).")
 @click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
               help="Write the responses (fit range set on those kept) to this HDF5 file.")
 @click.option("--plot", type=click.Path(dir_okay=False, writable=True, path_type=Path),
@@ -79,18 +87,22 @@ def freqresp(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_dista
              wind_offset: float | None, pairs: tuple[tuple[str, str], ...] | None,
              axis: str | None, kind: str, omega_min: float, omega_max: float, n_freq: int,
              windows: tuple[float, ...] | None, overlap: float, min_coherence: float, min_decades: float,
-             out: Path | None, plot: Path | None, json_path: str | None, quiet: bool) -> None:
+             reference: str, whole_record: bool, out: Path | None, plot: Path | None, json_path: str | None,
+             quiet: bool) -> None:
     """Compute composite (multi-window, chirp-z) frequency responses from the maneuvers of a DATASET
     (`sysid ingest -o`) or of LOGs ingested on the fly, gate them by coherence, and write them."""
     from sysid.freqresp import ResponseOptions, flight_responses, gate_responses, write_responses
 
+    forced = None if reference in ("auto", "none") else reference
     try:
         options = ResponseOptions(omega_min=omega_min, omega_max=omega_max, n_freq=n_freq, window_lengths_s=windows,
-                                  overlap=overlap, min_coherence=min_coherence, min_decades=min_decades)
+                                  overlap=overlap, min_coherence=min_coherence, min_decades=min_decades,
+                                  reference=forced, whole_record=whole_record)
     except ValueError as err:
         raise click.UsageError(str(err)) from None
     flights = _flights(sources, wind_paths, wind_distance, wind_offset, quiet=quiet)
-    computed = flight_responses(flights, pairs, axis=axis, kind=kind, options=options)
+    computed = flight_responses(flights, pairs, axis=axis, kind=kind, options=options,
+                                use_excitation=reference != "none")
     gated = gate_responses(computed.responses, min_coherence=min_coherence, min_decades=min_decades)
     kept = {response.pair: response for response in gated.kept}
     ordered = [kept.get(response.pair, response) for response in computed.responses]
@@ -100,7 +112,8 @@ def freqresp(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_dista
         write_bode_svg(plot, ordered, min_coherence=min_coherence)
     if out is not None:
         write_responses(out, ordered)
-    summary = _summary(ordered, gated.dropped, dict(computed.pieces), options, out, plot)
+    summary = _summary(ordered, gated.dropped, dict(computed.pieces), options, out, plot) | {
+        "notes": list(computed.notes)}
     if not quiet:
         _print_summary(summary, to_stderr=json_path == "-")
     emit_json(summary, json_path)
@@ -147,7 +160,8 @@ def _summary(responses: list[Any], dropped: tuple[Any, ...], pieces: dict[str, i
             "pair": response.pair, "input": response.input, "output": response.output,
             "kept": response.fit_range is not None, "fit_range_rad_s": None, "mean_coherence": None,
             "reason": reasons.get(response.pair), "windows_s": [round(t, 4) for t in response.windows_s],
-            "conditioned_on": list(response.conditioned_on),
+            "conditioned_on": list(response.conditioned_on), "reference": response.reference,
+            "whole_record": response.whole_record,
         }
         if response.fit_range is not None:
             lo, hi = response.fit_range
@@ -159,7 +173,8 @@ def _summary(responses: list[Any], dropped: tuple[Any, ...], pieces: dict[str, i
         "responses": entries, "pieces": pieces,
         "options": {"omega_min": options.omega_min, "omega_max": options.omega_max, "n_freq": options.n_freq,
                     "overlap": options.overlap, "min_coherence": options.min_coherence,
-                    "min_decades": options.min_decades},
+                    "min_decades": options.min_decades, "reference": options.reference,
+                    "whole_record": options.whole_record},
         "output": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
     }
 
@@ -170,6 +185,8 @@ def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
 
     for axis, count in summary["pieces"].items():
         say(f"{axis}: {count} maneuver piece(s)")
+    for note in summary["notes"]:
+        say(f"  {note}")
     for entry in summary["responses"]:
         if entry["kept"]:
             lo, hi = entry["fit_range_rad_s"]

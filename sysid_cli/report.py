@@ -87,8 +87,8 @@ def _read_json(path: Path) -> Any:
 def report(model_path: Path, validation_path: Path | None, out: Path | None, ingest_path: Path | None,
            title: str | None, json_path: str | None, quiet: bool) -> None:
     """Write the HTML report of MODEL.json (as 'sysid fit --report' does): verdict, responses with the model,
-    parameters, costs, correlations, modes; with VALIDATION.json (a saved verification, as 'sysid demo'
-    writes), also the doublets predicted with and without the wind term. One self-contained file."""
+    parameters, costs, correlations, modes; with VALIDATION.json (a saved verification, as 'sysid validate -o'
+    and 'sysid demo' write), also the doublets predicted with and without the wind term. One self-contained file."""
     from reports.model_report import model_report_html, model_verdict
     from reports.html import write_html
     from sysid.fit import read_model

@@ -15,8 +15,9 @@ __all__ = ["validate"]
 _EPILOG = """\b
 Examples:
   sysid validate model.json doublets/*.ulg --report validate.html
-  sysid validate model.json doublets/*.bin --wind anemometer.csv --wind-distance 4.6 --json -
+  sysid validate model.json doublets/*.bin --wind anemometer.csv --wind-distance 4.6 -o validation.json --json -
   sysid validate model.json flight.bin --segments doublets.toml --initial-state estimated --report v.html
+  sysid report model.json validation.json -o report.html    # the report again, from the saved files
 """
 
 
@@ -39,21 +40,28 @@ Examples:
 @click.option("--initial-state", type=click.Choice(["measured", "estimated", "zero"]), default="measured",
               show_default=True, help="Start each simulation from the measured states, from those corrected by "
                                       "least squares, or from zero.")
+@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+              help="Save the verification with its time histories (JSON) for 'sysid report'.")
 @click.option("--report", type=click.Path(dir_okay=False, writable=True, path_type=Path),
-              help="Write the HTML validation report here.")
+              help="Write the HTML model report, with this verification, here.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
 def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_distance: float | None,
              transport_delay: float | None, wind_offset: float | None, segments_file: Path | None, before_s: float,
-             after_s: float, initial_state: str, report: Path | None, json_path: str | None, quiet: bool) -> None:
-    """Simulate MODEL.json from the measured inputs of every doublet in LOGS and report the RMS error and Theil
-    inequality coefficient per output (with bias and reference shift estimated, as VERIFY does); with --wind,
-    also how much the wind term G_w reduces the error."""
+             after_s: float, initial_state: str, out: Path | None, report: Path | None, json_path: str | None,
+             quiet: bool) -> None:
+    """Simulate MODEL.json from all the measured inputs of every doublet in LOGS and report the RMS error and
+    Theil inequality coefficient per output (with bias and reference shift estimated, as VERIFY does), judging
+    each doublet on the outputs of the axis it excites; with --wind, also how much the wind term G_w reduces
+    the error."""
+    import datetime as dt
+
     from flightlogs.condition import ConditioningOptions
     from flightlogs.segments import read_segments_file
-    from reports.validate_report import write_validate_report
+    from reports.model_report import write_model_report
     from sysid.fit import read_model
-    from sysid.verify import VerificationOptions, verify_logs
+    from sysid.verify import VerificationOptions, axis_outputs, verify_logs
+    from sysid.verify_io import write_verification
 
     identified = read_model(model_path)
     model = identified.linear_model(include_wind=False)
@@ -68,12 +76,18 @@ def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, .
     options = VerificationOptions(initial_state=initial_state)  # type: ignore[arg-type]
     with progress_bar("reading", quiet=quiet) as bar:
         verification = verify_logs(model, list(logs), wind_model=with_wind if has_wind and wind_paths else None,
-                                   wind_paths=list(wind_paths), conditioning=conditioning, options=options,
-                                   before_s=before_s, after_s=after_s,
+                                   wind_paths=list(wind_paths), axes=axis_outputs(identified),
+                                   conditioning=conditioning, options=options, before_s=before_s, after_s=after_s,
                                    progress=lambda _name, done, total: bar(done, total))
+    saved = {"initial_state": initial_state, "before_s": before_s, "after_s": after_s,
+             "inputs": "all measured", "judged": "on-axis outputs of each doublet's axis",
+             "logs": [p.name for p in logs], "wind": [p.name for p in wind_paths]}
+    if out is not None:
+        created = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+        write_verification(out, verification, model=model_path.name, options=saved, created_utc=created)
     if report is not None:
-        write_validate_report(report, verification, model_name=model_path.name, logs=logs)
-    summary = _summary(verification, model_path, logs, report, notes)
+        write_model_report(report, identified, verification=verification, verification_options=saved)
+    summary = _summary(verification, model_path, logs, report, notes) | {"output": str(out) if out else None}
     if not quiet:
         _print(summary, to_stderr=json_path == "-")
     emit_json(summary, json_path)
@@ -87,10 +101,14 @@ def _summary(verification: Any, model_path: Path, logs: tuple[Path, ...], report
         "records": [{"label": r.label, "source": str(r.source), "start_s": float(r.time_s[0]),
                      "end_s": float(r.time_s[-1]), "rmse": r.rmse, "tic": r.tic, "unstable": r.unstable,
                      "growth": r.growth, "notice": r.notice, "reference_shifts": dict(r.reference_shifts),
-                     "bias": {o.name: o.bias for o in r.outputs}} for r in verification.records],
+                     "bias": {o.name: o.bias for o in r.outputs}, "excited": r.excited,
+                     "on_axis": [o.name for o in r.judged], "off_axis": list(r.off_axis)}
+                    for r in verification.records],
         "summary": {s.name: {"unit": s.unit, "rmse": s.rmse, "tic": s.tic, "records": s.n_records,
                              "one_step_rmse": s.prediction_rmse, "one_step_tic": s.prediction_tic}
                     for s in verification.summary},
+        "off_axis": {s.name: {"unit": s.unit, "rmse": s.rmse, "tic": s.tic, "records": s.n_records}
+                     for s in verification.off_axis},
         "overall": {"rmse": verification.rmse, "tic": verification.tic},
         "unstable": verification.unstable,
         "report": str(report) if report is not None else None,
@@ -107,7 +125,7 @@ def _print(summary: dict[str, Any], *, to_stderr: bool) -> None:
     def say(text: str = "") -> None:
         click.echo(text, err=to_stderr)
 
-    say(f"{summary['model']}: {len(summary['records'])} records")
+    say(f"{summary['model']}: {len(summary['records'])} records, each judged on the outputs of its axis")
     wind = summary.get("wind_correction", {})
     header = f"  {'output':<8} {'unit':<8} {'RMS error':>10} {'TIC':>6}"
     say(header + (f" {'without G_w':>12} {'reduction':>9}" if wind else ""))
@@ -117,10 +135,20 @@ def _print(summary: dict[str, Any], *, to_stderr: bool) -> None:
             reduction = wind[name]["reduction_percent"]
             line += f" {wind[name]['rmse_without']:>12.4g} {reduction:>8.1f}%" if math.isfinite(reduction) else ""
         say(line)
+    unstable = [r for r in summary["records"] if r["unstable"]]
+    if len(unstable) > 1:  # one note, not the same sentence per record
+        growth = max(r["growth"] for r in unstable)
+        say(f"  note: the model is unstable open loop and grows up to {growth:.0f}-fold over {len(unstable)} records "
+            f"({'; '.join(r['label'] for r in unstable)}): small input or initial-state errors diverge there, so "
+            "judge them also by the one-step-ahead prediction error (one_step_* in --json)")
     for record in summary["records"]:
-        if record["notice"]:
+        if record["notice"] and (len(unstable) < 2 or not record["unstable"]):
             say(f"  note: {record['label']}: {record['notice']}")
     for note in summary["notes"]:
         say(f"  note: {note}")
-    if summary["report"]:
-        say(f"wrote {summary['report']}")
+    if summary["off_axis"]:
+        say("  off-axis (not judged): " + ", ".join(f"{name} TIC {row['tic']:.2f}"
+                                                    for name, row in summary["off_axis"].items()))
+    for path in (summary["output"], summary["report"]):
+        if path:
+            say(f"wrote {path}")

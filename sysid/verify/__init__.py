@@ -2,17 +2,18 @@
 
 See :mod:`sysid.verify.engine` for the method (Tischler's VERIFY: bias and
 reference shift, RMS error and Theil inequality coefficient; chapter 3.5.3 of
-the dissertation for the wind correction of Table 3.6).
+the dissertation for the wind correction of Table 3.6). Each record is
+simulated from all measured inputs and judged on the outputs of the axis it
+excites (:func:`axis_outputs`).
 """
 
 from .engine import VerificationOptions, verify, verify_record
 from .logs import verify_logs
 from .records import DoubletRecords, doublet_records
-from .submodel import driven_part
+from .submodel import axis_outputs, driven_part
 from .results import (OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, rms_error,
                       theil_inequality)
 
-__all__ = ["VerificationOptions", "verify_record", "verify", "verify_logs", "driven_part", "doublet_records",
-           "DoubletRecords",
-           "OutputVerification", "RecordVerification", "OutputSummary", "WindCorrection", "Verification",
-           "rms_error", "theil_inequality"]
+__all__ = ["VerificationOptions", "verify_record", "verify", "verify_logs", "driven_part", "axis_outputs",
+           "doublet_records", "DoubletRecords", "OutputVerification", "RecordVerification", "OutputSummary",
+           "WindCorrection", "Verification", "rms_error", "theil_inequality"]

@@ -12,24 +12,30 @@ Per record:
    actuator lag at its input), or at zero where that is undetermined
    (``initial_state="estimated"`` also fits a correction to it in step 4,
    which absorbs a trim that is not an equilibrium; ``"zero"`` starts at 0);
-3. the model is simulated from the measured inputs, ``y_model(u)``;
+3. the model is simulated from *all* its measured inputs, ``y_model(u)``:
+   during a doublet on one axis the autopilot keeps flying the others (and
+   counters the wind with thrust), and leaving those commands out would
+   blame the model for what the pilot did;
 4. as in VERIFY, a constant reference shift ``Δu`` per input and a bias
    ``b`` per output are estimated by linear least squares on
    ``y_meas ≈ y_model(u) + Σ Δu_j s_j + b``, where ``s_j`` is the
    simulated response to a unit constant on input j from zero state, so a
    trim or sensor offset is not blamed on the dynamics;
-5. RMS error and Theil inequality coefficient per output, and overall as
-   Tischler's J_rms with angles and angular rates in degrees;
-6. an open-loop unstable model (``max Re λ > 0``) amplifies any error by
-   ``exp(Re λ · T)`` over a record of length T: when that exceeds
-   `max_growth` the record is flagged and the one-step-ahead prediction
-   error is reported as well (each step starts from the measured states,
-   the unmeasured ones from the model, as in the residual of eq. 3.14).
+5. RMS error and Theil inequality coefficient per output; a record that
+   excites one axis is judged on that axis' outputs only (`on_axis`; the
+   others are kept for information as off-axis), overall as Tischler's
+   J_rms with angles and angular rates in degrees;
+6. an open-loop unstable model (``max Re λ > 0`` of the states the judged
+   outputs depend on) amplifies any error by ``exp(Re λ · T)`` over a record
+   of length T: when that exceeds `max_growth` the record is flagged and the
+   one-step-ahead prediction error is reported as well (each step starts from
+   the measured states, the unmeasured ones from the model, as in the
+   residual of eq. 3.14).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -40,8 +46,8 @@ from flightlogs.record import Record
 
 from ..statespace import DelayedStateSpace
 from ._discrete import DiscreteModel, delayed_inputs, discretize, predict_one_step, simulate
-from .results import (OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, rms_error,
-                      theil_inequality)
+from .results import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, rms_error
+from .results import theil_inequality
 from .submodel import driven_part
 
 __all__ = ["VerificationOptions", "verify_record", "verify"]
@@ -155,10 +161,18 @@ def _offsets(residual: np.ndarray, regressors: list[np.ndarray], weights: np.nda
     return [solution[a:b] for a, b in zip(bounds[:-1], bounds[1:])]
 
 
-def _growth(model: DelayedStateSpace, duration_s: float) -> float:
-    if len(model.states) == 0:
+def _growth(model: DelayedStateSpace, judged: Sequence[int], duration_s: float) -> float:
+    """Open-loop growth over the record of the states the judged outputs depend on (through C and A)."""
+    a, c = np.asarray(model.a, dtype=float), np.asarray(model.c, dtype=float)
+    seen = np.any(c[list(judged)] != 0, axis=0) if len(model.states) else np.zeros(0, dtype=bool)
+    while seen.size:
+        grown = seen | np.any(a[seen] != 0, axis=0)
+        if np.array_equal(grown, seen):
+            break
+        seen = grown
+    if not seen.any():
         return 1.0
-    rate = float(np.max(np.linalg.eigvals(np.asarray(model.a, dtype=float)).real))
+    rate = float(np.max(np.linalg.eigvals(a[np.ix_(seen, seen)]).real))
     return float(np.exp(min(max(rate, 0.0) * duration_s, 700.0)))
 
 
@@ -177,17 +191,23 @@ def _overall(measured: np.ndarray, simulated: np.ndarray, weights: np.ndarray) -
     return rms_error(measured * weights, simulated * weights), theil_inequality(measured * weights, simulated * weights)
 
 
-def verify_record(model: DelayedStateSpace, record: Record, *,
+def verify_record(model: DelayedStateSpace, record: Record, *, on_axis: Sequence[str] | None = None,
+                  excited: str | None = None,
                   options: VerificationOptions = VerificationOptions()) -> RecordVerification:
     """Simulate `model` from the measured inputs of `record` and compare its outputs.
 
     Parameters
     ----------
     model : DelayedStateSpace
-        Perturbation model; its inputs and the outputs to verify must be
+        Perturbation model; all its inputs and the outputs to verify must be
         record columns (outputs that are not are skipped).
     record : Record
         A stretch of flight not used in the fit (a doublet), trim removed.
+    on_axis : sequence of str, optional
+        The outputs to judge the record on (the excited axis'); the others
+        are reported as off-axis, for information. Default: every output.
+    excited : str, optional
+        The input the record excites, kept with the result.
     options : VerificationOptions, optional
         Bias, reference shift, initial state and instability choices.
 
@@ -198,7 +218,7 @@ def verify_record(model: DelayedStateSpace, record: Record, *,
     Raises
     ------
     DataError
-        If the record lacks a model input or every model output.
+        If the record lacks a model input, or every model output to judge.
 
     Examples
     --------
@@ -217,9 +237,11 @@ def verify_record(model: DelayedStateSpace, record: Record, *,
     (0.1, True)
     """
     outputs = [k for k, name in enumerate(model.outputs) if name in record.signals]
-    if not outputs:
+    wanted = tuple(model.outputs) if on_axis is None else tuple(on_axis)
+    judged = [j for j, k in enumerate(outputs) if model.outputs[k] in wanted]
+    if not judged:
         raise DataError(f"{record.source.name}: record {record.label!r} has none of the model outputs "
-                        f"{', '.join(model.outputs)}")
+                        f"{', '.join(wanted)}")
     inputs = _signals(record, model.inputs, "inputs")
     disc = discretize(model, 1.0 / record.rate_hz)
     measured = np.column_stack([record[model.outputs[k]] for k in outputs])
@@ -228,21 +250,22 @@ def verify_record(model: DelayedStateSpace, record: Record, *,
     x0 = _initial_state(model, disc, record, inputs, options)
     raw = simulate(disc, inputs, x0)[:, outputs]
     simulated, shifts, biases, correction = _fit_offsets(model, disc, raw, measured, outputs, weights, options)
-    growth = _growth(model, record.end_s - record.start_s)
+    growth = _growth(model, [outputs[j] for j in judged], record.end_s - record.start_s)
     unstable = growth > options.max_growth
     predicted = None
     if options.one_step == "always" or (options.one_step == "auto" and unstable):
         predicted = _one_step(model, disc, record, inputs, x0 + correction, outputs, measured)
     results = tuple(_output(model.outputs[k], units[j], measured[:, j], simulated[:, j], float(biases[j]),
                             None if predicted is None else predicted[:, j]) for j, k in enumerate(outputs))
-    rmse, tic = _overall(measured, simulated, weights)
+    rmse, tic = _overall(measured[:, judged], simulated[:, judged], weights[judged])
     notice = ""
     if unstable:
         notice = (f"the model is unstable open loop and grows {growth:.0f}-fold over this "
                   f"{record.end_s - record.start_s:.1f} s record (limit {options.max_growth:g}): small input or "
                   "initial-state errors diverge, so judge it also by the one-step-ahead prediction error")
+    off_axis = tuple(o.name for j, o in enumerate(results) if j not in judged)
     return RecordVerification(record.label, record.source, record.time_s, tuple(model.inputs), results, shifts,
-                              rmse, tic, growth, unstable, notice)
+                              rmse, tic, growth, unstable, notice, excited, off_axis)
 
 
 def _fit_offsets(model: DelayedStateSpace, disc: DiscreteModel, raw: np.ndarray, measured: np.ndarray,
@@ -272,11 +295,15 @@ def _output(name: str, unit: str, measured: np.ndarray, simulated: np.ndarray, b
         None if predicted is None else theil_inequality(measured, predicted))
 
 
-def _pooled(records: Sequence[RecordVerification]) -> tuple[OutputSummary, ...]:
-    names = list(dict.fromkeys(o.name for r in records for o in r.outputs))
+def _pooled(records: Sequence[RecordVerification], *, judged: bool = True) -> tuple[OutputSummary, ...]:
+    """Per output, pooled over the records where it is judged (or, with ``judged=False``, off-axis)."""
+    picked = [(r, r.judged if judged else r.informative) for r in records]
+    names = list(dict.fromkeys(o.name for _, outputs in picked for o in outputs))  # on-axis: grouped by axis
+    if not judged:  # off-axis: in model order
+        names = [n for n in dict.fromkeys(o.name for r in records for o in r.outputs) if n in names]
     summaries = []
     for name in names:
-        pieces = [r.output(name) for r in records if any(o.name == name for o in r.outputs)]
+        pieces = [o for _, outputs in picked for o in outputs if o.name == name]
         measured = np.concatenate([p.measured for p in pieces])
         simulated = np.concatenate([p.simulated for p in pieces])
         with_prediction = [p for p in pieces if p.predicted is not None]
@@ -292,15 +319,18 @@ def _pooled(records: Sequence[RecordVerification]) -> tuple[OutputSummary, ...]:
 
 
 def _overall_pooled(records: Sequence[RecordVerification]) -> tuple[float, float]:
-    measured = np.concatenate([o.measured * _weight(o.unit) for r in records for o in r.outputs])
-    simulated = np.concatenate([o.simulated * _weight(o.unit) for r in records for o in r.outputs])
+    measured = np.concatenate([o.measured * _weight(o.unit) for r in records for o in r.judged])
+    simulated = np.concatenate([o.simulated * _weight(o.unit) for r in records for o in r.judged])
     return rms_error(measured, simulated), theil_inequality(measured, simulated)
 
 
 def verify(model: DelayedStateSpace, records: Sequence[Record], *, wind_model: DelayedStateSpace | None = None,
-           excited: Sequence[str | None] | None = None,
+           excited: Sequence[str | None] | None = None, axes: Mapping[str, Sequence[str]] | None = None,
            options: VerificationOptions = VerificationOptions()) -> Verification:
     """Verify a model on several records, with and without its wind term.
+
+    Every record is simulated from all the model's measured inputs; a record
+    that excites one axis is judged on that axis' outputs only.
 
     Parameters
     ----------
@@ -311,12 +341,16 @@ def verify(model: DelayedStateSpace, records: Sequence[Record], *, wind_model: D
     wind_model : DelayedStateSpace, optional
         The same model with G_w (wind inputs such as ``wind_lon``); then
         `Verification.records` holds it, `without_wind` the model without,
-        and `wind_correction` compares them per output.
+        and `wind_correction` compares them per on-axis output.
     excited : sequence of (str or None), optional
-        Per record, the input it excites (``"delta_lon"``): only the part of
-        the model that input drives is verified there (:func:`driven_part`),
-        so a lon doublet is not judged on the lateral outputs. None verifies
-        the whole model.
+        Per record, the input it excites (``"delta_lon"``): the record is
+        judged on that input's on-axis outputs (`axes`), the others are
+        reported as off-axis. None judges a record on every output.
+    axes : Mapping[str, sequence of str], optional
+        On-axis outputs of each excited input (:func:`axis_outputs` of an
+        identified model); default: the outputs it drives in `model`
+        (:func:`driven_part`), right for a model of decoupled axes but not
+        for one whose trim terms couple them.
     options : VerificationOptions, optional
         Choices shared by every record.
 
@@ -327,25 +361,31 @@ def verify(model: DelayedStateSpace, records: Sequence[Record], *, wind_model: D
     Raises
     ------
     DataError
-        If there are no records, or a record lacks a model input or every output.
+        If there are no records, or a record lacks a model input or every output to judge.
+    ModelError
+        If an excited input is not a model input.
     """
     if not records:
         raise DataError("no records to verify the model on")
     picks = list(excited) if excited is not None else [None] * len(records)
     if len(picks) != len(records):
         raise ValueError(f"excited has {len(picks)} entries for {len(records)} records")
+    judged: dict[str, tuple[str, ...]] = {}
+    for pick in dict.fromkeys(p for p in picks if p is not None):
+        judged[pick] = tuple(axes[pick]) if axes is not None and pick in axes else driven_part(model, pick).outputs
 
     def run(which: DelayedStateSpace) -> tuple[RecordVerification, ...]:
-        return tuple(verify_record(which if pick is None else driven_part(which, pick), record, options=options)
-                     for record, pick in zip(records, picks))
+        return tuple(verify_record(which, record, on_axis=None if pick is None else judged[pick], excited=pick,
+                                   options=options) for record, pick in zip(records, picks))
 
     without = run(model)
     final = run(wind_model) if wind_model is not None else without
     summary = _pooled(final)
+    off_axis = _pooled(final, judged=False)
     rmse, tic = _overall_pooled(final)
     if wind_model is None:
-        return Verification(final, summary, rmse, tic)
+        return Verification(final, summary, rmse, tic, off_axis=off_axis)
     before = {s.name: s for s in _pooled(without)}
     corrections = tuple(WindCorrection(s.name, s.unit, before[s.name].rmse, s.rmse)
                         for s in summary if s.name in before)
-    return Verification(final, summary, rmse, tic, without, corrections)
+    return Verification(final, summary, rmse, tic, without, corrections, off_axis)

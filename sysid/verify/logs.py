@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from flightlogs.campaign import ingest_campaign
@@ -23,6 +23,7 @@ def verify_logs(
     *,
     wind_model: DelayedStateSpace | None = None,
     wind_paths: Sequence[Path] = (),
+    axes: Mapping[str, Sequence[str]] | None = None,
     conditioning: ConditioningOptions = ConditioningOptions(),
     options: VerificationOptions = VerificationOptions(),
     before_s: float = 0.5,
@@ -41,6 +42,9 @@ def verify_logs(
         The model with G_w; needs `wind_paths`.
     wind_paths : sequence of Path, optional
         Anemometer CSV files or folders of them.
+    axes : Mapping[str, sequence of str], optional
+        On-axis outputs of each mixer input (:func:`sysid.verify.axis_outputs`);
+        each doublet is judged on its axis' outputs (see :func:`sysid.verify.verify`).
     conditioning : ConditioningOptions, optional
         Alignment, rate and segment choices (as for ``sysid ingest``).
     options : VerificationOptions, optional
@@ -73,4 +77,4 @@ def verify_logs(
                         "validation needs doublets not used in the fit (give their times with --segments if "
                         "they were not detected)")
     return verify(model, [cut.records[k] for k in kept], wind_model=wind_model,
-                  excited=[cut.excited[k] for k in kept], options=options)
+                  excited=[cut.excited[k] for k in kept], axes=axes, options=options)

@@ -150,6 +150,11 @@ class RecordVerification:
         reported as well.
     notice : str, optional
         Why the record is flagged, for people; empty when it is not.
+    excited : str or None, optional
+        The mixer input the record excites (``"delta_lon"``), when known.
+    off_axis : tuple of str, optional
+        Outputs shown for information only: not of the excited axis, so not
+        judged (left out of `rmse`, `tic` and the pooled summary); default none.
     """
 
     label: str
@@ -163,11 +168,19 @@ class RecordVerification:
     growth: float
     unstable: bool
     notice: str = ""
+    excited: str | None = None
+    off_axis: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         time_s = np.asarray(self.time_s, dtype=float)
         if time_s.ndim != 1:
             raise ValueError(f"record {self.label!r}: time_s must be 1-D")
+        names = [o.name for o in self.outputs]
+        unknown = [n for n in self.off_axis if n not in names]
+        if unknown or (self.outputs and len(set(self.off_axis)) == len(names)):
+            raise ValueError(f"record {self.label!r}: off_axis {tuple(self.off_axis)} must name some, not all, of "
+                             f"its outputs {tuple(names)}")
+        object.__setattr__(self, "off_axis", tuple(self.off_axis))
         for output in self.outputs:
             if output.measured.shape != time_s.shape:
                 raise ValueError(f"record {self.label!r}: output {output.name} has {output.measured.size} samples, "
@@ -192,6 +205,16 @@ class RecordVerification:
             if output.name == name:
                 return output
         raise KeyError(f"record {self.label!r} has no verified output {name!r}")
+
+    @property
+    def judged(self) -> tuple[OutputVerification, ...]:
+        """The outputs of the excited axis, which the record is judged on."""
+        return tuple(o for o in self.outputs if o.name not in self.off_axis)
+
+    @property
+    def informative(self) -> tuple[OutputVerification, ...]:
+        """The off-axis outputs, shown for information only."""
+        return tuple(o for o in self.outputs if o.name in self.off_axis)
 
 
 @dataclass(frozen=True, slots=True)
@@ -273,15 +296,18 @@ class Verification:
     records : tuple of RecordVerification
         The model verified, per record (the wind model when one was given).
     summary : tuple of OutputSummary
-        Per output, pooled over `records`.
+        Per output, pooled over the records where it is on-axis (judged).
     rmse : float
-        Overall weighted RMS error J_rms over every record and output.
+        Overall weighted RMS error J_rms over every record's on-axis outputs.
     tic : float
         Overall Theil inequality coefficient on the same weighted signals.
     without_wind : tuple of RecordVerification, optional
         The model without G_w on the same records, when a wind model was given.
     wind_correction : tuple of WindCorrection, optional
-        Per output common to both models.
+        Per output common to both models, over the records where it is on-axis.
+    off_axis : tuple of OutputSummary, optional
+        Per output, pooled over the records where it is off-axis: for
+        information, not judged.
     """
 
     records: tuple[RecordVerification, ...]
@@ -290,6 +316,11 @@ class Verification:
     tic: float
     without_wind: tuple[RecordVerification, ...] = ()
     wind_correction: tuple[WindCorrection, ...] = ()
+    off_axis: tuple[OutputSummary, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.without_wind and len(self.without_wind) != len(self.records):
+            raise ValueError(f"{len(self.without_wind)} records without wind for {len(self.records)} records")
 
     @property
     def unstable(self) -> bool:

@@ -1,6 +1,9 @@
-"""The part of a model of several decoupled axes that one excited input drives."""
+"""Which part of a model one excited input drives, and so which outputs a record excites is judged on."""
 
 from __future__ import annotations
+
+import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -8,7 +11,10 @@ from flightlogs.errors import ModelError
 
 from ..statespace import DelayedStateSpace
 
-__all__ = ["driven_part"]
+if TYPE_CHECKING:
+    from ..fit import IdentifiedModel
+
+__all__ = ["driven_part", "axis_outputs"]
 
 
 def driven_part(model: DelayedStateSpace, excited: str) -> DelayedStateSpace:
@@ -52,3 +58,42 @@ def driven_part(model: DelayedStateSpace, excited: str) -> DelayedStateSpace:
         a[np.ix_(x, x)], b[np.ix_(x, u)], c[np.ix_(y, x)], d[np.ix_(y, u)],
         tuple(model.states[i] for i in x), tuple(model.inputs[j] for j in u), tuple(model.outputs[i] for i in y),
         np.asarray(model.input_delays_s, dtype=float)[u], model.trim)
+
+
+def axis_outputs(model: IdentifiedModel) -> dict[str, tuple[str, ...]]:
+    """The on-axis outputs of each control input of an identified model, read from its structure.
+
+    The outputs each input drives (:func:`driven_part`) in the model rebuilt
+    with every trim-linked constant (``U0 V0 W0 phi0 theta0``, eq. 3.5) at
+    its declared value, zero for the built-in structures: the trim terms
+    couple the axes of a hovering vehicle weakly, which must not make a yaw
+    doublet judged on the lateral outputs. For the hover structures this
+    gives lon ``u q theta ax``, lat ``v p phi ay``, yaw ``r``, heave ``w az``.
+
+    Parameters
+    ----------
+    model : IdentifiedModel
+        The identified model (its structure and values; the wind inputs are left out).
+
+    Returns
+    -------
+    dict of str to tuple of str
+        Control input name (``"delta_lon"``) to its outputs, in model order.
+
+    Examples
+    --------
+    >>> from importlib import resources
+    >>> from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate
+    >>> from sysid.model import parse_structure
+    >>> text = (resources.files("sysid.model") / "builtin" / "hover.toml").read_text()
+    >>> parameters = tuple(ParameterEstimate(p.name, p.value) for p in parse_structure(text).parameters)
+    >>> hover = IdentifiedModel("hover", text, parameters, (), np.zeros((0, 0)), CostSummary(1.0),
+    ...                         constants={"g": 9.81, "U0": 1.4, "V0": -2.3, "W0": 0.1, "phi0": 0.0, "theta0": 0.0})
+    >>> axis_outputs(hover)["delta_yaw"], axis_outputs(hover)["delta_thr"]
+    (('r',), ('w', 'az'))
+    """
+    structure = model.structure
+    constants = {c.name: c.value if c.trim is not None else float(model.constants.get(c.name, c.value))
+                 for c in structure.constants}
+    nominal = dataclasses.replace(model, constants=constants).linear_model(include_wind=False)
+    return {name: driven_part(nominal, name).outputs for name in dict.fromkeys(nominal.inputs)}

@@ -8,11 +8,13 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from markupsafe import escape
 
 from flightlogs.store import read_dataset
 from reports.model_report import model_verdict
 from sysid.fit import read_model
 from sysid.sim.scenarios import write_demo_flight
+from sysid.verify import axis_outputs
 from sysid.verify_io import read_verification
 from sysid_cli.main import cli
 
@@ -69,10 +71,18 @@ def test_demo_ends_with_the_report_and_sysid_report_rebuilds_it(demo_run: tuple[
     assert saved.model == "model.json" and saved.options["initial_state"] == "estimated"
     assert {r.label.split()[1] for r in saved.verification.records} == {"lon", "lat", "yaw", "thr"}  # every doublet
     assert saved.verification.wind_correction  # verified with and without G_w
+    axes = axis_outputs(model)
+    for record in saved.verification.records:  # simulated from every input, judged on its axis' outputs
+        assert record.inputs == model.linear_model().inputs
+        assert record.excited is not None and [o.name for o in record.judged] == list(axes[record.excited])
+    for summary in saved.verification.summary:  # issue 7: TIC <= 0.25 on every on-axis output
+        assert summary.tic <= 0.25, summary
+    assert saved.verification.correction("az").reduction_percent >= 7.0  # Table 3.6, on the heave doublet
     verdict = model_verdict(model, saved.verification)
+    assert verdict.grade == "good"
     assert verdict.sentence in output
     text = page.read_text()
-    assert '<p class="verdict ' in text and verdict.sentence in text
+    assert '<p class="verdict ' in text and str(escape(verdict.sentence)) in text  # as the template escapes it
     assert "ArduCopter" in text and 'id="verification"' in text
     rebuilt = tmp_path / "rebuilt.html"
     result = CliRunner().invoke(cli, ["report", str(demo_dir / "model.json"), str(demo_dir / "validation.json"),

@@ -1,11 +1,10 @@
-"""``sysid report`` rebuilds the model report from the saved files; saved verifications round-trip.
+"""``sysid report`` rebuilds the model report from the saved files, also after ``sysid fit`` and ``sysid validate``.
 
-(The verification file, :mod:`sysid.verify_io`, is tested here with the command that reads it.)
+(The verification file itself, :mod:`sysid.verify_io`, is tested in ``tests/sysid/test_verify_io.py``.)
 """
 
 from __future__ import annotations
 
-import dataclasses
 import importlib.util
 import json
 import re
@@ -19,9 +18,11 @@ from click.testing import CliRunner
 
 from flightlogs.errors import DataError
 from reports.model_report import model_report_html
-from sysid.fit import IdentifiedModel, write_model
+from sysid.fit import IdentifiedModel, read_model, write_model
+from sysid.sim.campaign import run_scenario
+from sysid.sim.scenario import read_scenario
 from sysid.verify import Verification
-from sysid.verify_io import read_verification, verification_to_dict, write_verification
+from sysid.verify_io import read_verification, write_verification
 from sysid_cli.main import cli
 from sysid_cli.report import ingest_card
 
@@ -54,26 +55,6 @@ def saved(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, Identif
     write_verification(folder / "validation.json", verification, model="model.json",
                        options={"initial_state": "estimated", "after_s": 1.0})
     return folder / "model.json", folder / "validation.json", model, verification
-
-
-def _arrays(verification: Verification) -> list[np.ndarray]:
-    found = []
-    for record in (*verification.records, *verification.without_wind):
-        found.append(record.time_s)
-        for o in record.outputs:
-            found.extend([o.measured, o.simulated] + ([o.predicted] if o.predicted is not None else []))
-    return found
-
-
-def test_a_saved_verification_reads_back_exactly(saved: tuple[Path, Path, IdentifiedModel, Verification]) -> None:
-    _, path, _, verification = saved
-    loaded = read_verification(path)
-    assert loaded.model == "model.json" and dict(loaded.options) == {"initial_state": "estimated", "after_s": 1.0}
-    assert verification_to_dict(loaded.verification) == verification_to_dict(verification)
-    for before, after in zip(_arrays(verification), _arrays(loaded.verification), strict=True):
-        np.testing.assert_array_equal(before, after)  # every digit kept: the report redraws the same
-    assert [c.reduction_percent for c in loaded.verification.wind_correction] == [
-        c.reduction_percent for c in verification.wind_correction]
 
 
 def test_report_rebuilds_the_same_page_from_the_saved_files(
@@ -176,10 +157,67 @@ def test_report_help_has_an_example() -> None:
     assert result.exit_code == 0 and "sysid report model.json validation.json" in result.output
 
 
-def test_saved_verification_keeps_a_one_record_model_without_wind(tmp_path: Path) -> None:
-    verification = browser.sample_verification()
-    plain = dataclasses.replace(verification, without_wind=(), wind_correction=())
-    path = write_verification(tmp_path / "v.json", plain)
-    loaded = read_verification(path).verification
-    assert loaded.without_wind == () and loaded.wind_correction == ()
-    assert [r.label for r in loaded.records] == [r.label for r in plain.records]
+SCENARIO = """
+[scenario]
+description = "a pitch sweep and a pitch doublet of the Table 3.3 linear model"
+vehicle = "linear-octo"
+formats = ["dataflash"]
+trials = 1
+seed = 7
+utc_start = "2024-05-01T10:00:00Z"
+margin_s = 3.0
+[anemometer]
+distance_m = 4.6
+rate_hz = 20.0
+clock_offset_s = 0.0
+[[condition]]
+name = "calm"
+mean_speed_m_s = 0.9
+direction_from_deg = 300.0
+turbulence_ratio = 0.2
+[[maneuver]]
+axis = "lon"
+kind = "sweep"
+amplitude = 8.0
+duration_s = 34.0
+[[maneuver]]
+axis = "lon"
+kind = "doublet"
+amplitude = 15.0
+duration_s = 2.0
+"""
+
+
+def _sections(page: str) -> list[str]:
+    return re.findall(r'<h[23][^>]*>(.*?)</h[23]>', page)
+
+
+@pytest.mark.slow
+def test_fit_validate_and_report_from_the_command_line(tmp_path: Path) -> None:
+    """fit → validate -o (saved verification) --report → report: the rebuilt page is the one validate wrote."""
+    (tmp_path / "calm.toml").write_text(SCENARIO)
+    sweep, doublet = [t.logs[0] for t in run_scenario(read_scenario(tmp_path / "calm.toml"), tmp_path / "flights")]
+    model, validation = tmp_path / "model.json", tmp_path / "validation.json"
+    fitted = CliRunner().invoke(cli, ["fit", str(sweep), "--model", "hover", "-o", str(model), "-q"])
+    assert fitted.exit_code == 0, fitted.output
+    first = tmp_path / "validate.html"
+    result = CliRunner().invoke(cli, ["validate", str(model), str(doublet), "-o", str(validation),
+                                      "--report", str(first), "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert summary["output"] == str(validation) and summary["report"] == str(first)
+    assert set(summary["summary"]) == {"u", "q", "theta", "ax"}  # the lon doublet, judged on the lon outputs
+    assert {"v", "p", "phi", "ay", "r", "w", "az"} == set(summary["off_axis"])
+    assert summary["records"][0]["excited"] == "delta_lon"
+    assert summary["records"][0]["reference_shifts"].keys() == {"delta_lat", "delta_lon", "delta_yaw", "delta_thr"}
+    saved = read_verification(validation)
+    assert saved.model == "model.json" and saved.options["inputs"] == "all measured"
+    assert [s.name for s in saved.verification.summary] == list(summary["summary"])
+    rebuilt = tmp_path / "report.html"
+    again = CliRunner().invoke(cli, ["report", str(model), str(validation), "-o", str(rebuilt), "-q"])
+    assert again.exit_code == 0, again.output
+    page, original = rebuilt.read_text(), first.read_text()
+    assert _sections(page) == _sections(original)
+    assert "Verification on doublets" in _sections(page) and "Off-axis outputs, for information (not judged)" in page
+    assert _FOOTER.sub("", page) == _FOOTER.sub("", original)
+    assert read_model(model).structure_name in page

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from matplotlib.patches import Polygon, Rectangle
 
-from reports.bode import bode_figure, write_bode_svg
+from reports.bode import _nearest_branch, bode_figure, write_bode_svg
 from reports.svg import figure_svg
 from sysid.freqresp import FrequencyResponse
 
@@ -87,3 +87,36 @@ def test_standalone_svg_file(tmp_path: Path) -> None:
     text = target.read_text()
     assert text.startswith("<?xml") and "<svg" in text and "q/delta_lon" in text and "ax/delta_lon" in text
     assert figure_svg(bode_figure([_lag()])) == figure_svg(bode_figure([_lag()]))  # deterministic
+
+
+def test_the_model_phase_follows_the_data_branch_through_a_wrap() -> None:
+    """Data that wraps +180 at a zero while the model wraps -180: the model is moved a whole turn after it."""
+    model = np.concatenate([np.linspace(-100, -170, 20), np.linspace(-190, -260, 20)])
+    data = np.concatenate([model[:20] + 2.0, model[20:] + 360.0 - 3.0])
+    np.testing.assert_allclose(_nearest_branch(data, model), np.concatenate([model[:20], model[20:] + 360.0]))
+    noisy = data.copy()
+    noisy[5] += 360.0  # one wrapped noise point does not move the model
+    np.testing.assert_allclose(_nearest_branch(noisy, model)[:20], model[:20])
+
+
+def _tick_texts(ax: Any) -> list[str]:
+    """Tick labels inside the frequency range shown."""
+    low, high = ax.get_xlim()
+    return [t.get_text() for t, x in zip(ax.get_xticklabels(), ax.get_xticks()) if t.get_text() and low <= x <= high]
+
+
+def test_frequency_ticks_are_plain_numbers_labelled_once_per_column() -> None:
+    """Five blocks in two columns: only the last block of each column carries tick labels and the axis title."""
+    figure = bode_figure([_lag(name) for name in ("q", "ax", "theta", "u", "w")],
+                         models={"q/delta_lon": 1 / (1j * OMEGA * 0.2 + 1)})
+    figure.canvas.draw()
+    shown = _visible(figure)
+    labelled = [ax for ax in shown if _tick_texts(ax)]
+    assert len(labelled) == 2
+    assert [ax.get_xlabel() for ax in labelled] == ["frequency, rad/s"] * 2
+    assert sum(bool(ax.get_xlabel()) for ax in shown) == 2
+    for ax in labelled:
+        assert set(_tick_texts(ax)) <= {"0.5", "1", "2", "5", "10", "20", "50"} and "10" in _tick_texts(ax)
+    assert sum(ax.get_legend() is not None for ax in shown) == 1  # one legend per figure
+    left, right = sorted(labelled, key=lambda ax: ax.get_position().x0)
+    assert left.get_position().y0 < right.get_position().y0  # left column: 3 blocks, right: 2

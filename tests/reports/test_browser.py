@@ -1,4 +1,4 @@
-"""The validation report as a reader's browser shows it: loads clean, every figure drawn, nothing fetched.
+"""The model report as a reader's browser shows it: loads clean, every figure drawn, nothing fetched.
 
 Headless Chromium is Debian's package (``.ci/run`` installs it). Without it the
 test is skipped locally and fails in CI (``CI`` set), so a missing install
@@ -14,12 +14,18 @@ from pathlib import Path
 
 import pytest
 
-from reports.validate_report import write_validate_report
+from reports.model_report import write_model_report
 
 _HELPER = importlib.util.spec_from_file_location("_report_browser", Path(__file__).with_name("browser.py"))
 assert _HELPER is not None and _HELPER.loader is not None
 browser = sys.modules.setdefault(_HELPER.name, importlib.util.module_from_spec(_HELPER))
 _HELPER.loader.exec_module(browser)
+
+_MODELS = importlib.util.spec_from_file_location("_model_report_tests", Path(__file__).with_name(
+    "test_model_report.py"))
+assert _MODELS is not None and _MODELS.loader is not None
+fixtures = sys.modules.setdefault(_MODELS.name, importlib.util.module_from_spec(_MODELS))
+_MODELS.loader.exec_module(fixtures)
 
 ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
 
@@ -34,20 +40,24 @@ def chromium() -> Path:
         pytest.skip(str(err))
 
 
-def test_validate_report_renders_in_chromium(chromium: Path, tmp_path: Path) -> None:
+def test_model_report_renders_in_chromium(chromium: Path, tmp_path: Path) -> None:
+    """What ``sysid validate --report`` and ``sysid report`` write: the model with its verification."""
+    model = fixtures.small_model(files=("flight.bin", "anemometer.csv"))
     verification = browser.sample_verification()
-    page = write_validate_report(tmp_path / "validate.html", verification, model_name="hover-wind.json",
-                                 logs=["doublets.ulg"])
-    shot = ARTIFACTS / "validate.png"
+    page = write_model_report(tmp_path / "model.html", model, verification=verification,
+                              logs_summary={"vehicle": "linear octocopter"}, generated_utc=fixtures.STAMP)
+    shot = ARTIFACTS / "model_report.png"
     seen = browser.render_in_browser(page, shot)
     assert seen.console_errors == ()
     assert seen.external_requests == ()
-    assert seen.n_figures == len(verification.records) + 1  # the wind-correction bars and one per record
+    inputs = {r.input for r in model.responses}
+    # Bode per input, correlation, poles, the wind-correction bars and one per record
+    assert seen.n_figures == page.read_text().count("<svg ") == len(inputs) + 2 + 1 + len(verification.records)
     for (width, height), marks in zip(seen.figure_sizes, seen.figure_marks):
-        assert width > 300 and height > 100
+        assert width > 250 and height > 150
         assert marks > 20
     assert seen.screenshot_nonblank
-    assert shot.stat().st_size > 10_000
+    assert shot.stat().st_size > 50_000
 
 
 def test_a_blank_page_is_seen_as_blank(chromium: Path, tmp_path: Path) -> None:

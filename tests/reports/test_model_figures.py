@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from matplotlib.text import Text
 
-from reports.model_figures import (_nearest_branch, correlation_figure, pair_response, plain_text, pole_map_figure,
+from reports.model_figures import (correlation_figure, pair_response, plain_text, pole_map_figure,
                                    response_figures)
 from reports.svg import figure_svg
 from sysid.fit import IdentifiedModel
@@ -62,23 +62,11 @@ def test_the_overlay_is_the_model_and_the_phase_sits_on_the_data_branch(small_mo
     np.testing.assert_allclose(offset, np.round(offset), atol=1e-9)  # moved by whole turns only
 
 
-def test_the_branch_follows_the_data_through_a_wrap() -> None:
-    """Data that wraps +180 at a zero while the model wraps -180: the model is moved a whole turn after it."""
-    model = np.concatenate([np.linspace(-100, -170, 20), np.linspace(-190, -260, 20)])
-    data = np.concatenate([model[:20] + 2.0, model[20:] + 360.0 - 3.0])
-    np.testing.assert_allclose(_nearest_branch(data, model), np.concatenate([model[:20], model[20:] + 360.0]))
-
-
-def test_frequency_ticks_are_plain_numbers_under_each_column_only(small_model: IdentifiedModel) -> None:
+def test_each_column_is_labelled_once_with_plain_frequency_ticks(small_model: IdentifiedModel) -> None:
     figure = response_figures(small_model)[0][0]
     figure.canvas.draw()
-    shown = [ax for ax in figure.axes if ax.get_visible()]
-    labelled = [ax for ax in shown if any(t.get_text() for t in ax.get_xticklabels())]
-    assert len(labelled) == 2  # the coherence panel of each of the two columns
-    for ax in labelled:
-        assert ax.get_xlabel() == "frequency, rad/s"
-        texts = [t.get_text() for t in ax.get_xticklabels() if t.get_text()]
-        assert set(texts) <= {"0.1", "0.2", "0.5", "1", "2", "5", "10", "20", "50", "100"} and "10" in texts
+    labelled = [ax for ax in figure.axes if ax.get_visible() and any(t.get_text() for t in ax.get_xticklabels())]
+    assert len(labelled) == 2 and all(ax.get_xlabel() == "frequency, rad/s" for ax in labelled)
 
 
 def test_correlation_cells_beyond_the_threshold_are_written_in() -> None:

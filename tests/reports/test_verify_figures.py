@@ -1,4 +1,4 @@
-"""Figures and the HTML page of a verification (drawn from a small simulated one)."""
+"""Figures of a verification (drawn from a small simulated one) and the verification section of the model report."""
 
 from __future__ import annotations
 
@@ -10,20 +10,28 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from matplotlib.transforms import Bbox
 
-from reports.validate_report import render_validate_report
+from reports.model_report import model_report_html
 from reports.verify_figures import display_scale, record_figure, verification_figures, wind_correction_figure
-from sysid.verify import WindCorrection
+from sysid.verify import Verification, WindCorrection
 
 _HELPER = importlib.util.spec_from_file_location("_report_browser", Path(__file__).with_name("browser.py"))
 assert _HELPER is not None and _HELPER.loader is not None
 browser = sys.modules.setdefault(_HELPER.name, importlib.util.module_from_spec(_HELPER))
 _HELPER.loader.exec_module(browser)
 
+_MODEL_SPEC = importlib.util.spec_from_file_location("_model_report_tests", Path(__file__).with_name(
+    "test_model_report.py"))
+assert _MODEL_SPEC is not None and _MODEL_SPEC.loader is not None
+fixtures = sys.modules.setdefault(_MODEL_SPEC.name, importlib.util.module_from_spec(_MODEL_SPEC))
+_MODEL_SPEC.loader.exec_module(fixtures)
+
 
 @pytest.fixture(scope="module")
-def verification():  # type: ignore[no-untyped-def]
-    return browser.sample_verification()
+def verification() -> Verification:
+    result: Verification = browser.sample_verification()
+    return result
 
 
 def test_display_scale_shows_radians_as_degrees() -> None:
@@ -32,43 +40,81 @@ def test_display_scale_shows_radians_as_degrees() -> None:
     assert display_scale("m/s^2") == (1.0, "m/s^2")
 
 
-def test_record_figure_draws_every_output_with_and_without_wind(verification) -> None:  # type: ignore[no-untyped-def]
+def test_record_figure_stacks_the_judged_outputs_and_shows_the_others_small(verification: Verification) -> None:
     record, without = verification.records[0], verification.without_wind[0]
+    assert record.off_axis == ("p",) and [o.name for o in record.judged] == ["q", "theta", "ax"]
     svg = record_figure(record, without_wind=without)
     assert svg.startswith("<svg") and 'class="figure"' in svg
-    for output in record.outputs:
+    for output in record.judged:
         assert f"{output.name} [{display_scale(output.unit)[1]}]" in svg
-        assert f"TIC {output.tic:.2f}" in svg
-    assert "without" in svg
-    alone = record_figure(record)
-    assert "without" not in alone and "model" in alone
+        assert f"TIC {output.tic:.2f} with" in svg
+    assert "off-axis outputs, for information only" in svg and "delta_lon" in svg
+    assert f"TIC {record.output('p').tic:.2f}" in svg and "p [deg/s]" in svg
+    alone = record_figure(replace(record, off_axis=()))
+    assert "off-axis" not in alone and "without" not in alone and "model" in alone
 
 
-def test_unstable_records_say_so_in_the_title(verification) -> None:  # type: ignore[no-untyped-def]
+def test_unstable_records_say_so_in_the_title(verification: Verification) -> None:
     record = replace(verification.records[0], unstable=True, growth=21.4, notice="grows")
     assert "unstable open loop: grows 21-fold" in record_figure(record)
 
 
-def test_wind_correction_figure_annotates_the_reduction() -> None:
+def test_a_dollar_in_a_record_label_is_drawn_as_it_is(verification: Verification) -> None:
+    """A label from a log is text, not mathtext: ``$x^2$`` is drawn with its dollars."""
+    record = replace(verification.records[0], label="flight $x^2$.ulg lon doublet")
+    svg = record_figure(record)
+    assert "flight $x^2$.ulg lon doublet" in svg
+
+
+def test_wind_correction_figure_annotates_the_change() -> None:
     svg = wind_correction_figure([WindCorrection("ax", "m/s^2", 0.4129, 0.3480),
-                                  WindCorrection("p", "rad/s", 0.1, 0.1)])
-    assert "−16 %" in svg  # Table 3.6, strong wind: 0.4129 -> 0.3480
-    assert ">p<" not in svg  # an output the wind term does not touch is left out
+                                  WindCorrection("p", "rad/s", 0.1, 0.1),
+                                  WindCorrection("az", "m/s^2", 0.187, 0.295)])
+    assert "−16 %" in svg and "+58 %" in svg  # Table 3.6, strong wind: 0.4129 -> 0.3480; a worse az
+    assert "−-" not in svg and "−+" not in svg
+    assert ">p<" not in svg  # an output the wind term does not change is left out
 
 
-def test_report_has_a_figure_per_record_and_the_tables(verification) -> None:  # type: ignore[no-untyped-def]
-    page = render_validate_report(verification, model_name="<model>.json", logs=[Path("/x/doublets.ulg")])
-    assert page.count('<svg') == len(verification_figures(verification)) == len(verification.records) + 1
-    assert "&lt;model&gt;.json" in page and "<model>" not in page
-    assert not re.search(r"""(src|href|url)\s*[=(]\s*["']?(https?:)?//""", page)  # namespaces are not fetches
-    for summary in verification.summary:
-        assert re.search(rf"<td>{summary.name}</td>", page)
-    assert "Wind correction" in page and "%" in page
-    assert "Good predictive accuracy" in page
+def _wind_axes(corrections: list[WindCorrection]):  # type: ignore[no-untyped-def]
+    """The bar chart's axes, drawn, and the renderer to measure it with."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from reports.verify_figures import _wind_figure
+
+    canvas = FigureCanvasAgg(_wind_figure(corrections))
+    canvas.draw()
+    return canvas.figure.axes[0], canvas.get_renderer()
 
 
-def test_report_without_wind_has_no_wind_section(verification) -> None:  # type: ignore[no-untyped-def]
+def test_the_legend_never_covers_a_bar_even_beyond_the_old_axis_limit() -> None:
+    """An output made 58 % worse (ratio 1.58 > 1.2) still fits, and the legend sits outside every bar."""
+    ax, renderer = _wind_axes([WindCorrection("ax", "m/s^2", 0.0675, 0.0585),
+                               WindCorrection("az", "m/s^2", 0.187, 0.295),
+                               WindCorrection("w", "m/s", 0.135, 0.141)])
+    assert ax.get_ylim()[1] > 0.295 / 0.187
+    legend: Bbox = ax.get_legend().get_window_extent(renderer)
+    for bar in ax.patches:
+        assert not legend.overlaps(bar.get_window_extent(renderer))
+    for text in ax.texts:  # the change labels stay inside the axes
+        assert ax.get_window_extent(renderer).contains(*text.get_window_extent(renderer).get_points()[1])
+
+
+def test_figures_are_the_wind_bars_then_one_per_record(verification: Verification) -> None:
+    figures = verification_figures(verification)
+    assert len(figures) == len(verification.records) + 1
+    assert "on-axis" in figures[0][1]
+    assert "judged on q, theta, ax" in figures[1][1]
     plain = replace(verification, without_wind=(), wind_correction=())
-    page = render_validate_report(plain, model_name="m.json")
-    assert "Wind correction" not in page
-    assert page.count("<svg") == len(verification.records)
+    assert len(verification_figures(plain)) == len(verification.records)
+
+
+def test_the_report_tables_judge_on_axis_outputs_and_list_the_others(verification: Verification) -> None:
+    page = model_report_html(fixtures.small_model(responses=False), verification=verification,
+                             generated_utc=fixtures.STAMP)
+    section = page[page.index('id="verification"'):page.index('id="reduction"')]
+    judged, informative = section.split("Off-axis outputs", 1)
+    for summary in verification.summary:
+        assert re.search(rf"<tr><td>{summary.name}</td>.*?<td class=\"mono left\">delta_lon</td></tr>", judged)
+    assert "<tr><td>p</td>" not in judged and "<tr><td>p</td>" in informative
+    assert "With and without the wind term" in section and "−13 to −16 %" in section
+    assert section.count("<svg ") == len(verification.records) + 1

@@ -26,8 +26,8 @@ from flightlogs.segments import Segment
 from sysid.sim.excitation import Maneuver
 from sysid.sim.linear_flight import CALM_HOVER, STRONG_WIND_TERMS, SimulatedFlight, WindField, simulate_hover
 from sysid.statespace import DelayedStateSpace
-from sysid.verify import (VerificationOptions, doublet_records, driven_part, theil_inequality, verify,
-                          verify_record)
+from sysid.verify import (RecordVerification, VerificationOptions, axis_outputs, doublet_records, driven_part,
+                          theil_inequality, verify, verify_record)
 from sysid.verify._discrete import discretize, simulate
 
 G = 9.81
@@ -235,6 +235,79 @@ def test_driven_part_keeps_one_axis_and_its_wind() -> None:
         driven_part(model, "delta_roll")
 
 
+def test_every_measured_input_drives_the_simulation() -> None:
+    """A pitch doublet while the autopilot also moves the thrust, which reaches q: simulated exactly only with
+    both inputs (the old excited-input-only simulation left delta_thr out)."""
+    model = DelayedStateSpace(np.array([[-1.2, -4.0], [1.0, 0.0]]), np.array([[2.0, 0.6], [0.0, 0.0]]),
+                              np.eye(2), np.zeros((2, 2)), ("q", "theta"), ("delta_lon", "delta_thr"),
+                              ("q", "theta"), np.array([0.02, 0.01]))
+    t = np.arange(300) * 0.01
+    u = np.column_stack([np.where((t > 0.5) & (t < 1.5), 1.0, 0.0) - np.where((t >= 1.5) & (t < 2.5), 1.0, 0.0),
+                         0.8 * np.sin(2.1 * t)])
+    y = simulate(discretize(model, 0.01), u, np.zeros(2))
+    record = _record({"delta_lon": u[:, 0], "delta_thr": u[:, 1], "q": y[:, 0], "theta": y[:, 1]})
+    result = verify(model, [record], excited=["delta_lon"], axes={"delta_lon": ("q",)},
+                    options=VerificationOptions(initial_state="zero"))
+    (checked,) = result.records
+    assert checked.inputs == ("delta_lon", "delta_thr") and checked.excited == "delta_lon"
+    assert checked.off_axis == ("theta",) and [s.name for s in result.summary] == ["q"]
+    assert [s.name for s in result.off_axis] == ["theta"]
+    assert checked.output("q").tic < 1e-9 and result.tic < 1e-9
+    alone = DelayedStateSpace(model.a, model.b[:, :1], model.c, model.d[:, :1], model.states, ("delta_lon",),
+                              model.outputs, model.input_delays_s[:1])
+    bare = VerificationOptions(initial_state="zero", fit_bias=False, fit_reference_shift=False)
+    thrust_part = simulate(discretize(model, 0.01), u * [0.0, 1.0], np.zeros(2))[:, 0]
+    left_out = verify(alone, [record], options=bare).output("q")
+    assert left_out.rmse == pytest.approx(np.sqrt(np.mean(thrust_part**2)), rel=1e-9)  # exactly what is missing
+
+
+def _coupled_hover(constants: Mapping[str, float]):  # type: ignore[no-untyped-def]
+    """The hover structure at the simulator's values, built with the given trim constants."""
+    from importlib import resources
+
+    from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate
+    from sysid.model import parse_structure
+
+    text = (resources.files("sysid.model") / "builtin" / "hover.toml").read_text()
+    values = dict(flown(CALM_HOVER)) | {"N_r": 0.0, "Z_w": 0.0}
+    parameters = tuple(ParameterEstimate(p.name, values[p.name]) for p in parse_structure(text).parameters)
+    return IdentifiedModel("hover", text, parameters, (), np.zeros((0, 0)), CostSummary(1.0),
+                           constants={"g": G, "phi0": 0.0, "theta0": 0.0} | dict(constants))
+
+
+def test_axes_come_from_the_structure_not_from_the_trim_coupling(calm_flights: list[ConditionedFlight]) -> None:
+    """With 1.5 m/s of trim airspeed the yaw rate reaches the other axes through U0 and V0 (eq. 3.5): judged on
+    driven_part, a yaw doublet would be judged on nearly every output; the structure says r alone."""
+    identified = _coupled_hover({"U0": 1.2, "V0": -0.9, "W0": 0.1})
+    coupled = identified.linear_model()
+    assert {"r", "u", "q", "theta", "v", "p", "phi", "w"} <= set(driven_part(coupled, "delta_yaw").outputs)
+    axes = axis_outputs(identified)
+    assert axes == {"delta_lat": ("v", "p", "phi", "ay"), "delta_lon": ("u", "q", "theta", "ax"),
+                    "delta_yaw": ("r",), "delta_thr": ("w", "az")}
+    assert axis_outputs(_coupled_hover({"U0": 0.0, "V0": 0.0, "W0": 0.0})) == axes  # the trim does not matter
+    cut = doublet_records(calm_flights[:1])
+    result = verify(coupled, cut.records, excited=cut.excited, axes=axes)
+    for record, excited in zip(result.records, cut.excited):
+        assert record.inputs == coupled.inputs and record.excited == excited
+        assert tuple(o.name for o in record.judged) == axes[excited]
+        assert set(record.off_axis) == set(coupled.outputs) - set(axes[excited])
+    # r' = N_yaw delta_yaw alone: the yaw doublet is not flagged although the airframe is unstable in pitch
+    assert [r.unstable for r in result.records] == [True, True, False, True]
+    assert {s.name for s in result.summary} == {n for names in axes.values() for n in names}
+
+
+def test_off_axis_names_some_outputs_of_the_record() -> None:
+    from sysid.verify import OutputVerification
+
+    out = OutputVerification("q", "rad/s", np.zeros(3), np.zeros(3), 0.0, 0.0, 0.0)
+    make = lambda off: RecordVerification("r", Path("f.bin"), np.arange(3.0), ("delta_lon",), (out,), {},  # noqa: E731
+                                          0.0, 0.0, 1.0, False, off_axis=off)
+    with pytest.raises(ValueError, match="some, not all"):
+        make(("q",))
+    with pytest.raises(ValueError, match="some, not all"):
+        make(("p",))
+
+
 def test_missing_signals_are_named() -> None:
     model = _second_order()
     with pytest.raises(DataError, match="wind_lon"):
@@ -243,6 +316,9 @@ def test_missing_signals_are_named() -> None:
         verify_record(model, _record({"delta_lon": np.zeros(10), "wind_lon": np.zeros(10)}))
     with pytest.raises(DataError, match="no records"):
         verify(model, [])
+    with pytest.raises(ModelError, match="delta_yaw"):
+        verify(model, [_record({"delta_lon": np.zeros(10), "wind_lon": np.zeros(10), "q": np.zeros(10)})],
+               excited=["delta_yaw"])
 
 
 def test_theil_inequality_bounds() -> None:
@@ -264,11 +340,12 @@ def test_doublet_records_cut_each_doublet_with_margins(calm_flights: list[Condit
 
 
 def test_calm_doublets_are_predicted_by_the_truth(calm_flights: list[ConditionedFlight]) -> None:
-    """Issue 7: TIC <= 0.25 on every on-axis output of the calm truth's doublets."""
+    """Issue 7: TIC <= 0.25 on every on-axis output of the calm truth's doublets (simulated from all inputs)."""
     cut = doublet_records(calm_flights)
     result = verify(_block(truth_models()), cut.records, excited=cut.excited)
     on_axis = {"u", "q", "theta", "ax", "v", "p", "phi", "ay", "r", "psi", "w", "az"}
-    assert {s.name for s in result.summary} == on_axis
+    assert {s.name for s in result.summary} == on_axis == {s.name for s in result.off_axis}
+    assert all(len(r.inputs) == 4 and len(r.judged) + len(r.off_axis) == 12 for r in result.records)
     for summary in result.summary:
         assert summary.n_records == 3
         assert summary.tic <= 0.25, summary
@@ -283,6 +360,8 @@ def test_wind_term_reduces_the_error_on_strong_wind_doublets(strong_flights: lis
     cut = doublet_records(strong_flights)
     result = verify(_block(truth_models()), cut.records, excited=cut.excited,
                     wind_model=_block(truth_models(wind=STRONG_WIND_TERMS)))
+    # Table 3.6 is per output over the doublets of its axis: a_x on the lon doublets, a_z on the heave ones
+    assert result.output("ax").n_records == result.output("az").n_records == 3
     assert result.correction("ax").reduction_percent >= 13.0
     assert result.correction("az").reduction_percent >= 7.0
     assert result.correction("ay").reduction_percent == pytest.approx(0.0)  # no lateral wind term in the truth

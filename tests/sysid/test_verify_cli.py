@@ -86,13 +86,16 @@ def test_validate_reports_the_wind_correction(flights: tuple[Path, list[Path], l
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert len(summary["records"]) == 2
+    assert set(summary["summary"]) == {"u", "q", "theta", "ax"}  # lon doublets: judged on the lon outputs
+    assert {"w", "az", "v", "p"} <= set(summary["off_axis"])  # the others, for information
     for name in ("u", "q", "theta", "ax"):
         assert summary["summary"][name]["tic"] <= 0.25
     assert summary["wind_correction"]["ax"]["reduction_percent"] >= 13.0  # Table 3.6, strong wind
     assert summary["wind_correction"]["ax"]["rmse_with"] < summary["wind_correction"]["ax"]["rmse_without"]
     assert summary["unstable"] is True and summary["summary"]["q"]["one_step_tic"] is not None
-    page = report.read_text()
-    assert page.count('<svg') == 3 and "Wind correction" in page
+    page = report.read_text()  # the model report, with the verification
+    assert 'id="verification"' in page and "With and without the wind term" in page
+    assert 'id="parameters"' in page and page.count("<svg ") == 1 + 1 + 2  # poles, wind bars, two records
 
 
 def test_validate_without_wind_verifies_the_model_without_it(flights: tuple[Path, list[Path], list[Path]]) -> None:
