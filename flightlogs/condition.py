@@ -45,6 +45,7 @@ _MIXER = {"lat": "delta_lat", "lon": "delta_lon", "yaw": "delta_yaw", "thr": "de
 _POSITION = ("latitude", "longitude")
 _EARTH_RADIUS_M = 6_371_008.8
 _MAX_GPS_DISTANCE_M = 1000.0  # farther, the anemometer's position is more likely mistyped than meant
+_MIN_CORRELATION_S = 20.0  # shortest stretch a residual clock offset is estimated over
 
 
 @dataclass(frozen=True, slots=True)
@@ -189,6 +190,10 @@ def condition_flight(
         alignment = _residual(alignment, time_base, values, rate_hz)
         if options.estimate_wind_offset and alignment.residual is not None:
             return _with_estimated_offset(log, wind, options, alignment)
+        if options.estimate_wind_offset:
+            notes.append(f"{log.path}: the clock offset was not estimated: that needs {_MIN_CORRELATION_S:g} s "
+                         "where the wind and the autopilot's wind estimate or attitude are logged together; "
+                         f"the offset used is {alignment.clock_offset_s:+.3f} s ({alignment.clock_offset_source})")
     _derived(values, units, wind_given=bool(wind_signals), notes=notes)
     segments = _segments(log, time_base, values, options)
     records = tuple(
@@ -318,7 +323,7 @@ def _residual(alignment: WindAlignment, time_base: np.ndarray, values: dict[str,
             continue
         columns = ("wind_n", "wind_e", *needed)
         start, stop = _longest_finite_run(np.all([np.isfinite(values[n]) for n in columns], axis=0))
-        if stop - start < 20 * rate_hz:
+        if stop - start < _MIN_CORRELATION_S * rate_hz:
             continue
         table = {n: values[n][start:stop] for n in columns}
         estimate, against = estimate_residual_offset(

@@ -254,3 +254,19 @@ def test_a_mistyped_anemometer_position_is_refused(demo: dict) -> None:
                          ConditioningOptions(anemometer_position_rad=(lat, -lon), wind_offset_s=1.5))
     with pytest.raises(ValueError, match="latitude within"):
         ConditioningOptions(anemometer_position_rad=(lon, lat))
+
+
+def test_a_clock_offset_that_cannot_be_estimated_is_reported(demo: dict) -> None:
+    """Under 20 s of overlap the correlation is not tried: the flight says so and which offset it used."""
+    log = demo["log"]
+    start = log["p"].time_s[0]
+
+    def first_12_s(signal: Signal) -> Signal:
+        keep = signal.time_s < start + 12.0
+        return replace(signal, time_s=signal.time_s[keep], values=signal.values[keep])
+
+    short = replace(log, signals={name: first_12_s(signal) for name, signal in log.signals.items()})
+    flight = condition_flight(short, demo["wind"], ConditioningOptions(wind_distance_m=4.6, estimate_wind_offset=True))
+    assert flight.wind is not None and flight.wind.clock_offset_source != "estimated"
+    (note,) = [w for w in flight.warnings if "clock offset was not estimated" in w]
+    assert "20 s" in note and f"{flight.wind.clock_offset_s:+.3f} s" in note
