@@ -5,19 +5,26 @@ The public names live in small modules and are re-exported here:
 :mod:`~sysid.freqresp.estimate` (:func:`frequency_responses`),
 :mod:`~sysid.freqresp.gating` (:func:`gate_responses`),
 :mod:`~sysid.freqresp.records` (:func:`maneuver_records`, :data:`DEFAULT_PAIRS`,
-:func:`flight_responses`) and :mod:`~sysid.freqresp.io` (HDF5).
+:func:`flight_responses`) and :mod:`~sysid.freqresp.io` (HDF5). Private
+modules hold the numerics: ``_spectra`` (windowed spectra), ``_whole`` (the
+records' whole-length transforms, the composite's bias-free member),
+``_conditioning`` (conditioned and instrumental-variable estimates) and
+``_composite``.
 """
 
 from .estimate import automatic_window_lengths, frequency_responses
 from .gating import DroppedResponse, GatingResult, fit_range, gate_responses
 from .io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
 from .options import ResponseOptions
-from .records import DEFAULT_PAIRS, FlightResponses, default_pairs, flight_responses, maneuver_records, parse_pairs
+from .records import (
+    DEFAULT_PAIRS, EXCITATION, FlightResponses, default_pairs, flight_responses, maneuver_records, parse_pairs,
+)
 from .response import FrequencyResponse
 
 __all__ = [
     "FrequencyResponse", "ResponseOptions", "frequency_responses", "automatic_window_lengths",
     "DroppedResponse", "GatingResult", "gate_responses", "fit_range",
     "write_responses", "read_responses", "RESPONSES_SCHEMA_VERSION",
-    "DEFAULT_PAIRS", "maneuver_records", "parse_pairs", "default_pairs", "FlightResponses", "flight_responses",
+    "DEFAULT_PAIRS", "EXCITATION", "maneuver_records", "parse_pairs", "default_pairs", "FlightResponses",
+    "flight_responses",
 ]

@@ -8,15 +8,22 @@ weights ``1 / eps_r^2 = 2 n_d gamma^2 / (1 - gamma^2)``, eps_r being each
 window's normalised random error (from its own, partial, coherence and its
 effective number of averages), and zero below the lowest frequency the window
 resolves. The response, coherence and random error then follow from the
-composite spectra; the random error uses the same weighted mean of ``n_d``
-(the windows reuse the same data, so their errors are not independent and
-the composite is credited no more averages than its windows had).
+composite spectra; the random error uses a weighted mean of ``n_d`` (the
+windows reuse the same data, so their errors are not independent and the
+composite is credited no more averages than its windows had), each member
+counted by its share of the estimate, its weight times the spectrum the
+response is divided by (``G_xx``, or ``|G_rx|`` with a reference): a member
+whose spectra are larger there carries more of the estimate than its weight.
 
 Both the weights and the random error use the coherence with the bias of a
 finite number of averages removed, ``(n_d g^2 - 1) / (n_d - 1)``: unrelated
 signals give ``E[g^2] = 1 / n_d``, and a long window with few averages would
 otherwise look coherent in noise and claim too small an error. The coherence
 reported is the usual estimate, the one thresholds (eq. 3.8) refer to.
+
+The whole-record member (:mod:`sysid.freqresp._whole`), when present, is one
+more member weighed the same way, but only where its output power passes its
+significance test; where no member is usable the coherence is zero.
 """
 
 from __future__ import annotations
@@ -26,8 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._conditioning import coherence, conditioned_spectra, random_error, response
+from ._conditioning import pair_estimate, random_error
 from ._spectra import WindowSpectra
+from ._whole import significance_threshold
 
 __all__: list[str] = []
 
@@ -43,45 +51,61 @@ class PairEstimate:
     output_autospectrum: np.ndarray
     cross_spectrum: np.ndarray
     windows_s: tuple[float, ...]
+    whole_record: bool
 
 
 def composite_pair(
-    windows: Sequence[WindowSpectra], omega: np.ndarray, inputs: Sequence[int], j: int, y: int
+    windows: Sequence[WindowSpectra], omega: np.ndarray, inputs: Sequence[int], j: int, y: int,
+    instrument: int | None = None,
 ) -> PairEstimate:
-    """Composite conditioned estimate of channel `y` against input channel ``inputs[j]``."""
-    others = [k for n, k in enumerate(inputs) if n != j]
-    n_conditioned = len(others)
+    """Composite estimate of channel `y` against input channel ``inputs[j]`` (conditioned, or by `instrument`)."""
+    n_conditioned = len(inputs) - 1
+    n_d = np.array([max(w.n_effective - n_conditioned, 1.0) for w in windows])
     weights = np.zeros((len(windows), omega.size))
-    valid = np.zeros((len(windows), omega.size), dtype=bool)
+    reach = np.array([omega >= w.omega_low * (1.0 - 1e-12) for w in windows]).reshape(len(windows), omega.size)
+    valid = reach.copy()
     for i, window in enumerate(windows):
-        valid[i] = omega >= window.omega_low * (1.0 - 1e-12)
-        spectra_i = window.spectra[valid[i]]
-        g_jj, g_yy, g_jy = conditioned_spectra(spectra_i, inputs[j], others, y)
-        gamma2 = coherence(g_jj, g_yy, g_jy, g_xx_total=np.real(spectra_i[:, inputs[j], inputs[j]]),
-                           g_yy_total=np.real(spectra_i[:, y, y]))
-        n_d = max(window.n_effective - n_conditioned, 1.0)
-        unbiased = _unbiased_coherence(gamma2, n_d)
-        weights[i, valid[i]] = 2.0 * n_d * unbiased / np.maximum(1.0 - unbiased, 1e-12)
-    total = weights.sum(axis=0)
-    weights = np.where(total > 0, weights, valid.astype(float))  # no coherence anywhere: plain mean of valid windows
+        _, gamma2, *_ = pair_estimate(window.spectra[reach[i]], inputs, j, y, instrument)
+        if window.noise_dof is not None:  # the whole-record member: only where its signal is significant
+            valid[i, reach[i]] = _significant(gamma2, window.n_effective, len(inputs), window.noise_dof[reach[i]])
+        unbiased = np.where(valid[i, reach[i]], _unbiased_coherence(gamma2, n_d[i]), 0.0)
+        weights[i, reach[i]] = 2.0 * n_d[i] * unbiased / np.maximum(1.0 - unbiased, 1e-12)
+    whole = any(w.noise_dof is not None and bool(np.any(weights[k] > 0)) for k, w in enumerate(windows))
+    usable = valid.any(axis=0)
+    fallback = np.where(usable, valid, reach).astype(float)  # no coherence anywhere: plain mean of the members
+    weights = np.where(weights.sum(axis=0) > 0, weights, fallback)
     weights /= np.maximum(weights.sum(axis=0), np.finfo(float).tiny)
     stacked = np.stack([window.spectra for window in windows])  # (n_windows, n_freq, n_ch, n_ch)
     spectra = np.einsum("if,ifab->fab", weights, stacked)
-    g_jj, g_yy, g_jy = conditioned_spectra(spectra, inputs[j], others, y)
-    gamma2 = coherence(g_jj, g_yy, g_jy, g_xx_total=np.real(spectra[:, inputs[j], inputs[j]]),
-                       g_yy_total=np.real(spectra[:, y, y]))
-    n_d = weights.T @ np.array([max(w.n_effective - n_conditioned, 1.0) for w in windows])
-    contributes = np.any(weights > 0, axis=1)
-    used = tuple(float(w.window_s) for k, w in enumerate(windows) if contributes[k])
+    response, gamma2, g_jj, g_yy, g_jy = pair_estimate(spectra, inputs, j, y, instrument)
+    gamma2 = np.where(usable, gamma2, 0.0)
+    # averages credited: each member's, by its share of the estimate (weight x the spectrum H is divided by)
+    divisor = instrument if instrument is not None and j == 0 else inputs[j]
+    share = weights * np.abs(stacked[:, :, divisor, inputs[j]])
+    n_d_mean = np.where(share.sum(axis=0) > 0, (share.T @ n_d) / np.maximum(share.sum(axis=0), np.finfo(float).tiny),
+                        weights.T @ n_d)
+    used = tuple(float(w.window_s) for k, w in enumerate(windows) if w.noise_dof is None and np.any(weights[k] > 0))
     return PairEstimate(
-        response=response(g_jj, g_jy, np.real(spectra[:, inputs[j], inputs[j]])),
+        response=response,
         coherence=gamma2,
-        random_error=random_error(_unbiased_coherence(gamma2, n_d), n_d),
+        random_error=random_error(_unbiased_coherence(gamma2, n_d_mean), n_d_mean),
         input_autospectrum=g_jj,
         output_autospectrum=g_yy,
         cross_spectrum=g_jy,
         windows_s=used,
+        whole_record=whole,
     )
+
+
+def _significant(gamma2: np.ndarray, n_records: float, n_inputs: int, noise_dof: np.ndarray) -> np.ndarray:
+    """Whether the whole-record member's output power stands out of its smoothed noise (F test, see ``_whole``).
+
+    Its autospectra carry the noise as ``(K - q) / K`` of the smoothed estimate, so signal over noise is
+    ``(K - q) / K g^2 / (1 - g^2)``; the statistic is ``n_d`` times that, ``n_d = K - q + 1``.
+    """
+    n_d = n_records - n_inputs + 1
+    statistic = n_d * (n_records - n_inputs) / n_records * gamma2 / np.maximum(1.0 - gamma2, 1e-300)
+    return statistic > significance_threshold(noise_dof)
 
 
 def _unbiased_coherence(gamma2: np.ndarray, n_d: float | np.ndarray) -> np.ndarray:

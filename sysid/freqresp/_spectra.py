@@ -41,6 +41,9 @@ class WindowSpectra:
         Equivalent number of independent averages (overlap-corrected).
     omega_low : float
         Lowest frequency the window resolves, rad/s.
+    noise_dof : ndarray, shape (n_freq,), or None
+        Degrees of freedom of the smoothed noise autospectra the whole-record
+        member (:mod:`sysid.freqresp._whole`) carries; None for a window.
     """
 
     window_s: float
@@ -48,6 +51,7 @@ class WindowSpectra:
     n_windows: int
     n_effective: float
     omega_low: float
+    noise_dof: np.ndarray | None = None
 
 
 def window_spectra(

@@ -11,6 +11,7 @@ from flightlogs.record import Record
 
 from ._composite import composite_pair
 from ._spectra import WindowSpectra, window_spectra
+from ._whole import whole_record_spectra
 from .options import ResponseOptions
 from .response import FrequencyResponse
 
@@ -42,23 +43,25 @@ def frequency_responses(
     outputs : sequence of str
         Output signal names (``q``, ``ax`` ...).
     options : ResponseOptions, optional
-        Grid, windows, overlap, taper.
+        Grid, windows, overlap, taper, reference, whole-record member.
 
     Returns
     -------
     tuple of FrequencyResponse
         For each output, for each input, in the order given. ``coherence`` is
         the partial coherence when conditioned; the spectra stored are then
-        the conditioned ones (so that ``response = cross / input`` and
-        ``coherence = |cross|^2 / (input output)`` hold for every response).
+        the conditioned ones (so that ``response = cross / input`` and,
+        without a reference, ``coherence = |cross|^2 / (input output)`` hold
+        for every response).
 
     Raises
     ------
     MissingSignalError
-        If a record lacks a signal named.
+        If a record lacks a signal named (the reference included).
     DataError
         If the records differ in rate, hold NaNs, are shorter than every
-        window, an input never varies, or the grid exceeds the Nyquist frequency.
+        window, an input or the reference never varies, the reference is
+        also an input or output, or the grid exceeds the Nyquist frequency.
 
     Notes
     -----
@@ -70,7 +73,10 @@ def frequency_responses(
     (Bendat & Piersol), ``n_d`` the overlap-corrected number of averages
     (less one per conditioning input), see :mod:`sysid.freqresp._composite`.
     Grid points below ``2 pi min_cycles / T`` of the longest window ``T`` are
-    left out.
+    left out; with the whole-record member (``options.whole_record`` and more
+    records than inputs, :mod:`sysid.freqresp._whole`) ``T`` is the longest
+    record. With ``options.reference`` the estimate of the first input is the
+    instrumental-variable one (:mod:`sysid.freqresp._conditioning`).
 
     Examples
     --------
@@ -85,33 +91,46 @@ def frequency_responses(
     ('q/delta_lon', True, True)
     """
     inputs, outputs = tuple(inputs), tuple(outputs)
-    _check_names(inputs, outputs)
+    reference = options.reference
+    _check_names(inputs, outputs, reference)
     if not records:
         raise DataError("no records to compute frequency responses from")
     dt = _common_step(records)
     if options.omega_max > np.pi / dt:
         raise DataError(f"omega_max={options.omega_max:g} rad/s is above the Nyquist frequency "
                         f"{np.pi / dt:.1f} rad/s of the {1 / dt:g} Hz records")
-    channels = inputs + outputs
+    extra = () if reference is None else (reference,)
+    channels = inputs + extra + outputs
     data = [_channels(record, channels) for record in records]
-    for k, name in enumerate(inputs):
+    for k, name in enumerate(inputs + extra):
         if all(np.ptp(block[k]) == 0 for block in data):
-            raise DataError(f"input {name} does not vary in any record: nothing excites the responses")
+            what = f"input {name}" if k < len(inputs) else f"reference {name}"
+            raise DataError(f"{what} does not vary in any record: nothing excites the responses")
+    input_rows = list(range(len(inputs)))
+    instrument = len(inputs) if reference is not None else None
+    output_rows = [len(inputs) + len(extra) + o for o in range(len(outputs))]
     lengths = _window_samples(data, dt, options)
-    omega = _grid(options, dt, lengths)
+    whole = options.whole_record and len(data) > len(inputs)
+    longest = max(block.shape[1] for block in data) if whole else max(lengths)
+    omega = _grid(options, dt, longest)
     windows = [_spectra(data, dt, n, omega, options) for n in lengths]
+    if whole:
+        member = whole_record_spectra(data, dt, omega, inputs=input_rows, outputs=output_rows, instrument=instrument,
+                                      min_cycles=options.min_cycles)
+        windows += [member] if member is not None else []
     units = _units(records, channels)
     found = []
     for o, output in enumerate(outputs):
         for j, name in enumerate(inputs):
-            estimate = composite_pair(windows, omega, list(range(len(inputs))), j, len(inputs) + o)
+            estimate = composite_pair(windows, omega, input_rows, j, output_rows[o], instrument)
             found.append(FrequencyResponse(
                 input=name, output=output, omega=omega.copy(), response=estimate.response,
                 coherence=estimate.coherence, random_error=estimate.random_error,
                 input_autospectrum=estimate.input_autospectrum, output_autospectrum=estimate.output_autospectrum,
                 cross_spectrum=estimate.cross_spectrum, windows_s=estimate.windows_s,
                 conditioned_on=tuple(other for other in inputs if other != name),
-                input_unit=units[name], output_unit=units[output],
+                input_unit=units[name], output_unit=units[output], reference=reference,
+                whole_record=estimate.whole_record,
             ))
     return tuple(found)
 
@@ -144,12 +163,14 @@ def automatic_window_lengths(longest_record_s: float, omega_min: float) -> tuple
     return tuple(float(t) for t in np.geomspace(shortest, longest, _N_AUTOMATIC_WINDOWS))
 
 
-def _check_names(inputs: tuple[str, ...], outputs: tuple[str, ...]) -> None:
+def _check_names(inputs: tuple[str, ...], outputs: tuple[str, ...], reference: str | None) -> None:
     if not inputs or not outputs:
         raise DataError(f"need at least one input and one output, got inputs={inputs}, outputs={outputs}")
     doubled = sorted({n for n in inputs + outputs if (inputs + outputs).count(n) > 1})
     if doubled:
         raise DataError(f"signal(s) {', '.join(doubled)} named twice among the inputs and outputs")
+    if reference is not None and reference in inputs + outputs:
+        raise DataError(f"reference {reference} is also an input or output; it must be the injected excitation")
 
 
 def _common_step(records: Sequence[Record]) -> float:
@@ -187,12 +208,13 @@ def _window_samples(data: Sequence[np.ndarray], dt: float, options: ResponseOpti
     return samples
 
 
-def _grid(options: ResponseOptions, dt: float, lengths: Sequence[int]) -> np.ndarray:
+def _grid(options: ResponseOptions, dt: float, longest: int) -> np.ndarray:
+    """The grid from the lowest frequency the longest member (window or record, samples) resolves."""
     omega = options.grid()
-    lowest = 2.0 * np.pi * options.min_cycles / (max(lengths) * dt)
+    lowest = 2.0 * np.pi * options.min_cycles / (longest * dt)
     kept = omega[omega >= lowest * (1.0 - 1e-12)]
     if kept.size < 2:
-        raise DataError(f"the longest window ({max(lengths) * dt:.2f} s) resolves nothing below "
+        raise DataError(f"the longest window ({longest * dt:.2f} s) resolves nothing below "
                         f"{lowest:.3g} rad/s, at or above omega_max={options.omega_max:g} rad/s")
     return kept
 

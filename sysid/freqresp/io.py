@@ -4,7 +4,8 @@ Layout (schema version 1)::
 
     /                         attrs: schema, schema_version, software, created_utc
     /responses/<nnn>/         attrs: input, output, input_unit, output_unit, windows_s,
-                                     conditioned_on (JSON list), fit_range (2 floats; absent before gating)
+                                     conditioned_on (JSON list), fit_range (2 floats; absent before gating),
+                                     reference (absent when none), whole_record (bool; absent: False)
     /responses/<nnn>/omega                 float64 (n_freq,), attrs unit = "rad/s"
     /responses/<nnn>/response              complex128 (n_freq,), attrs unit = "<output>/<input>"
     /responses/<nnn>/coherence             float64 (n_freq,), unit "1"
@@ -14,6 +15,9 @@ Layout (schema version 1)::
     /responses/<nnn>/cross_spectrum        complex128 (n_freq,), unit "<input>*<output>/(rad/s)"
 
 ``<nnn>`` is the zero-padded position, so the order written is the order read.
+``reference`` and ``whole_record`` are optional attributes: files written
+before them read as responses without a reference or whole-record member,
+and older readers ignore them, so the layout version stays 1.
 """
 
 from __future__ import annotations
@@ -116,6 +120,9 @@ def _write_one(group: h5py.Group, response: FrequencyResponse) -> None:
     group.attrs["conditioned_on"] = json.dumps(list(response.conditioned_on))
     if response.fit_range is not None:
         group.attrs["fit_range"] = np.asarray(response.fit_range, dtype=np.float64)
+    if response.reference is not None:
+        group.attrs["reference"] = response.reference
+    group.attrs["whole_record"] = bool(response.whole_record)
     units = _units(response)
     for name in _ARRAYS:
         dataset = group.create_dataset(name, data=np.asarray(getattr(response, name)))
@@ -132,12 +139,15 @@ def _units(response: FrequencyResponse) -> dict[str, str]:
 def _read_one(group: h5py.Group) -> FrequencyResponse:
     arrays = {name: group[name][()] for name in _ARRAYS}
     fit = group.attrs.get("fit_range")
+    reference = group.attrs.get("reference")
     return FrequencyResponse(
         input=_text(group.attrs["input"]), output=_text(group.attrs["output"]),
         windows_s=tuple(float(t) for t in np.atleast_1d(group.attrs["windows_s"])),
         conditioned_on=tuple(json.loads(_text(group.attrs["conditioned_on"]))),
         input_unit=_text(group.attrs["input_unit"]), output_unit=_text(group.attrs["output_unit"]),
         fit_range=None if fit is None else (float(fit[0]), float(fit[1])),
+        reference=None if reference is None else _text(reference),
+        whole_record=bool(group.attrs.get("whole_record", False)),
         **arrays,
     )
 

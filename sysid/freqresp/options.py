@@ -49,11 +49,31 @@ class ResponseOptions:
         transforms by one matrix product per window length; ``"linear"`` uses
         the chirp-z transform (:class:`scipy.signal.CZT`), the fast one for a
         dense, evenly spaced zoom grid.
+    reference : str or None
+        Record column holding the injected excitation (``"excitation"``,
+        ArduPilot's SIDD), or None. When given it stands in for the first
+        input as an instrumental variable: ``H = G_ry / G_rx`` (conditioned
+        on the other inputs, which are their own instruments). In closed
+        loop the mixer input carries the feedback of the output noise and
+        turbulence, which biases ``G_xy / G_xx`` towards ``-1 / K``; the
+        injected signal is uncorrelated with both. The coherence is then the
+        one matching the estimate's random error (see
+        :mod:`sysid.freqresp._conditioning`). None: the inputs themselves.
+    whole_record : bool
+        Add the records' whole-length transforms to the composite where they
+        are significant (:mod:`sysid.freqresp._whole`; needs more records
+        than inputs). A record holding a whole maneuver from trim to trim
+        gives ``Y = H X`` exactly, free of the windows' resolution bias near
+        a closed loop's notch, an unstable pair and the sweep's fade-in
+        tone; the grid then reaches down to ``min_cycles`` periods of the
+        longest record. False: windows only (CIFER's composite).
 
     Examples
     --------
     >>> ResponseOptions(window_lengths_s=(2.0, 4.0, 8.0), overlap=0.5).window_lengths_s
     (2.0, 4.0, 8.0)
+    >>> ResponseOptions(reference="excitation").reference
+    'excitation'
     """
 
     omega_min: float = 0.5
@@ -66,6 +86,8 @@ class ResponseOptions:
     min_decades: float = 0.3
     min_cycles: float = 3.0
     spacing: Literal["log", "linear"] = "log"
+    reference: str | None = None
+    whole_record: bool = True
 
     def __post_init__(self) -> None:
         if not 0.0 < self.omega_min < self.omega_max or not np.isfinite(self.omega_max):
@@ -91,6 +113,8 @@ class ResponseOptions:
             raise ValueError(f"{self.min_cycles=} must be > 0")
         if self.spacing not in ("log", "linear"):
             raise ValueError(f"spacing={self.spacing!r} must be 'log' or 'linear'")
+        if self.reference is not None and (not isinstance(self.reference, str) or not self.reference):
+            raise ValueError(f"reference={self.reference!r} must be a signal name or None")
 
     def grid(self) -> np.ndarray:
         """The requested frequency grid, rad/s, shape (n_freq,)."""

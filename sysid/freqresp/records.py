@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import MappingProxyType
 
 import numpy as np
@@ -17,7 +17,10 @@ from .estimate import frequency_responses
 from .options import ResponseOptions
 from .response import FrequencyResponse
 
-__all__ = ["DEFAULT_PAIRS", "maneuver_records", "parse_pairs", "default_pairs", "FlightResponses", "flight_responses"]
+__all__ = [
+    "DEFAULT_PAIRS", "EXCITATION", "maneuver_records", "parse_pairs", "default_pairs", "FlightResponses",
+    "flight_responses",
+]
 
 #: Outputs per mixer axis, after the chapter 3 model (eqs. 3.10-3.13, accelerations by eq. 3.7); inputs ``delta_<axis>``.
 DEFAULT_PAIRS: Mapping[str, tuple[str, ...]] = MappingProxyType({
@@ -27,6 +30,8 @@ DEFAULT_PAIRS: Mapping[str, tuple[str, ...]] = MappingProxyType({
     "thr": ("az", "w"),
 })
 _MIN_PIECE_SAMPLES = 16
+#: The canonical signal holding the injected excitation (ArduPilot SIDD), used as reference when logged.
+EXCITATION = "excitation"
 
 
 def maneuver_records(
@@ -152,10 +157,14 @@ class FlightResponses:
         One per pair asked for, in that order.
     pieces : Mapping[str, int]
         Number of record pieces used per axis.
+    notes : tuple of str, optional
+        One sentence per axis on what the responses were computed against:
+        the logged excitation as reference, or the mixer input and why.
     """
 
     responses: tuple[FrequencyResponse, ...]
     pieces: Mapping[str, int]
+    notes: tuple[str, ...] = ()
 
 
 def flight_responses(
@@ -165,6 +174,7 @@ def flight_responses(
     axis: str | None = None,
     kind: str = "sweep",
     options: ResponseOptions = ResponseOptions(),
+    use_excitation: bool = True,
 ) -> FlightResponses:
     """Frequency responses of the pairs on the maneuvers of their axis.
 
@@ -172,6 +182,14 @@ def flight_responses(
     `axis` for every pair when given. Within an axis all inputs named are
     computed together, so an output paired with two inputs (``ax/delta_lon``
     and ``ax/wind_lon``) gets responses conditioned on the other input.
+
+    Where every piece of an axis carries a varying ``excitation`` (ArduPilot
+    logs its System ID chirp as SIDD) and the axis's mixer input is among the
+    inputs, that excitation is the reference of the mixer input's responses
+    (``ResponseOptions.reference``: ``H = G_ry / G_rx``, free of the bias the
+    feedback of noise and turbulence puts into ``G_xy / G_xx``). Otherwise
+    (PX4 logs no excitation, doublets are not logged) the responses are
+    computed from the mixer input itself; `notes` says which, per axis.
 
     Parameters
     ----------
@@ -184,7 +202,11 @@ def flight_responses(
     kind : str, optional
         Maneuver kind.
     options : ResponseOptions, optional
-        Grid and windows.
+        Grid and windows. A `reference` set here is used on every axis (a
+        piece without it is then an error).
+    use_excitation : bool, optional
+        Use the logged excitation as reference where it can be (default
+        True); False computes every response from the inputs themselves.
 
     Returns
     -------
@@ -205,16 +227,42 @@ def flight_responses(
         groups.setdefault(axis or _axis_of(input_, chosen), []).append((output, input_))
     found: dict[tuple[str, str], FrequencyResponse] = {}
     pieces: dict[str, int] = {}
+    notes: list[str] = []
     for group_axis, group in groups.items():
         records = maneuver_records(flights, group_axis, kind=kind)
         if not records:
             raise DataError(f"no {kind} on axis {group_axis} in {_names(flights)}")
+        mixer = f"delta_{group_axis}"
         inputs = list(dict.fromkeys(input_ for _, input_ in group))
+        inputs.sort(key=lambda name: name != mixer)  # the reference stands in for the first input: the mixer's
         outputs = list(dict.fromkeys(output for output, _ in group))
-        for response in frequency_responses(records, inputs, outputs, options):
+        chosen_options, note = _reference_for(records, group_axis, inputs, kind, options, use_excitation)
+        notes.append(note)
+        for response in frequency_responses(records, inputs, outputs, chosen_options):
             found[(response.output, response.input)] = response
         pieces[group_axis] = len(records)
-    return FlightResponses(tuple(found[pair] for pair in chosen), MappingProxyType(pieces))
+    return FlightResponses(tuple(found[pair] for pair in chosen), MappingProxyType(pieces), tuple(notes))
+
+
+def _reference_for(records: Sequence[Record], axis: str, inputs: Sequence[str], kind: str,
+                   options: ResponseOptions, use_excitation: bool) -> tuple[ResponseOptions, str]:
+    """The options for one axis (reference set or not) and the note saying which and why."""
+    first = inputs[0]
+    if options.reference is not None:
+        return options, f"{axis}: {options.reference} is the reference of the {first} responses (as asked)."
+    if not use_excitation:
+        return options, f"{axis}: responses computed from {first} itself (reference not used, as asked)."
+    mixer = f"delta_{axis}"
+    if first != mixer:
+        return options, f"{axis}: no mixer input {mixer} among the inputs: responses computed from {first} itself."
+    carrying = [r for r in records if EXCITATION in r.signals and np.ptp(r[EXCITATION]) > 0]
+    if len(carrying) == len(records):
+        return replace(options, reference=EXCITATION), (
+            f"{axis}: the logged {EXCITATION} (SIDD) is the reference of the {mixer} responses, H = G_ry / G_rx.")
+    which = "none" if not carrying else f"only {len(carrying)} of {len(records)}"
+    return options, (f"{axis}: {which} of the {kind} pieces carry a logged {EXCITATION} (PX4 logs none): responses "
+                     f"computed from the mixer input {mixer}, which in closed loop also carries the feedback of "
+                     f"noise and turbulence.")
 
 
 def _axis_of(input_: str, pairs: Sequence[tuple[str, str]]) -> str:

@@ -31,7 +31,9 @@ class FrequencyResponse:
     input_autospectrum, output_autospectrum : ndarray, shape (n_freq,)
         G_xx and G_yy (one-sided), unit^2 / (rad/s).
     cross_spectrum : ndarray of complex, shape (n_freq,)
-        G_xy.
+        G_xy; with a `reference`, ``response * G_xx`` (``response = cross /
+        input`` always holds, ``coherence = |cross|^2 / (input output)`` only
+        without a reference).
     windows_s : tuple of float
         Window lengths combined into this response, s.
     conditioned_on : tuple of str, optional
@@ -41,6 +43,11 @@ class FrequencyResponse:
     fit_range : tuple of float or None, optional
         ``(omega_min, omega_max)``, rad/s, where the response passed gating;
         ``None`` before gating.
+    reference : str or None, optional
+        The injected excitation used as instrument for the input (``H = G_ry /
+        G_rx``), or None when the response is ``G_xy / G_xx``.
+    whole_record : bool, optional
+        Whether the records' whole-length transforms contributed to the composite.
     """
 
     input: str
@@ -57,6 +64,8 @@ class FrequencyResponse:
     input_unit: str = ""
     output_unit: str = ""
     fit_range: tuple[float, float] | None = None
+    reference: str | None = None
+    whole_record: bool = False
 
     def __post_init__(self) -> None:
         n_freq = np.shape(self.omega)

@@ -9,7 +9,12 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from datetime import datetime, timezone
+
 from sysid.freqresp import DEFAULT_PAIRS, read_responses
+from sysid.sim.excitation import Maneuver
+from sysid.sim.linear_flight import CALM_HOVER, simulate_hover
+from sysid.sim.px4_writer import write_px4_log
 from sysid.sim.scenarios import write_demo_flight
 from sysid_cli.main import cli
 
@@ -51,6 +56,34 @@ def test_default_pairs_from_a_dataset_with_outputs_reopened(demo: dict[str, Path
         lo, hi = by_pair[pair].fit_range or (1.0, 1.0)
         assert np.log10(hi / lo) > 1.0, pair
     assert "q/delta_lon" in plot.read_text() and "kept" in result.stderr
+    # the simulator's ArduPilot log carries SIDD: the excitation is every axis's reference, said so
+    assert all(entry["reference"] == "excitation" for entry in summary["responses"])
+    assert all(r.reference == "excitation" and not r.whole_record for r in responses)  # one piece per axis
+    assert summary["notes"][1] == "lon: the logged excitation (SIDD) is the reference of the delta_lon responses, " \
+                                  "H = G_ry / G_rx."
+    assert summary["options"]["reference"] is None and summary["options"]["whole_record"] is True
+
+
+def test_the_reference_can_be_switched_off(demo: dict[str, Path]) -> None:
+    result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), "--pairs", "q/delta_lon", "--reference", "none",
+                                      "--no-whole-record", "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert summary["responses"][0]["reference"] is None and summary["options"]["whole_record"] is False
+    assert summary["notes"] == ["lon: responses computed from delta_lon itself (reference not used, as asked)."]
+
+
+def test_a_px4_log_has_no_excitation_and_the_mixer_input_is_used(tmp_path: Path) -> None:
+    """PX4 logs no injected excitation: the responses come from the mixer input, and the notes say so."""
+    flight = simulate_hover(50.0, (Maneuver("lon", "sweep", 8.0, 8.0, 34.0),), parameters=CALM_HOVER, seed=2)
+    log = write_px4_log(flight, tmp_path / "sweep.ulg", utc_start=datetime(2024, 5, 1, 10, tzinfo=timezone.utc))
+    result = CliRunner().invoke(cli, ["freqresp", str(log), "--pairs", "q/delta_lon", "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert summary["responses"][0]["reference"] is None and summary["responses"][0]["kept"]
+    assert summary["notes"] == ["lon: none of the sweep pieces carry a logged excitation (PX4 logs none): responses "
+                                "computed from the mixer input delta_lon, which in closed loop also carries the "
+                                "feedback of noise and turbulence."]
 
 
 def test_logs_are_ingested_on_the_fly_and_wind_inputs_conditioned(demo: dict[str, Path]) -> None:
@@ -72,6 +105,7 @@ def test_logs_are_ingested_on_the_fly_and_wind_inputs_conditioned(demo: dict[str
     (["--pairs", "q/delta_lon", "--kind", "3211"], "no 3211 on axis lon"),
     (["--windows", "90"], "longer than every record"),
     (["--omega-max", "400"], "above the Nyquist frequency"),
+    (["--pairs", "q/delta_lon", "--reference", "sidd"], "has no signal sidd"),
 ])
 def test_bad_data_is_exit_1_with_one_sentence_and_no_file(demo: dict[str, Path], tmp_path: Path, args: list[str],
                                                            fragment: str) -> None:

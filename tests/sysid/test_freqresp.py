@@ -9,15 +9,23 @@ test; 4.5 sigma keeps the chance of a false alarm over the ~300 points of a
 test under 0.3 % (Bonferroni), and test_random_error_estimate_matches_the_scatter
 checks that the reported error is that standard deviation. The systems are simulated exactly (input evaluated analytically at 10x
 the log rate, first-order-hold integration, then sampled at 100 Hz), so what
-remains is the estimator's error.
+remains is the estimator's error. No band is excused.
 
-In closed loop the feedback notches the mixer input at the unstable pair's
-frequency, and every windowed estimate smooths the spectra over its main
-lobe (±2 bins of the longest window, ±0.7 rad/s for 18 s); the sweep's 5 s
-fade-in tone at 0.1 Hz does the same at the lowest frequencies, and its
-fade-out tone above the sweep's top (10 Hz in the octocopter's sweeps). In
-those bands the bias measured is up to 0.95 dB and 11° (the tests bound it
-at 1 dB and 12°); everywhere else the tolerance above holds.
+Closed loop, the mixer input is notched at the unstable pair's frequency
+and the pair's impulse response never decays, so every window's estimate is
+biased there (it smooths the spectra over its main lobe, and the output in a
+window answers input from before it); so is the sweep's 0.1 Hz fade-in tone
+at the lowest frequencies. Measured with windows only: 0.64 dB / 6.4° on
+theta, 11° on q, 0.58 dB on u, below 2.6 rad/s, in every seed: CIFER's
+windows hide it behind the random error their lowered coherence reports. The
+records' whole-length transforms (:mod:`sysid.freqresp._whole`) hold
+``Y = H X`` exactly and remove it: the bias tests below check 0.5 dB / 3°
+with no random-error allowance where those transforms measure to a fraction
+of a degree, and that windows alone fail them.
+
+The feedback of a disturbance (turbulence) biases the mixer-input estimate
+towards ``-1 / K`` even where gamma^2 > 0.8; the injected excitation as
+reference (``H = G_ry / G_rx``) does not.
 """
 
 from __future__ import annotations
@@ -34,7 +42,7 @@ from scipy import signal as sps
 from flightlogs.record import Record
 from sysid.freqresp import ResponseOptions, frequency_responses
 from sysid.freqresp._spectra import effective_averages
-from sysid.sim.excitation import Maneuver, sweep
+from sysid.sim.excitation import Maneuver, excitation_signal, sweep
 from sysid.sim.linear_flight import CALM_HOVER, simulate_hover
 from sysid.statespace import DelayedStateSpace
 
@@ -72,36 +80,28 @@ def _errors(estimate: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def _assert_within_tolerance(response, truth: np.ndarray, *, min_decades: float,  # type: ignore[no-untyped-def]
-                             biased: tuple[tuple[float, float], ...] = ()) -> None:
-    """0.5 dB / 3° (or K_SIGMA eps_r) where gamma^2 > 0.8; 1 dB / 12° inside the `biased` bands (rad/s)."""
+                             k_sigma: float = K_SIGMA, below_rad_s: float = np.inf) -> None:
+    """0.5 dB / 3° (or `k_sigma` eps_r) wherever gamma^2 > 0.8 (below `below_rad_s`)."""
     good = response.coherence > 0.8
     assert np.log10(response.omega[good].max() / response.omega[good].min()) >= min_decades
+    good &= response.omega <= below_rad_s
     db, deg = _errors(response.response[good], truth[good])
     eps = response.random_error[good]
     omega = response.omega[good]
-    inside = np.zeros(omega.size, dtype=bool)
-    for lo, hi in biased:
-        inside |= (omega >= lo) & (omega <= hi)
-    allowed_db = np.where(inside, 1.0, np.maximum(MAX_DB, 20 * np.log10(np.e) * K_SIGMA * eps))
-    allowed_deg = np.where(inside, 12.0, np.maximum(MAX_DEG, np.degrees(K_SIGMA * eps)))
+    allowed_db = np.maximum(MAX_DB, 20 * np.log10(np.e) * k_sigma * eps)
+    allowed_deg = np.maximum(MAX_DEG, np.degrees(k_sigma * eps))
     worst = np.argmax(db / allowed_db)
     assert db[worst] < allowed_db[worst], f"{response.pair}: {db[worst]:.2f} dB at {omega[worst]:.2f} rad/s"
     worst = np.argmax(deg / allowed_deg)
     assert deg[worst] < allowed_deg[worst], f"{response.pair}: {deg[worst]:.2f} deg at {omega[worst]:.2f} rad/s"
 
 
-def _resolution_bands(response, resonance_rad_s: float, f_stop_hz: float | None = None):  # type: ignore[no-untyped-def]
-    """Up to two bins of the longest window above the resonance (its main lobe), and above the sweep's top.
-
-    Below the resonance, the lobe of the fade-in tone (0.63 rad/s + 2 bins = 1.3 rad/s for 18 s windows)
-    meets the notch's (1.9 - 2 bins = 1.2 rad/s): the band runs from the lowest frequency. Above the
-    sweep's top frequency there is no excitation of its own, only the fade-out tone's lobe.
-    """
-    bins = 2 * 2 * np.pi / max(response.windows_s)
-    bands = [(0.0, resonance_rad_s + bins)]
-    if f_stop_hz is not None:
-        bands.append((2 * np.pi * f_stop_hz, np.inf))
-    return tuple(bands)
+def _fails_tolerance(response, truth: np.ndarray, **kwargs: float) -> bool:  # type: ignore[no-untyped-def]
+    try:
+        _assert_within_tolerance(response, truth, **kwargs)
+    except AssertionError:
+        return True
+    return False
 
 
 def test_first_order_lag_with_delay() -> None:
@@ -167,9 +167,14 @@ def test_scaling_the_input_scales_the_response_inversely(scale: float, seed: int
     np.testing.assert_allclose(scaled.random_error, base.random_error, rtol=1e-6)
 
 
-def _closed_loop_unstable(noise: float, seed: int, n_records: int = 5, oversample: int = 10) -> list[Record]:
+def _closed_loop_unstable(noise: float, seed: int, n_records: int = 5, oversample: int = 10,
+                          disturbance: float = 0.0) -> list[Record]:
     """Plant b / (s^2 - 1.756 s + 3.641) (poles 0.878 +- 1.694j, the calm pitch pair) with a 20 ms input
-    delay, stabilised by u = r - kp y - kd y'; the sweep r enters at the mixer input u, which is logged.
+    delay, stabilised by u = r - kp y - kd y'; the sweep r enters at the mixer input u, which is logged, and
+    r itself as ``excitation`` (as ArduPilot logs SIDD).
+
+    `disturbance`: RMS of a torque d at the plant input, white noise low-passed at 3 rad/s (turbulence), fed
+    back by the loop: u = S (r + d) - d and y = P S (r + d) with S = 1 / (1 + K P).
 
     Exact ZOH discretisation at 1 kHz; closed loop solved as a rational filter (lfilter), so there is no
     divergence and no integration error: the plant sees u held over each 1 ms step (half a step of delay).
@@ -187,25 +192,79 @@ def _closed_loop_unstable(noise: float, seed: int, n_records: int = 5, oversampl
     rng = np.random.default_rng(seed)
     fine = np.arange(int((34.0 + 2 * PAD_S) * RATE_HZ * oversample)) * dt
     r = sweep(fine, _sweep(amplitude=2.0))[0]
-    u = sps.lfilter(np.concatenate([den, np.zeros(lag)]), closed, r)
-    y = sps.lfilter(delayed_y, closed, r)
-    u, y = u[::oversample], y[::oversample]
-    return [_record({"u": u, "y": y + noise * np.std(y) * rng.normal(size=y.size)}, fine[::oversample])
-            for _ in range(n_records)]
+    low_pass = sps.butter(1, 3.0 * dt / np.pi, output="sos")
+    records = []
+    for _ in range(n_records):
+        d = np.zeros(fine.size)
+        if disturbance > 0:
+            d = sps.sosfilt(low_pass, rng.normal(size=fine.size))
+            d *= disturbance / np.std(d)
+        u = sps.lfilter(np.concatenate([den, np.zeros(lag)]), closed, r + d)[::oversample] - d[::oversample]
+        y = sps.lfilter(delayed_y, closed, r + d)[::oversample]
+        records.append(_record({"u": u, "y": y + noise * np.std(y) * rng.normal(size=y.size),
+                                "excitation": r[::oversample]}, fine[::oversample]))
+    return records
 
 
-def test_unstable_pair_identified_in_closed_loop_from_the_mixer_input() -> None:
-    records = _closed_loop_unstable(noise=0.05, seed=3)
-    assert np.max(np.abs(records[0]["y"])) < 10.0  # flown stabilised
-    (response,) = frequency_responses(records, ["u"], ["y"])
+def _unstable_plant_truth(omega: np.ndarray) -> np.ndarray:
     plant = DelayedStateSpace(np.array([[0.0, 1.0], [-3.641, 1.756]]), np.array([[0.0], [2.0]]),
                               np.array([[1.0, 0.0]]), np.zeros((1, 1)), ("y", "y_dot"), ("u",), ("y",),
                               np.array([0.02 + 0.0005]))  # + half a 1 ms hold
-    truth = plant.frequency_response(response.omega)[:, 0, 0]
-    pair_rad_s = float(np.abs(np.linalg.eigvals(plant.a)[0]))  # 1.91
-    _assert_within_tolerance(response, truth, min_decades=1.0, biased=_resolution_bands(response, pair_rad_s))
+    return plant.frequency_response(omega)[:, 0, 0]
+
+
+@pytest.mark.parametrize("reference", [None, "excitation"])
+def test_unstable_pair_identified_in_closed_loop_from_the_mixer_input(reference: str | None) -> None:
+    records = _closed_loop_unstable(noise=0.05, seed=3)
+    assert np.max(np.abs(records[0]["y"])) < 10.0  # flown stabilised
+    (response,) = frequency_responses(records, ["u"], ["y"], ResponseOptions(reference=reference))
+    assert response.whole_record and response.reference == reference
+    _assert_within_tolerance(response, _unstable_plant_truth(response.omega), min_decades=1.0)
     good = response.coherence > 0.8
-    assert response.omega[good].min() < 1.5  # the unstable pair's frequency is measured
+    assert response.omega[good].min() < 0.7  # the pair (1.91 rad/s) and the fade-in tone (0.63 rad/s) are measured
+
+
+def test_the_windows_bias_at_the_unstable_pair_is_gone() -> None:
+    """Below 2.6 rad/s (the pair plus two bins of the longest window): 0.5 dB / 3° with no random-error
+    allowance. The windows alone are 0.5-0.7 dB off there (and claim a random error that hides it)."""
+    records = _closed_loop_unstable(noise=0.05, seed=3)
+    (response,) = frequency_responses(records, ["u"], ["y"])
+    truth = _unstable_plant_truth(response.omega)
+    _assert_within_tolerance(response, truth, min_decades=1.0, k_sigma=0.0, below_rad_s=2.6)
+    (windows,) = frequency_responses(records, ["u"], ["y"], ResponseOptions(whole_record=False))
+    assert not windows.whole_record
+    assert _fails_tolerance(windows, _unstable_plant_truth(windows.omega), min_decades=1.0, k_sigma=0.0,
+                            below_rad_s=2.6)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_fed_back_disturbance_biases_the_mixer_input_estimate_but_not_the_reference_one(seed: int) -> None:
+    """Turbulence at the plant input, fed back by the loop: where it dominates, x = -K y + ... and G_xy / G_xx
+    tends to -1 / K with a coherence still above 0.8 (2-5 dB off, measured). G_ry / G_rx with the injected
+    excitation r, uncorrelated with the disturbance, stays within the tolerance."""
+    records = _closed_loop_unstable(noise=0.05, seed=seed, disturbance=0.5)
+    (mixer,) = frequency_responses(records, ["u"], ["y"])
+    assert _fails_tolerance(mixer, _unstable_plant_truth(mixer.omega), min_decades=0.5)
+    (referenced,) = frequency_responses(records, ["u"], ["y"], ResponseOptions(reference="excitation"))
+    _assert_within_tolerance(referenced, _unstable_plant_truth(referenced.omega), min_decades=0.5)
+
+
+def test_reference_random_error_matches_the_scatter() -> None:
+    """As test_random_error_estimate_matches_the_scatter, for the reference estimate in closed loop with a
+    fed-back disturbance: its coherence, ``1 / (1 + G_nn [G_zx^-1 G_zz G_zx^-H] / |H|^2)`` (the one its error
+    covariance gives), makes the error scatter with unit RMS. Measured on four closed-loop cases (disturbance
+    0.1 and 0.3, sensor noise fed back at 0.3 and 1 x RMS): RMS 0.89-1.14. The min of gamma^2_rx and
+    gamma^2_ry gave 1.39 with fed-back noise (it ignores the x channel's error); their product, close to this
+    one while both errors are small, gave 4 and 32 points out of tolerance in two of the cases."""
+    z = []
+    for seed in range(3):
+        records = _closed_loop_unstable(noise=0.05, seed=seed, disturbance=0.3)
+        (response,) = frequency_responses(records, ["u"], ["y"], ResponseOptions(reference="excitation"))
+        log_ratio = np.log(response.response / _unstable_plant_truth(response.omega))
+        used = response.coherence > 0.5
+        z.extend(np.concatenate([log_ratio.real[used], log_ratio.imag[used]]) / np.tile(response.random_error[used], 2))
+    rms = float(np.sqrt(np.mean(np.square(z))))
+    assert 0.8 < rms < 1.3, rms
 
 
 def _bare_airframe_lon(p: dict[str, float], delay_s: float) -> DelayedStateSpace:
@@ -224,38 +283,65 @@ def _bare_airframe_lon(p: dict[str, float], delay_s: float) -> DelayedStateSpace
 
 @pytest.fixture(scope="module")
 def octocopter_sweeps() -> list[Record]:
-    """Three 34 s pitch sweeps (0.1-10 Hz, 8 %) of the Table 3.3 calm model flown by the LQR hover controller."""
+    """Three 34 s pitch sweeps (0.1-10 Hz, 8 %) of the Table 3.3 calm model flown by the LQR hover controller,
+    with the injected sweep logged as ``excitation`` (normalised, as SIDD)."""
     starts = (4.0, 44.0, 84.0)
     maneuvers = tuple(Maneuver("lon", "sweep", s, 8.0, 34.0) for s in starts)
     flight = simulate_hover(124.0, maneuvers, parameters=CALM_HOVER, seed=5)
     time_s = flight.time_s
     table = pd.DataFrame({name: flight.signals[name] for name in ("delta_lon", "q", "ax", "theta", "u")}, index=time_s)
+    table["excitation"] = excitation_signal(time_s, maneuvers, "lon") / 100.0
     record = Record(table, {c: "-" for c in table.columns}, {}, Path("octocopter"))
     return [record.between(s - 1.0, s + 36.0) for s in starts]
 
 
-def test_octocopter_of_table_3_3(octocopter_sweeps: list[Record]) -> None:
-    """q, ax, theta, u per delta_lon against eqs. 3.7, 3.11 with T_a and tau_lon (closed loop, sensor noise).
+def _octocopter_truth(omega: np.ndarray) -> np.ndarray:
+    """Shape (n_freq, 4): q, ax, theta, u per delta_lon, as the simulator's log carries them.
 
     The simulator delays the command by whole 2 ms integration steps (tau = 10 x 2 ms) and holds its
     500 Hz command over each step, ``exp(-j w h/2) sinc(w h/2)`` with h = 2 ms, which the airframe sees;
     its log carries the command averaged over the five steps centred on each log instant, a zero-phase
     boxcar ``(1 + 2 cos w h + 2 cos 2 w h) / 5`` (-0.13 dB at 70 rad/s), which divides the response.
     """
-    responses = frequency_responses(octocopter_sweeps, ["delta_lon"], ["q", "ax", "theta", "u"])
     step = 0.002
     tau = round(CALM_HOVER["tau_lon"] / step) * step
-    omega = responses[0].omega
     hold = np.exp(-0.5j * omega * step) * np.sinc(omega * step / (2 * np.pi))
     boxcar = (1 + 2 * np.cos(omega * step) + 2 * np.cos(2 * omega * step)) / 5
-    truth = _bare_airframe_lon(dict(CALM_HOVER), tau).frequency_response(omega)[:, :, 0] * (hold / boxcar)[:, None]
+    return _bare_airframe_lon(dict(CALM_HOVER), tau).frequency_response(omega)[:, :, 0] * (hold / boxcar)[:, None]
+
+
+@pytest.mark.parametrize("reference", [None, "excitation"])
+def test_octocopter_of_table_3_3(octocopter_sweeps: list[Record], reference: str | None) -> None:
+    """q, ax, theta, u per delta_lon against eqs. 3.7, 3.11 with T_a and tau_lon (closed loop, sensor noise),
+    from the mixer input or with the excitation as reference, over the whole grid (0.5-70 rad/s).
+
+    At 70 rad/s, 1 Hz above the sweep's top, only the skirt of its 1 s fade-out is left: the outputs with
+    sensor noise lose their coherence there (u, noise-free in the simulator, keeps it, and is right)."""
+    responses = frequency_responses(octocopter_sweeps, ["delta_lon"], ["q", "ax", "theta", "u"],
+                                    ResponseOptions(reference=reference))
+    truth = _octocopter_truth(responses[0].omega)
     spans = {"q": 1.5, "ax": 1.0, "theta": 1.5, "u": 0.5}
-    eigenvalues = np.linalg.eigvals(_bare_airframe_lon(dict(CALM_HOVER), tau).a)
-    pitch_pair = float(np.abs(eigenvalues[np.argmax(eigenvalues.real)]))  # 0.878 ± 1.694j: 1.91 rad/s
     for k, response in enumerate(responses):
-        assert response.pair == f"{('q', 'ax', 'theta', 'u')[k]}/delta_lon"
-        _assert_within_tolerance(response, truth[:, k], min_decades=spans[response.output],
-                                 biased=_resolution_bands(response, pitch_pair, f_stop_hz=10.0))
+        assert response.pair == f"{('q', 'ax', 'theta', 'u')[k]}/delta_lon" and response.whole_record
+        _assert_within_tolerance(response, truth[:, k], min_decades=spans[response.output])
+        assert response.omega[response.coherence > 0.8].min() < 0.6  # down to the fade-in tone
+        if response.output != "u":
+            assert response.coherence[-1] < 0.5 and response.omega[-1] == pytest.approx(70.0)
+
+
+def test_the_windows_bias_below_the_pitch_pair_is_gone(octocopter_sweeps: list[Record]) -> None:
+    """Below 2.6 rad/s the whole records measure q, theta and u to a fraction of a degree: 0.5 dB / 3° with no
+    random-error allowance. The windows alone are 11° (q), 0.64 dB and 6.4° (theta), 0.58 dB (u) off there,
+    in every seed tried. (ax, whose random error there is 4°, is held to the general rule above.)"""
+    outputs = ["q", "theta", "u"]
+    responses = frequency_responses(octocopter_sweeps, ["delta_lon"], outputs)
+    windows = frequency_responses(octocopter_sweeps, ["delta_lon"], outputs, ResponseOptions(whole_record=False))
+    for response, window in zip(responses, windows):
+        k = ("q", "ax", "theta", "u").index(response.output)
+        _assert_within_tolerance(response, _octocopter_truth(response.omega)[:, k], min_decades=0.5, k_sigma=0.0,
+                                 below_rad_s=2.6)
+        assert _fails_tolerance(window, _octocopter_truth(window.omega)[:, k], min_decades=0.5, k_sigma=0.0,
+                                below_rad_s=2.6)
 
 
 def test_chirp_z_on_an_even_grid_equals_the_matrix_transform() -> None:

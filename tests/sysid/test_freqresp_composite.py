@@ -1,9 +1,13 @@
-"""Multi-input conditioning and the multi-window composite.
+"""Multi-input conditioning, the multi-window composite and its whole-record member.
 
 Conditioning: two correlated inputs drive one output through known discrete
 filters, so the truth is exact (``freqz`` at ``omega dt``). The conditioned
 (MISO) responses recover each filter; the single-input ones absorb the other
 input's correlated part, ``H1 + H2 G_12 / G_11``, and are visibly biased.
+
+The windows' composite (CIFER's) is compared with its single windows with
+the whole-record member switched off; the member's own rules (more records
+than inputs, significance against its noise) are tested at the end.
 """
 
 from __future__ import annotations
@@ -105,16 +109,23 @@ def test_composite_beats_every_single_window_over_the_full_range(noise: float) -
 
     Each single window is run alone over the same grid (its low-frequency limit lifted), as an analysis
     with one window length would be: short windows are biased at low frequency, long ones noisy at high.
+    The composite, with its whole-record member (which takes the grid down to 3 periods of the record),
+    beats every one of them, and beats the windows' composite where both are defined.
     """
     records, model = _lag_sweeps(noise, seed=4)
     (composite,) = frequency_responses(records, ["x"], ["y"])
     truth = model.frequency_response(composite.omega)[:, 0, 0]
     composite_error = float(np.sqrt(np.mean(np.abs(np.log(composite.response / truth)) ** 2)))
-    assert len(composite.windows_s) == 5
+    assert len(composite.windows_s) == 5 and composite.whole_record
+    (windows,) = frequency_responses(records, ["x"], ["y"], ResponseOptions(whole_record=False))
+    shared = np.isin(composite.omega, windows.omega)
+    assert windows.omega[0] > composite.omega[0] and shared.sum() == windows.omega.size
+    windows_error = float(np.sqrt(np.mean(np.abs(np.log(windows.response / truth[shared])) ** 2)))
+    assert float(np.sqrt(np.mean(np.abs(np.log(composite.response / truth)[shared]) ** 2))) <= windows_error
     for window_s in composite.windows_s:
         cycles = composite.omega[0] * window_s / (2 * np.pi) * (1 - 1e-9)
         (single,) = frequency_responses(records, ["x"], ["y"], ResponseOptions(window_lengths_s=(window_s,),
-                                                                               min_cycles=cycles))
+                                                                               min_cycles=cycles, whole_record=False))
         np.testing.assert_allclose(single.omega, composite.omega)
         single_error = float(np.sqrt(np.mean(np.abs(np.log(single.response / truth)) ** 2)))
         assert composite_error < single_error, f"{window_s:.1f} s window: {single_error:.4f} <= {composite_error:.4f}"
@@ -125,8 +136,8 @@ def test_composite_random_error_lies_between_its_windows() -> None:
     frequency, where the short windows add hundreds of averages. Never far below the best: the windows reuse
     the same data, so the composite is credited the weighted mean of their averages, not their sum."""
     records, _ = _lag_sweeps(0.1, seed=5)
-    (composite,) = frequency_responses(records, ["x"], ["y"])
-    singles = [frequency_responses(records, ["x"], ["y"], ResponseOptions(window_lengths_s=(t,)))[0]
+    (composite,) = frequency_responses(records, ["x"], ["y"], ResponseOptions(whole_record=False))
+    singles = [frequency_responses(records, ["x"], ["y"], ResponseOptions(window_lengths_s=(t,), whole_record=False))[0]
                for t in composite.windows_s]
     best = np.full(composite.omega.size, np.inf)
     worst = np.zeros(composite.omega.size)
@@ -138,3 +149,32 @@ def test_composite_random_error_lies_between_its_windows() -> None:
     assert np.all(composite.random_error <= worst)
     high = composite.omega > 20.0
     assert np.median(composite.random_error[high] / singles[-1].random_error[high]) < 0.5
+
+
+def test_the_whole_record_member_needs_more_records_than_inputs() -> None:
+    """Its noise is measured between records: one record (or as many as inputs) leaves the windows alone."""
+    records, _ = _lag_sweeps(0.1, seed=6)
+    (one,) = frequency_responses(records[:1], ["x"], ["y"])
+    (two,) = frequency_responses(records[:2], ["x"], ["y"])
+    assert not one.whole_record and two.whole_record
+    longest_window = max(one.windows_s)
+    assert one.omega[0] >= 2 * np.pi * 3 / longest_window * (1 - 1e-9)
+    assert two.omega[0] < 2 * np.pi * 3 / longest_window  # down to 3 periods of the 38 s records
+    assert two.omega[0] >= 2 * np.pi * 3 / 38.0 * (1 - 1e-9)
+
+
+@pytest.mark.parametrize("n_records", [2, 3])
+def test_noise_only_records_never_look_coherent(n_records: int) -> None:
+    """An output unrelated to the sweep: from 2 or 3 records the member's own coherence is 0.5 or more at a
+    few per cent of the frequencies by chance; its significance test (1e-4) keeps it out, so the response is
+    the windows' composite where the windows reach and has no coherence below."""
+    records, _ = _lag_sweeps(0.1, seed=7)
+    rng = np.random.default_rng(8)
+    unrelated = [_record({"x": r["x"], "y": rng.normal(size=r["x"].size)}) for r in records[:n_records]]
+    (response,) = frequency_responses(unrelated, ["x"], ["y"])
+    (windows,) = frequency_responses(unrelated, ["x"], ["y"], ResponseOptions(whole_record=False))
+    assert not response.whole_record and response.omega[0] < windows.omega[0]
+    shared = np.isin(response.omega, windows.omega)
+    np.testing.assert_allclose(response.coherence[shared], windows.coherence, rtol=1e-12)
+    np.testing.assert_allclose(response.response[shared], windows.response, rtol=1e-12)
+    assert np.all(response.coherence[~shared] == 0.0)

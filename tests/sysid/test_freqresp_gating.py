@@ -95,7 +95,8 @@ def test_gate_thresholds_are_checked(kwargs: dict[str, float]) -> None:
 
 
 def test_responses_round_trip_through_hdf5(tmp_path: Path) -> None:
-    gated = dataclasses.replace(_response(_band(1.0, 50.0), input_unit="%", output_unit="rad/s"), fit_range=(1.0, 50.0))
+    gated = dataclasses.replace(_response(_band(1.0, 50.0), input_unit="%", output_unit="rad/s", reference="excitation",
+                                          whole_record=True), fit_range=(1.0, 50.0))
     conditioned = _response(_band(1.0, 50.0), output="ax", conditioned_on=("wind_lon",), windows_s=(4.0,))
     target = tmp_path / "fr.h5"
     write_responses(target, [gated, conditioned])
@@ -110,6 +111,17 @@ def test_responses_round_trip_through_hdf5(tmp_path: Path) -> None:
         assert group["omega"].attrs["unit"] == "rad/s"
         assert group["response"].attrs["unit"] == "(rad/s)/(%)"
         assert group["input_autospectrum"].attrs["unit"] == "(%)^2/(rad/s)"
+        assert group.attrs["reference"] == "excitation" and "reference" not in h5["responses"]["001"].attrs
+
+
+def test_a_file_without_the_newer_attributes_reads_as_no_reference(tmp_path: Path) -> None:
+    target = tmp_path / "old.h5"
+    write_responses(target, [_response(_band(1.0, 50.0), reference="excitation", whole_record=True)])
+    with h5py.File(target, "a") as h5:
+        for name in ("reference", "whole_record"):
+            del h5["responses"]["000"].attrs[name]
+    (back,) = read_responses(target)
+    assert back.reference is None and back.whole_record is False
 
 
 def test_a_failed_write_leaves_the_old_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -149,13 +161,21 @@ def test_reading_a_foreign_or_newer_file_is_a_format_error(tmp_path: Path) -> No
 RATE_HZ = 100.0
 
 
-def _flight(*, gap: tuple[float, float] | None = None, seed: int = 0) -> ConditionedFlight:
-    """100 s at 100 Hz: a lon sweep 10-50 s (q = 2 delta_lon + noise), a lat sweep 60-90 s, a lon doublet 52-54 s."""
+def _flight(*, gap: tuple[float, float] | None = None, seed: int = 0, excitation: str = "none") -> ConditionedFlight:
+    """100 s at 100 Hz: a lon sweep 10-50 s (q = 2 delta_lon + noise), a lat sweep 60-90 s, a lon doublet 52-54 s.
+
+    `excitation`: "none" (as PX4), "sweeps" (logged during the sweeps only, as ArduPilot's SIDD: the lon one
+    is delta_lon there, the mixer input being the excitation itself), "lat" (during the lat sweep only).
+    """
     rng = np.random.default_rng(seed)
     t = np.arange(int(100 * RATE_HZ)) / RATE_HZ
     delta = rng.normal(size=t.size)
     columns = {"delta_lon": delta, "q": 2.0 * delta + 0.1 * rng.normal(size=t.size), "ax": rng.normal(size=t.size),
                "delta_lat": rng.normal(size=t.size), "p": rng.normal(size=t.size)}
+    if excitation != "none":
+        lon, lat = (t >= 10.0) & (t <= 50.0), (t >= 60.0) & (t <= 90.0)
+        columns["excitation"] = np.where(lon, delta, 0.0) * (excitation == "sweeps") + np.where(
+            lat, columns["delta_lat"], 0.0)
     table = pd.DataFrame(columns, index=t)
     units = {name: "-" for name in columns}
     whole = Record(table, units, {}, Path("f.bin"), "piece 1 of 1")
@@ -214,6 +234,45 @@ def test_a_flight_without_sweeps_has_no_default_pairs() -> None:
         flight_responses([quiet])
 
 
+def test_the_logged_excitation_is_the_reference_where_every_piece_carries_it() -> None:
+    options = ResponseOptions(omega_min=2.0, n_freq=40)
+    found = flight_responses([_flight(excitation="sweeps")], [("q", "delta_lon"), ("p", "delta_lat")], options=options)
+    q, p = found.responses
+    assert (q.reference, p.reference) == ("excitation", "excitation")
+    assert found.notes == tuple(f"{axis}: the logged excitation (SIDD) is the reference of the delta_{axis} responses, "
+                                f"H = G_ry / G_rx." for axis in ("lon", "lat"))
+    good = q.coherence > 0.9
+    assert good.mean() > 0.9 and np.allclose(q.response[good], 2.0, rtol=0.05)
+    off = flight_responses([_flight(excitation="sweeps")], [("q", "delta_lon")], options=options, use_excitation=False)
+    assert off.responses[0].reference is None and "reference not used, as asked" in off.notes[0]
+
+
+def test_without_a_logged_excitation_the_mixer_input_is_used_and_said_so() -> None:
+    """PX4 logs no excitation; an axis whose pieces do not all carry it falls back too."""
+    options = ResponseOptions(omega_min=2.0, n_freq=40)
+    px4 = flight_responses([_flight()], [("q", "delta_lon")], options=options)
+    assert px4.responses[0].reference is None
+    assert px4.notes == ("lon: none of the sweep pieces carry a logged excitation (PX4 logs none): responses "
+                         "computed from the mixer input delta_lon, which in closed loop also carries the feedback "
+                         "of noise and turbulence.",)
+    mixed = flight_responses([_flight(excitation="sweeps"), _flight(seed=1)], [("q", "delta_lon")], options=options)
+    assert mixed.responses[0].reference is None and "only 1 of 2 of the sweep pieces" in mixed.notes[0]
+    lat_only = flight_responses([_flight(excitation="lat")], [("q", "delta_lon"), ("p", "delta_lat")], options=options)
+    assert [r.reference for r in lat_only.responses] == [None, "excitation"]
+    wind_only = flight_responses([_flight(excitation="sweeps")], [("q", "ax")], axis="lon", options=options)
+    assert wind_only.responses[0].reference is None and "no mixer input delta_lon" in wind_only.notes[0]
+
+
+def test_a_reference_asked_for_is_used_on_every_axis_or_is_an_error() -> None:
+    options = ResponseOptions(omega_min=2.0, n_freq=40, reference="excitation")
+    found = flight_responses([_flight(excitation="sweeps")], [("q", "delta_lon")], options=options)
+    assert found.responses[0].reference == "excitation" and "(as asked)" in found.notes[0]
+    with pytest.raises(MissingSignalError, match="has no signal excitation"):
+        flight_responses([_flight()], [("q", "delta_lon")], options=options)
+    with pytest.raises(DataError, match="reference excitation does not vary in any record"):
+        flight_responses([_flight(excitation="lat")], [("q", "delta_lon")], options=options)
+
+
 def test_two_inputs_on_one_axis_are_conditioned_on_each_other() -> None:
     found = flight_responses([_flight()], [("q", "delta_lon"), ("q", "ax")], axis="lon",
                              options=ResponseOptions(omega_min=2.0, n_freq=20))
@@ -237,7 +296,7 @@ def test_parse_pairs() -> None:
     {"omega_min": 0.0}, {"omega_min": 10.0, "omega_max": 5.0}, {"n_freq": 1}, {"n_freq": 2.5},
     {"window_lengths_s": ()}, {"window_lengths_s": (2.0, -1.0)}, {"overlap": 0.95}, {"overlap": -0.1},
     {"taper": "no-such-window"}, {"min_coherence": 1.0}, {"min_decades": 0.0}, {"min_cycles": 0.0},
-    {"spacing": "octave"},
+    {"spacing": "octave"}, {"reference": ""},
 ])
 def test_options_are_checked(kwargs: dict[str, object]) -> None:
     with pytest.raises(ValueError):
@@ -262,6 +321,7 @@ def _simple(columns: dict[str, np.ndarray], rate_hz: float = RATE_HZ) -> Record:
     ("ok", ["x"], ["z"], MissingSignalError, "has no signal z"),
     ("ok", ["x"], ["x"], DataError, "named twice"),
     ("ok", [], ["y"], DataError, "at least one input"),
+    ("ok", ["x"], ["y"], DataError, "reference y is also an input or output"),
 ])
 def test_bad_inputs_raise_one_sentence(records: object, inputs: list[str], outputs: list[str],
                                        error: type[Exception], fragment: str) -> None:
@@ -275,6 +335,8 @@ def test_bad_inputs_raise_one_sentence(records: object, inputs: list[str], outpu
     }
     chosen = cases.get(records, records) if isinstance(records, str) else records
     options = ResponseOptions(window_lengths_s=(40.0,)) if records == "short" else ResponseOptions()
+    if fragment.startswith("reference"):
+        options = ResponseOptions(reference="y")
     if records == "short":
         chosen = cases["ok"]
     with pytest.raises(error, match=fragment):

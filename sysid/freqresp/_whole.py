@@ -1,0 +1,146 @@
+"""The whole-record member of the composite: each record transformed over its full length.
+
+Windowed estimates are biased wherever the response changes within a
+window's spectral lobe or the system remembers its input for longer than a
+window: near a closed loop's notch in the mixer input, around an unstable
+pair (whose impulse response never decays: the output inside a window keeps
+answering input from before it) and next to the sweep's fade-in tone. A
+record that starts and ends at trim holds the whole transient, and its
+Fourier transforms obey ``Y(omega) = H(omega) X(omega)`` exactly at every
+frequency: no window, no leakage, no resolution bias. Averaged over the
+``K`` records (``n_d = K``, less one per further input), these spectra are
+the composite's longest member.
+
+Two details make the member usable:
+
+* the ends: each record is tapered over its first and last 0.5 s (a
+  raised cosine, the rest untouched) and its level over the first 0.5 s (the
+  trim flown before the maneuver) removed, so an offset or an unfinished
+  response at the ends leaks little;
+* its noise: from ``K`` records the output noise ``G_nn`` (the part no
+  input explains, :func:`~sysid.freqresp._conditioning.residual_noise`)
+  has only ``2 (K - q)`` degrees of freedom per frequency, too few to weigh
+  the member by. The noise varies slowly with frequency, so it is averaged
+  over ``±max(3 bins, 10 %)`` of each frequency (bins of ``2 pi / T``) and
+  put back into the output autospectra, unbiased; the coherence, the
+  composite weight and the random error all follow from that smoothed noise
+  and the pointwise signal. The composite then uses the member only where its
+  output power stands out of that noise at the 1e-4 level
+  (:func:`significance_threshold`): with few records a noise-only frequency
+  would otherwise now and then look coherent.
+
+The signal is not smoothed across frequency: in closed loop the mixer
+input's notch is a bin or two wide, and weighting ``H`` by ``|X|^2`` over
+even ±1 bin brings the bias back (2.5 dB on the octocopter's q/delta_lon at
+0.5 rad/s, measured). A whole record also gathers the noise of its whole
+length, where a window only that of the seconds the sweep spends near each
+frequency, so at high frequency the windows are the better estimates; the
+composite's weights (inverse random error) sort that out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ._conditioning import residual_noise
+from ._spectra import WindowSpectra
+
+__all__: list[str] = []
+
+EDGE_S = 0.5  # taper at each end, and the stretch whose level is removed, s
+SMOOTH_BINS = 3.0  # noise averaged over at least ±3 bins of 2 pi / T ...
+SMOOTH_FRACTION = 0.1  # ... or ±10 % of the frequency
+SIGNIFICANCE = 1e-4  # chance that a noise-only frequency passes the member's test
+_CHUNK = 8192  # samples transformed at once
+
+
+def whole_record_spectra(
+    data: Sequence[np.ndarray],
+    dt: float,
+    omega: np.ndarray,
+    *,
+    inputs: Sequence[int],
+    outputs: Sequence[int],
+    instrument: int | None,
+    min_cycles: float,
+) -> WindowSpectra | None:
+    """Spectral matrix of the records' full-length transforms, noise smoothed; None with too few records.
+
+    `data` holds one array per record, shape (n_channels, n_samples). The
+    member needs more records than inputs (the noise is measured between them).
+    """
+    n_records, n_inputs = len(data), len(inputs)
+    if n_records <= n_inputs:
+        return None
+    n_channels = data[0].shape[0]
+    longest = max(block.shape[1] for block in data)
+    stacked = np.zeros((n_records * n_channels, longest))  # tapered, levelled, zero beyond each record's end
+    energy = 0.0
+    edge = max(1, int(round(EDGE_S / dt)))
+    for k, block in enumerate(data):
+        taper = _edge_taper(block.shape[1], dt)
+        stacked[k * n_channels:(k + 1) * n_channels, : block.shape[1]] = (
+            block - block[:, :edge].mean(axis=1, keepdims=True)) * taper
+        energy += float(np.sum(taper**2))
+    x = np.zeros((omega.size, n_records * n_channels), dtype=complex)
+    for start in range(0, longest, _CHUNK):  # a long record's kernel would not fit in memory at once
+        stop = min(start + _CHUNK, longest)
+        x += _kernel(omega * dt, start, stop) @ stacked[:, start:stop].T
+    x = x.reshape(omega.size, n_records, n_channels)
+    spectra = np.einsum("fka,fkb->fab", np.conj(x), x) * (dt / (np.pi * energy))
+    lengths_s = [block.shape[1] * dt for block in data]
+    omega_low = 2.0 * np.pi * min_cycles / max(lengths_s)
+    valid = omega >= omega_low * (1.0 - 1e-12)
+    bin_rad_s = 2.0 * np.pi / min(lengths_s)
+    dof = _smooth_noise(spectra, omega, valid, inputs, outputs, instrument, n_records, bin_rad_s)
+    spectra[~valid] = 0.0
+    return WindowSpectra(max(lengths_s), spectra, n_records, float(n_records), omega_low, noise_dof=dof)
+
+
+def significance_threshold(noise_dof: np.ndarray, level: float = SIGNIFICANCE) -> np.ndarray:
+    """``x`` with ``P(F > x) = level`` for ``F`` of (2, `noise_dof`) degrees of freedom, shape of `noise_dof`.
+
+    The ratio of a cross-spectral power from unrelated signals (2 degrees of
+    freedom) to the noise estimate (``noise_dof``) is F-distributed,
+    ``P(F > x) = (1 + 2 x / d)^(-d / 2)``; ``ln(1 / level)`` for large ``d``.
+    """
+    d = np.maximum(np.asarray(noise_dof, dtype=float), 1.0)
+    return d / 2.0 * (level ** (-2.0 / d) - 1.0)
+
+
+def _edge_taper(n_samples: int, dt: float) -> np.ndarray:
+    taper = np.ones(n_samples)
+    edge = min(int(round(EDGE_S / dt)), n_samples // 4)
+    if edge > 0:
+        ramp = 0.5 - 0.5 * np.cos(np.pi * (np.arange(edge) + 0.5) / edge)
+        taper[:edge], taper[n_samples - edge:] = ramp, ramp[::-1]
+    return taper
+
+
+def _kernel(step_rad: np.ndarray, start: int, stop: int, block: int = 64) -> np.ndarray:
+    """``exp(-j step n)`` for ``start <= n < stop``, shape (n_freq, stop - start), from two small tables
+    (``n = start + m block + r``) rather than a sine and cosine per element."""
+    n_blocks = -(-(stop - start) // block)
+    inner = np.exp(-1j * np.outer(step_rad, np.arange(block)))
+    outer = np.exp(-1j * np.outer(step_rad, start + block * np.arange(n_blocks)))
+    return (outer[:, :, None] * inner[:, None, :]).reshape(step_rad.size, n_blocks * block)[:, : stop - start]
+
+
+def _smooth_noise(spectra: np.ndarray, omega: np.ndarray, valid: np.ndarray, inputs: Sequence[int],
+                  outputs: Sequence[int], instrument: int | None, n_records: int, bin_rad_s: float) -> np.ndarray:
+    """Replace each output's noise in `spectra` (in place) by its frequency average; its degrees of freedom."""
+    n_inputs = len(inputs)
+    half = np.maximum(SMOOTH_BINS * bin_rad_s, SMOOTH_FRACTION * omega)
+    near = (np.abs(omega[:, None] - omega[None, :]) <= half[:, None]) & valid[None, :]  # (n_freq, n_freq)
+    counts = near.sum(axis=1)
+    independent = np.minimum(counts, 2.0 * half / bin_rad_s + 1.0)
+    dof = 2.0 * (n_records - n_inputs) * np.maximum(independent, 1.0)
+    kept = (n_records - n_inputs) / n_records  # a residual from K records keeps (K - q) / K of the noise
+    for y in outputs:
+        raw = np.zeros(omega.size)
+        raw[valid] = residual_noise(spectra[valid], inputs, y, instrument)
+        smoothed = near.astype(float) @ (raw / kept) / np.maximum(counts, 1)
+        spectra[:, y, y] += smoothed * kept - raw
+    return np.where(valid, dof, 0.0)
