@@ -26,7 +26,8 @@ from flightlogs.errors import FitError
 from flightlogs.record import Record
 from flightlogs.store import file_sha256
 
-from ..freqresp import FrequencyResponse, ResponseOptions, frequency_responses, gate_responses, maneuver_records
+from ..freqresp import (FrequencyResponse, ResponseOptions, frequency_responses, gate_responses, maneuver_records,
+                        reference_options)
 from ..model.structure import ModelStructure
 from ..model.toml_format import load_structure
 from .engine import FitOptions, FrequencyFit, fit_frequency_responses
@@ -77,6 +78,10 @@ class IdentifyOptions:
     condition_on_wind : bool
         Condition each response on the structure's wind signals when the
         records carry them (partial coherence).
+    use_excitation : bool
+        Use the logged excitation (ArduPilot SIDD) as the reference of the
+        mixer input's responses where every sweep carries it, which removes
+        the bias of noise and turbulence fed back by the autopilot.
     wind_outputs : tuple of str
         Outputs whose eq. 3.14 residual the wind step fits.
     wind_axes : tuple of str
@@ -95,6 +100,7 @@ class IdentifyOptions:
     constants: Mapping[str, float] | None = None
     initial: Mapping[str, float] | None = None
     condition_on_wind: bool = True
+    use_excitation: bool = True
     wind_outputs: tuple[str, ...] = ("ax", "az")
     wind_axes: tuple[str, ...] = ("lon", "thr")
 
@@ -104,8 +110,8 @@ def _report(progress: Progress | None, stage: str, done: int, total: int) -> Non
         progress(stage, done, total)
 
 
-def _axis_responses(structure: ModelStructure, records: list[Record], axis: str, options: IdentifyOptions
-                    ) -> tuple[FrequencyResponse, ...]:
+def _axis_responses(structure: ModelStructure, records: list[Record], axis: str, options: IdentifyOptions,
+                    notes: list[str]) -> tuple[FrequencyResponse, ...]:
     control = f"delta_{axis}"
     logged = set.intersection(*(set(r.signals) for r in records))
     if options.pairs is not None:
@@ -120,6 +126,8 @@ def _axis_responses(structure: ModelStructure, records: list[Record], axis: str,
     longest = max(r.end_s - r.start_s for r in records)
     lowest = max(options.responses.omega_min, 2.0 * np.pi * options.min_record_periods / longest)
     grid = dataclasses.replace(options.responses, omega_min=min(lowest, options.responses.omega_max / 2.0))
+    grid, note = reference_options(records, axis, inputs, options.kind, grid, options.use_excitation)
+    notes.append(note)
     found = frequency_responses(records, inputs, outputs, grid)
     return tuple(r for r in found if r.input == control)
 
@@ -167,7 +175,7 @@ def identify_flights(
         records = maneuver_records(flights, axis, kind=options.kind)
         if records:
             used[axis] = records
-            responses += _axis_responses(structure, records, axis, options)
+            responses += _axis_responses(structure, records, axis, options, notes)
     if not responses:
         names = ", ".join(f.source.name for f in flights) or "no flight"
         raise FitError(f"no {options.kind} in {names} gives a response the model {structure.name} can be fitted to")

@@ -92,7 +92,8 @@ def _response_to_dict(r: FrequencyResponse) -> dict[str, Any]:
             "input_autospectrum": _array(r.input_autospectrum), "output_autospectrum": _array(r.output_autospectrum),
             "cross_spectrum_real": _array(r.cross_spectrum.real), "cross_spectrum_imag": _array(r.cross_spectrum.imag),
             "windows_s": list(r.windows_s), "conditioned_on": list(r.conditioned_on), "input_unit": r.input_unit,
-            "output_unit": r.output_unit, "fit_range": None if r.fit_range is None else list(r.fit_range)}
+            "output_unit": r.output_unit, "fit_range": None if r.fit_range is None else list(r.fit_range),
+            "reference": r.reference, "whole_record": r.whole_record}
 
 
 def _vector(values: Any) -> np.ndarray:
@@ -106,7 +107,8 @@ def _response_from_dict(d: Mapping[str, Any]) -> FrequencyResponse:
         _vector(d["coherence"]), _vector(d["random_error"]), _vector(d["input_autospectrum"]),
         _vector(d["output_autospectrum"]), _vector(d["cross_spectrum_real"]) + 1j * _vector(d["cross_spectrum_imag"]),
         tuple(float(v) for v in d["windows_s"]), tuple(d.get("conditioned_on", ())), d.get("input_unit", ""),
-        d.get("output_unit", ""), None if fit_range is None else (float(fit_range[0]), float(fit_range[1])))
+        d.get("output_unit", ""), None if fit_range is None else (float(fit_range[0]), float(fit_range[1])),
+        reference=d.get("reference"), whole_record=bool(d.get("whole_record", False)))
 
 
 def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> IdentifiedModel:

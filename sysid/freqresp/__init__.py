@@ -18,6 +18,7 @@ from .io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
 from .options import ResponseOptions
 from .records import (
     DEFAULT_PAIRS, EXCITATION, FlightResponses, default_pairs, flight_responses, maneuver_records, parse_pairs,
+    reference_options,
 )
 from .response import FrequencyResponse
 
@@ -25,6 +26,6 @@ __all__ = [
     "FrequencyResponse", "ResponseOptions", "frequency_responses", "automatic_window_lengths",
     "DroppedResponse", "GatingResult", "gate_responses", "fit_range",
     "write_responses", "read_responses", "RESPONSES_SCHEMA_VERSION",
-    "DEFAULT_PAIRS", "EXCITATION", "maneuver_records", "parse_pairs", "default_pairs", "FlightResponses",
+    "DEFAULT_PAIRS", "EXCITATION", "maneuver_records", "parse_pairs", "default_pairs", "reference_options", "FlightResponses",
     "flight_responses",
 ]

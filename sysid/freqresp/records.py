@@ -18,7 +18,8 @@ from .options import ResponseOptions
 from .response import FrequencyResponse
 
 __all__ = [
-    "DEFAULT_PAIRS", "EXCITATION", "maneuver_records", "parse_pairs", "default_pairs", "FlightResponses",
+    "DEFAULT_PAIRS", "EXCITATION", "maneuver_records", "parse_pairs", "default_pairs",
+    "reference_options", "FlightResponses",
     "flight_responses",
 ]
 
@@ -236,7 +237,7 @@ def flight_responses(
         inputs = list(dict.fromkeys(input_ for _, input_ in group))
         inputs.sort(key=lambda name: name != mixer)  # the reference stands in for the first input: the mixer's
         outputs = list(dict.fromkeys(output for output, _ in group))
-        chosen_options, note = _reference_for(records, group_axis, inputs, kind, options, use_excitation)
+        chosen_options, note = reference_options(records, group_axis, inputs, kind, options, use_excitation)
         notes.append(note)
         for response in frequency_responses(records, inputs, outputs, chosen_options):
             found[(response.output, response.input)] = response
@@ -244,9 +245,36 @@ def flight_responses(
     return FlightResponses(tuple(found[pair] for pair in chosen), MappingProxyType(pieces), tuple(notes))
 
 
-def _reference_for(records: Sequence[Record], axis: str, inputs: Sequence[str], kind: str,
-                   options: ResponseOptions, use_excitation: bool) -> tuple[ResponseOptions, str]:
-    """The options for one axis (reference set or not) and the note saying which and why."""
+def reference_options(records: Sequence[Record], axis: str, inputs: Sequence[str], kind: str,
+                      options: ResponseOptions, use_excitation: bool = True) -> tuple[ResponseOptions, str]:
+    """The options for one axis's responses (excitation as reference or not) and a note saying which and why.
+
+    The logged ``excitation`` becomes the reference of the mixer input's
+    responses when every record carries a varying one and the first input is
+    the axis's mixer input.
+
+    Parameters
+    ----------
+    records : sequence of Record
+        The maneuver pieces of the axis.
+    axis : {"lat", "lon", "yaw", "thr"}
+        Mixer axis.
+    inputs : sequence of str
+        Inputs of the responses, the mixer input first.
+    kind : str
+        Maneuver kind, for the note (``"sweep"``).
+    options : ResponseOptions
+        Options asked for; a reference set there is kept.
+    use_excitation : bool, optional
+        False to compute from the mixer input itself.
+
+    Returns
+    -------
+    options : ResponseOptions
+        With ``reference`` set where the excitation is used.
+    note : str
+        One sentence for the report.
+    """
     first = inputs[0]
     if options.reference is not None:
         return options, f"{axis}: {options.reference} is the reference of the {first} responses (as asked)."

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import json
 import math
 
@@ -48,6 +50,15 @@ def test_json_round_trip_keeps_everything(model: IdentifiedModel, tmp_path) -> N
     doc = json.loads(path.read_text())
     assert doc["schema_version"] == 1 and doc["parameters"]["X_w_lon"]["status"] == "dropped"
     assert doc["parameters"]["N_r"]["cr_percent"] is None  # NaN is written as null
+
+
+def test_how_each_response_was_computed_is_kept(model: IdentifiedModel, tmp_path) -> None:
+    first = dataclasses.replace(model.responses[0], reference="excitation", whole_record=True)
+    changed = dataclasses.replace(model, responses=(first, *model.responses[1:]))
+    back = read_model(write_model(tmp_path / "model.json", changed))
+    assert [(r.reference, r.whole_record) for r in back.responses] == [
+        (r.reference, r.whole_record) for r in changed.responses]
+    assert (back.responses[0].reference, back.responses[0].whole_record) == ("excitation", True)
 
 
 def test_wind_parameters_without_a_wind_step_are_dropped_and_logged(model: IdentifiedModel) -> None:
