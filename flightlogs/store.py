@@ -30,7 +30,6 @@ import hashlib
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, cast
 
@@ -38,8 +37,8 @@ import h5py
 import numpy as np
 
 from .atomic import atomic_output
-from .errors import LogFormatError
 from .flightlog import FlightLog, Signal, SystemIdRun
+from .hdf5 import open_schema, stamp_schema
 
 __all__ = ["Dataset", "write_dataset", "read_dataset", "file_sha256", "SCHEMA_VERSION"]
 
@@ -104,10 +103,7 @@ def write_dataset(
         Aligned records, segments and alignment of each flight.
     """
     with atomic_output(path) as tmp, h5py.File(tmp, "w") as h5:
-        h5.attrs["schema"] = SCHEMA
-        h5.attrs["schema_version"] = SCHEMA_VERSION
-        h5.attrs["software"] = f"flight-sysid {_version()}"
-        h5.attrs["created_utc"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        stamp_schema(h5, SCHEMA, SCHEMA_VERSION)
         log_group = h5.create_group("logs")
         for log in logs:
             _write_log(log_group.create_group(_unique_key(log_group, log.path)), log)
@@ -133,34 +129,14 @@ def read_dataset(path: str | Path) -> Dataset:
         If the file is not an HDF5 dataset of this schema, or of a newer version.
     """
     path = Path(path)
-    try:
-        h5 = h5py.File(path, "r")
-    except (OSError, ValueError) as err:
-        raise LogFormatError(f"{path}: not an HDF5 dataset ({err}).") from err
-    with h5:
-        if h5.attrs.get("schema") != SCHEMA:
-            raise LogFormatError(f"{path}: HDF5 file is not a flight-sysid dataset.")
-        version = int(h5.attrs["schema_version"])
-        if version > SCHEMA_VERSION:
-            raise LogFormatError(
-                f"{path}: dataset schema version {version} is newer than this "
-                f"software reads ({SCHEMA_VERSION}); upgrade flight-sysid."
-            )
+    with open_schema(path, SCHEMA, SCHEMA_VERSION, what="dataset", not_hdf5="an HDF5 dataset",
+                     wrong_schema="HDF5 file is not a flight-sysid dataset.") as (h5, version):
         logs = tuple(_read_log(group) for group in h5["logs"].values())
         sha = {g.attrs["path"]: g.attrs["sha256"] for g in h5["logs"].values()}
         winds = tuple(_read_wind(group) for group in h5.get("wind", {}).values())
         sha.update({g.attrs["path"]: g.attrs["sha256"] for g in h5.get("wind", {}).values()})
         conditioned = tuple(_read_conditioned(g) for g in h5.get("conditioned", {}).values())
     return Dataset(logs=logs, winds=winds, conditioned=conditioned, sha256=sha, schema_version=version)
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("flight-sysid")
-    except PackageNotFoundError:
-        return "unknown"
 
 
 def _unique_key(group: h5py.Group, path: Path) -> str:

@@ -10,9 +10,7 @@ report. Files are written atomically.
 
 from __future__ import annotations
 
-import json
-import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -20,9 +18,13 @@ from typing import Any
 
 import numpy as np
 
-from flightlogs.atomic import atomic_output
 from flightlogs.errors import DataError
 
+from ._json import finite_or_none as _num
+from ._json import float_array as _array
+from ._json import float_or_nan as _float
+from ._json import json_floats as _list
+from ._json import read_json_object, write_json
 from .verify import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection
 
 __all__ = ["VERIFICATION_SCHEMA", "VERIFICATION_SCHEMA_VERSION", "SavedVerification", "verification_to_dict",
@@ -59,24 +61,8 @@ class SavedVerification:
         object.__setattr__(self, "options", MappingProxyType(dict(self.options)))
 
 
-def _num(value: float | None) -> float | None:
-    return None if value is None or not math.isfinite(value) else float(value)
-
-
-def _float(value: Any) -> float:
-    return math.nan if value is None else float(value)
-
-
 def _optional(value: Any) -> float | None:
     return None if value is None else float(value)
-
-
-def _list(values: np.ndarray) -> list[float | None]:
-    return [_num(v) for v in np.asarray(values, dtype=float).tolist()]
-
-
-def _array(values: Sequence[Any]) -> np.ndarray:
-    return np.array([_float(v) for v in values], dtype=float)
 
 
 def _output_to_dict(o: OutputVerification) -> dict[str, Any]:
@@ -229,11 +215,8 @@ def write_verification(path: str | Path, verification: Verification, *, model: s
     >>> read_verification(path).verification.records[0].output("q").simulated.tolist()
     [0.0, 0.9, 0.1]
     """
-    doc = verification_to_dict(verification, model=model, options=options, created_utc=created_utc)
-    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
-    with atomic_output(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-    return Path(path)
+    return write_json(path, verification_to_dict(verification, model=model, options=options,
+                                                 created_utc=created_utc))
 
 
 def read_verification(path: str | Path) -> SavedVerification:
@@ -253,10 +236,4 @@ def read_verification(path: str | Path) -> SavedVerification:
     DataError
         If the file cannot be read or is not a verification file of a supported version.
     """
-    try:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise DataError(f"{path}: cannot read the verification file ({err})") from None
-    if not isinstance(doc, dict):
-        raise DataError(f"{path}: not a flight-sysid verification file")
-    return verification_from_dict(doc, source=str(path))
+    return verification_from_dict(read_json_object(path, DataError, "verification"), source=str(path))

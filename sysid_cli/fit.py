@@ -9,7 +9,8 @@ from typing import Any
 import click
 
 from ._common import emit_json, json_option, progress_bar
-from .ingest import parse_position
+from ._wind_options import (anemometer_at_option, transport_delay_option, wind_distance_option, wind_offset_option,
+                            wind_option)
 
 __all__ = ["fit", "parse_assignments", "print_modes"]
 
@@ -40,14 +41,11 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--model", "model_name", default="hover", show_default=True, metavar="NAME|FILE",
               help="Built-in structure (hover, hover-wind) or a structure TOML file.")
-@click.option("--wind", "wind_paths", multiple=True, type=click.Path(exists=True, path_type=Path),
-              help="Anemometer CSV or folder (repeatable): air-relative u v w and the wind input.")
-@click.option("--wind-distance", type=click.FloatRange(min=0, min_open=True), metavar="M",
-              help="Anemometer-to-vehicle distance, m (transport delay = distance / mean wind speed).")
-@click.option("--anemometer-at", "anemometer_at", callback=parse_position, metavar="LAT,LON",
-              help="Anemometer position, deg, for the distance to the vehicle's GPS position.")
-@click.option("--transport-delay", type=float, metavar="S", help="Transport delay of the wind, s.")
-@click.option("--wind-offset", type=float, metavar="S", help="Anemometer clock minus UTC, s.")
+@wind_option("Anemometer CSV or folder (repeatable): air-relative u v w and the wind input.")
+@wind_distance_option()
+@anemometer_at_option("Anemometer position, deg, for the distance to the vehicle's GPS position.")
+@transport_delay_option("Transport delay of the wind, s.")
+@wind_offset_option("Anemometer clock minus UTC, s.")
 @click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset by cross-correlation.")
 @click.option("--kind", default="sweep", show_default=True, help="Maneuvers to fit (sweep, 3211, multisine).")
 @click.option("--set", "initial", multiple=True, callback=parse_assignments, metavar="NAME=VALUE",

@@ -8,6 +8,7 @@ from typing import Any
 import click
 
 from ._common import emit_json, json_option, progress_bar
+from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["freqresp"]
 
@@ -44,11 +45,9 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
 @click.command(epilog=_EPILOG)
 @click.argument("sources", metavar="DATASET|LOG...", nargs=-1, required=True,
                 type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--wind", "wind_paths", multiple=True, type=click.Path(exists=True, path_type=Path),
-              help="Anemometer CSV or folder (with logs; aligned by UTC as in `sysid ingest`).")
-@click.option("--wind-distance", type=click.FloatRange(min=0, min_open=True), metavar="M",
-              help="Anemometer-to-vehicle distance, m (with --wind; see `sysid ingest` for the other choices).")
-@click.option("--wind-offset", type=float, metavar="S", help="Anemometer clock minus UTC, s (with --wind).")
+@wind_option("Anemometer CSV or folder (with logs; aligned by UTC as in `sysid ingest`).")
+@wind_distance_option("Anemometer-to-vehicle distance, m (with --wind; see `sysid ingest` for the other choices).")
+@wind_offset_option("Anemometer clock minus UTC, s (with --wind).")
 @click.option("--pairs", callback=_pairs, metavar="OUT/IN,...",
               help="Responses to compute, e.g. q/delta_lon,ax/delta_lon (default: the chapter 3 outputs of "
                    "every axis with a sweep).")

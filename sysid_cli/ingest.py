@@ -9,6 +9,8 @@ from typing import Any
 import click
 
 from ._common import emit_json, json_option, progress_bar
+from ._wind_options import (anemometer_at_option, parse_position, segments_from, segments_option,
+                            transport_delay_option, wind_distance_option, wind_offset_option, wind_option)
 
 __all__ = ["ingest", "parse_columns", "parse_position"]
 
@@ -35,45 +37,25 @@ def parse_columns(_ctx: click.Context, _param: click.Parameter, value: str | Non
     return mapping
 
 
-def parse_position(_ctx: click.Context, _param: click.Parameter, value: str | None) -> tuple[float, float] | None:
-    """Parse ``LAT,LON`` in degrees into latitude and longitude in radians (click callback)."""
-    if value is None:
-        return None
-    parts = value.split(",")
-    try:
-        lat, lon = (float(part) for part in parts)
-    except ValueError:
-        raise click.BadParameter(
-            f"{value!r} is not LAT,LON in decimal degrees (e.g. 35.000021,-106.900043)") from None
-    if not (math.isfinite(lat) and math.isfinite(lon) and abs(lat) <= 90.0 and abs(lon) <= 180.0):
-        raise click.BadParameter(f"{value!r}: latitude must lie within ±90° and longitude within ±180°")
-    return math.radians(lat), math.radians(lon)
-
-
 @click.command(epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--wind", "wind_paths", multiple=True, type=click.Path(exists=True, path_type=Path),
-              help="Anemometer CSV, or a folder of them (repeatable); each log takes the file overlapping it in UTC.")
+@wind_option("Anemometer CSV, or a folder of them (repeatable); each log takes the file overlapping it in UTC.")
 @click.option("--columns", callback=parse_columns,
               help="Override anemometer column detection: time=,speed=,direction= or time=,u=,v=.")
-@click.option("--wind-distance", type=click.FloatRange(min=0, min_open=True), metavar="M",
-              help="Anemometer-to-vehicle distance, m (transport delay = distance / mean wind speed).")
+@wind_distance_option()
 @click.option("--wind-bearing", type=float, metavar="DEG",
               help="Direction from the anemometer to the vehicle, deg from north (default: straight upstream).")
-@click.option("--anemometer-at", "anemometer_at", callback=parse_position, metavar="LAT,LON",
-              help="Anemometer position, deg (WGS-84); without --wind-distance, the distance and bearing "
-                   "to the vehicle come from its mean GPS position in the log.")
-@click.option("--transport-delay", type=float, metavar="S", help="Use this transport delay, s, instead.")
-@click.option("--wind-offset", type=float, metavar="S",
-              help="Anemometer clock minus UTC, s (minus the log's clock when the log has no GPS time).")
+@anemometer_at_option("Anemometer position, deg (WGS-84); without --wind-distance, the distance and bearing "
+                      "to the vehicle come from its mean GPS position in the log.")
+@transport_delay_option()
+@wind_offset_option()
 @click.option("--estimate-wind-offset", is_flag=True,
               help="Correct the clock offset by cross-correlating the wind with the vehicle's response.")
 @click.option("--estimate-transport-delay", is_flag=True,
               help="Find the transport delay by that cross-correlation instead (trusting the clock offset).")
 @click.option("--rate", "rate_hz", type=click.FloatRange(min=0, min_open=True), metavar="HZ",
               help="Rate of the common time base (default: the fastest core signal's).")
-@click.option("--segments", "segments_file", type=click.Path(exists=True, dir_okay=False, path_type=Path),
-              help="TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
+@segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
 @click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
               help="Write signals, records and segments to this HDF5 dataset.")
 @json_option
@@ -88,7 +70,6 @@ def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[s
     canonical signal with its rate, unit and source, align the anemometer wind, and find the maneuvers."""
     from flightlogs.campaign import ingest_campaign
     from flightlogs.condition import ConditioningOptions
-    from flightlogs.segments import read_segments_file
     from flightlogs.store import write_dataset
 
     if estimate_wind_offset and estimate_transport_delay:
@@ -98,7 +79,7 @@ def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[s
         estimate_transport_delay=estimate_transport_delay,
         wind_distance_m=wind_distance, wind_bearing_rad=None if wind_bearing is None else math.radians(wind_bearing),
         anemometer_position_rad=anemometer_at, transport_delay_s=transport_delay,
-        segments=read_segments_file(segments_file) if segments_file is not None else None,
+        segments=segments_from(segments_file),
     )
     with progress_bar("reading", quiet=quiet) as bar:
         campaign = ingest_campaign(list(logs), list(wind_paths), columns=columns, options=options,

@@ -9,6 +9,8 @@ from typing import Any
 import click
 
 from ._common import emit_json, json_option, progress_bar
+from ._wind_options import (segments_from, segments_option, transport_delay_option, wind_distance_option,
+                            wind_offset_option, wind_option)
 
 __all__ = ["validate"]
 
@@ -24,15 +26,11 @@ Examples:
 @click.command(epilog=_EPILOG)
 @click.argument("model_path", metavar="MODEL.json", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--wind", "wind_paths", multiple=True, type=click.Path(exists=True, path_type=Path),
-              help="Anemometer CSV, or a folder of them (repeatable): verifies the wind term G_w too.")
-@click.option("--wind-distance", type=click.FloatRange(min=0, min_open=True), metavar="M",
-              help="Anemometer-to-vehicle distance, m (transport delay = distance / mean wind speed).")
-@click.option("--transport-delay", type=float, metavar="S", help="Use this transport delay, s, instead.")
-@click.option("--wind-offset", type=float, metavar="S",
-              help="Anemometer clock minus UTC, s (minus the log's clock when the log has no GPS time).")
-@click.option("--segments", "segments_file", type=click.Path(exists=True, dir_okay=False, path_type=Path),
-              help="TOML or CSV of maneuvers (start_s, end_s, axis, kind) overriding detection.")
+@wind_option("Anemometer CSV, or a folder of them (repeatable): verifies the wind term G_w too.")
+@wind_distance_option()
+@transport_delay_option()
+@wind_offset_option()
+@segments_option("TOML or CSV of maneuvers (start_s, end_s, axis, kind) overriding detection.")
 @click.option("--before", "before_s", type=click.FloatRange(min=0), default=0.5, show_default=True, metavar="S",
               help="Quiet stretch kept before each doublet, s.")
 @click.option("--after", "after_s", type=click.FloatRange(min=0), default=1.0, show_default=True, metavar="S",
@@ -57,7 +55,6 @@ def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, .
     import datetime as dt
 
     from flightlogs.condition import ConditioningOptions
-    from flightlogs.segments import read_segments_file
     from reports.model_report import write_model_report
     from sysid.fit import read_model
     from sysid.verify import VerificationOptions, axis_outputs, verify_logs
@@ -72,7 +69,7 @@ def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, .
         notes.append("the model's wind term is not verified: no anemometer file was given (--wind)")
     conditioning = ConditioningOptions(
         wind_offset_s=wind_offset, wind_distance_m=wind_distance, transport_delay_s=transport_delay,
-        segments=read_segments_file(segments_file) if segments_file is not None else None)
+        segments=segments_from(segments_file))
     options = VerificationOptions(initial_state=initial_state)  # type: ignore[arg-type]
     with progress_bar("reading", quiet=quiet) as bar:
         verification = verify_logs(model, list(logs), wind_model=with_wind if has_wind and wind_paths else None,

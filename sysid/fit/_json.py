@@ -2,32 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
+from .._json import finite_or_none
 from .result import ParameterEstimate
 
-__all__ = ["finite_or_none", "parameter_entry"]
-
-
-def finite_or_none(value: float) -> float | None:
-    """`value` as a float, or None (JSON ``null``) when it is NaN or infinite.
-
-    Parameters
-    ----------
-    value : float
-        Any number, in its own unit.
-
-    Returns
-    -------
-    float or None
-
-    Examples
-    --------
-    >>> finite_or_none(2), finite_or_none(float("nan"))
-    (2.0, None)
-    """
-    return float(value) if math.isfinite(value) else None
+__all__ = ["finite_or_none", "parameter_entry"]  # finite_or_none lives in sysid._json
 
 
 def parameter_entry(p: ParameterEstimate) -> dict[str, Any]:

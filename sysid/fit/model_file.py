@@ -7,8 +7,6 @@ outside Python. NaN is written as ``null``. Files are written atomically.
 
 from __future__ import annotations
 
-import json
-import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -19,8 +17,12 @@ from scipy import io as sio
 from flightlogs.atomic import atomic_output
 from flightlogs.errors import ModelError
 
+from .._json import finite_or_none as _num
+from .._json import float_array as _vector
+from .._json import float_or_nan as _float
+from .._json import json_floats as _array
+from .._json import read_json_object, write_json
 from ..freqresp import FrequencyResponse
-from ._json import finite_or_none as _num
 from ._json import parameter_entry
 from .cost import CostSummary
 from .reduce import ReductionStep
@@ -30,14 +32,6 @@ __all__ = ["SCHEMA", "SCHEMA_VERSION", "model_to_dict", "model_from_dict", "writ
 
 SCHEMA = "flight-sysid/identified-model"
 SCHEMA_VERSION = 1
-
-
-def _float(value: Any) -> float:
-    return math.nan if value is None else float(value)
-
-
-def _array(values: np.ndarray) -> Any:
-    return [_array(v) for v in values] if np.ndim(values) > 1 else [_num(float(v)) for v in np.ravel(values)]
 
 
 def model_to_dict(model: IdentifiedModel) -> dict[str, Any]:
@@ -94,10 +88,6 @@ def _response_to_dict(r: FrequencyResponse) -> dict[str, Any]:
             "windows_s": list(r.windows_s), "conditioned_on": list(r.conditioned_on), "input_unit": r.input_unit,
             "output_unit": r.output_unit, "fit_range": None if r.fit_range is None else list(r.fit_range),
             "reference": r.reference, "whole_record": r.whole_record}
-
-
-def _vector(values: Any) -> np.ndarray:
-    return np.array([_float(v) for v in values], dtype=float)
 
 
 def _response_from_dict(d: Mapping[str, Any]) -> FrequencyResponse:
@@ -174,10 +164,7 @@ def write_model(path: str | Path, model: IdentifiedModel) -> Path:
     -------
     Path
     """
-    text = json.dumps(model_to_dict(model), indent=1, allow_nan=False) + "\n"
-    with atomic_output(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-    return Path(path)
+    return write_json(path, model_to_dict(model))
 
 
 def read_model(path: str | Path) -> IdentifiedModel:
@@ -193,13 +180,7 @@ def read_model(path: str | Path) -> IdentifiedModel:
     ModelError
         If the file cannot be read or is not a model file of a supported version.
     """
-    try:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise ModelError(f"{path}: cannot read the model file ({err})") from None
-    if not isinstance(doc, dict):
-        raise ModelError(f"{path}: not a flight-sysid model file")
-    return model_from_dict(doc, source=str(path))
+    return model_from_dict(read_json_object(path, ModelError, "model"), source=str(path))
 
 
 def write_mat(path: str | Path, model: IdentifiedModel) -> Path:

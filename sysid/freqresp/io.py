@@ -24,14 +24,13 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from datetime import datetime, timezone
 from pathlib import Path
 
 import h5py
 import numpy as np
 
 from flightlogs.atomic import atomic_output
-from flightlogs.errors import LogFormatError
+from flightlogs.hdf5 import open_schema, stamp_schema
 
 from .response import FrequencyResponse
 
@@ -68,10 +67,7 @@ def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) ->
     ('q/delta_lon', '%', True)
     """
     with atomic_output(path) as tmp, h5py.File(tmp, "w") as h5:
-        h5.attrs["schema"] = _SCHEMA
-        h5.attrs["schema_version"] = RESPONSES_SCHEMA_VERSION
-        h5.attrs["software"] = f"flight-sysid {_version()}"
-        h5.attrs["created_utc"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+        stamp_schema(h5, _SCHEMA, RESPONSES_SCHEMA_VERSION)
         group = h5.create_group("responses")
         width = max(3, len(str(len(responses))))
         for k, response in enumerate(responses):
@@ -95,18 +91,8 @@ def read_responses(path: str | Path) -> tuple[FrequencyResponse, ...]:
     LogFormatError
         If the file is not a responses file of this schema, or of a newer version.
     """
-    path = Path(path)
-    try:
-        h5 = h5py.File(path, "r")
-    except (OSError, ValueError) as err:
-        raise LogFormatError(f"{path}: not an HDF5 file ({err}).") from err
-    with h5:
-        if h5.attrs.get("schema") != _SCHEMA:
-            raise LogFormatError(f"{path}: HDF5 file holds no flight-sysid frequency responses.")
-        version = int(h5.attrs["schema_version"])
-        if version > RESPONSES_SCHEMA_VERSION:
-            raise LogFormatError(f"{path}: responses schema version {version} is newer than this software reads "
-                                 f"({RESPONSES_SCHEMA_VERSION}); upgrade flight-sysid.")
+    with open_schema(Path(path), _SCHEMA, RESPONSES_SCHEMA_VERSION, what="responses", not_hdf5="an HDF5 file",
+                     wrong_schema="HDF5 file holds no flight-sysid frequency responses.") as (h5, _):
         group = h5["responses"]
         return tuple(_read_one(group[key]) for key in sorted(group))
 
@@ -154,12 +140,3 @@ def _read_one(group: h5py.Group) -> FrequencyResponse:
 
 def _text(value: object) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("flight-sysid")
-    except PackageNotFoundError:  # pragma: no cover - running from a source tree
-        return "unknown"

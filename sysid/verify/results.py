@@ -6,6 +6,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
+from typing import Protocol, TypeVar
 
 import numpy as np
 
@@ -63,6 +64,22 @@ def theil_inequality(measured: np.ndarray, simulated: np.ndarray) -> float:
     measured, simulated = np.asarray(measured, dtype=float), np.asarray(simulated, dtype=float)
     scale = np.sqrt(np.mean(measured**2)) + np.sqrt(np.mean(simulated**2))
     return float(rms_error(measured, simulated) / scale) if scale > 0 else float("nan")
+
+
+class _Named(Protocol):
+    @property
+    def name(self) -> str: ...
+
+
+_N = TypeVar("_N", bound=_Named)
+
+
+def _named(items: tuple[_N, ...], name: str, missing: str) -> _N:
+    """The item called `name`; KeyError(`missing`) when there is none."""
+    for item in items:
+        if item.name == name:
+            return item
+    raise KeyError(missing)
 
 
 def _vector(value: np.ndarray, name: str, n: int) -> np.ndarray:
@@ -201,10 +218,7 @@ class RecordVerification:
         KeyError
             If the output was not verified on this record.
         """
-        for output in self.outputs:
-            if output.name == name:
-                return output
-        raise KeyError(f"record {self.label!r} has no verified output {name!r}")
+        return _named(self.outputs, name, f"record {self.label!r} has no verified output {name!r}")
 
     @property
     def judged(self) -> tuple[OutputVerification, ...]:
@@ -340,10 +354,7 @@ class Verification:
         KeyError
             If no record verified that output.
         """
-        for summary in self.summary:
-            if summary.name == name:
-                return summary
-        raise KeyError(f"no record verified output {name!r}")
+        return _named(self.summary, name, f"no record verified output {name!r}")
 
     def correction(self, name: str) -> WindCorrection:
         """The wind correction of one output.
@@ -358,7 +369,4 @@ class Verification:
         KeyError
             If there is no wind model or it does not share that output.
         """
-        for correction in self.wind_correction:
-            if correction.name == name:
-                return correction
-        raise KeyError(f"no wind correction for output {name!r}")
+        return _named(self.wind_correction, name, f"no wind correction for output {name!r}")

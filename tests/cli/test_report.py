@@ -5,12 +5,10 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import re
-import sys
 from pathlib import Path
-from typing import Any
+from types import ModuleType
 
 import numpy as np
 import pytest
@@ -26,19 +24,6 @@ from sysid.verify_io import read_verification, write_verification
 from sysid_cli.main import cli
 from sysid_cli.report import ingest_card
 
-_TESTS = Path(__file__).resolve().parents[1] / "reports"
-
-
-def _load(name: str, file: str) -> Any:
-    spec = importlib.util.spec_from_file_location(name, _TESTS / file)
-    assert spec is not None and spec.loader is not None
-    module = sys.modules.setdefault(spec.name, importlib.util.module_from_spec(spec))
-    spec.loader.exec_module(module)
-    return module
-
-
-browser = _load("_report_browser", "browser.py")
-fixtures = _load("_model_report_tests", "test_model_report.py")
 _FOOTER = re.compile(r"<footer>.*?</footer>", re.S)
 INGEST = {"path": "/data/flight.bin", "log_format": "dataflash", "autopilot": "ardupilot",
           "vehicle": "ArduCopter V4.5.7 <octo>", "duration_s": 204.0, "utc_start": "2024-05-01T10:00:00+00:00",
@@ -47,10 +32,11 @@ INGEST = {"path": "/data/flight.bin", "log_format": "dataflash", "autopilot": "a
 
 
 @pytest.fixture(scope="module")
-def saved(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, IdentifiedModel, Verification]:
+def saved(tmp_path_factory: pytest.TempPathFactory, report_browser: ModuleType,
+          report_models: ModuleType) -> tuple[Path, Path, IdentifiedModel, Verification]:
     folder = tmp_path_factory.mktemp("saved")
-    model = fixtures.small_model(files=("flight.bin", "anemometer.csv"))
-    verification = browser.sample_verification()
+    model = report_models.small_model(files=("flight.bin", "anemometer.csv"))
+    verification = report_browser.sample_verification()
     write_model(folder / "model.json", model)
     write_verification(folder / "validation.json", verification, model="model.json",
                        options={"initial_state": "estimated", "after_s": 1.0})

@@ -7,31 +7,20 @@ cannot pass silently. The screenshot is kept in ``tests/artifacts/``.
 
 from __future__ import annotations
 
-import importlib.util
 import os
-import sys
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 
 from reports.model_report import write_model_report
 
-_HELPER = importlib.util.spec_from_file_location("_report_browser", Path(__file__).with_name("browser.py"))
-assert _HELPER is not None and _HELPER.loader is not None
-browser = sys.modules.setdefault(_HELPER.name, importlib.util.module_from_spec(_HELPER))
-_HELPER.loader.exec_module(browser)
-
-_MODELS = importlib.util.spec_from_file_location("_model_report_tests", Path(__file__).with_name(
-    "test_model_report.py"))
-assert _MODELS is not None and _MODELS.loader is not None
-fixtures = sys.modules.setdefault(_MODELS.name, importlib.util.module_from_spec(_MODELS))
-_MODELS.loader.exec_module(fixtures)
-
 ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
 
 
 @pytest.fixture(scope="module")
-def chromium() -> Path:
+def chromium(report_browser: ModuleType) -> Path:
+    browser = report_browser
     try:
         return browser.chromium_path()
     except browser.BrowserUnavailable as err:
@@ -40,8 +29,10 @@ def chromium() -> Path:
         pytest.skip(str(err))
 
 
-def test_model_report_renders_in_chromium(chromium: Path, tmp_path: Path) -> None:
+def test_model_report_renders_in_chromium(chromium: Path, tmp_path: Path, report_browser: ModuleType,
+                                          report_models: ModuleType) -> None:
     """What ``sysid validate --report`` and ``sysid report`` write: the model with its verification."""
+    browser, fixtures = report_browser, report_models
     model = fixtures.small_model(files=("flight.bin", "anemometer.csv"))
     verification = browser.sample_verification()
     page = write_model_report(tmp_path / "model.html", model, verification=verification,
@@ -60,12 +51,12 @@ def test_model_report_renders_in_chromium(chromium: Path, tmp_path: Path) -> Non
     assert shot.stat().st_size > 50_000
 
 
-def test_a_blank_page_is_seen_as_blank(chromium: Path, tmp_path: Path) -> None:
+def test_a_blank_page_is_seen_as_blank(chromium: Path, tmp_path: Path, report_browser: ModuleType) -> None:
     """The helper itself: an empty page has no figures and no ink; a broken script and a fetch are reported."""
     page = tmp_path / "blank.html"
     page.write_text('<!DOCTYPE html><html><body><script>undefinedFunction()</script>'
                     '<img src="http://127.0.0.1:9/pixel.png" alt=""></body></html>')  # loopback discard port
-    seen = browser.render_in_browser(page, tmp_path / "blank.png")
+    seen = report_browser.render_in_browser(page, tmp_path / "blank.png")
     assert seen.n_figures == 0 and not seen.screenshot_nonblank
     assert any("undefinedFunction" in error for error in seen.console_errors)
     assert seen.external_requests == ("http://127.0.0.1:9/pixel.png",)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from types import ModuleType
 
 import numpy as np
 import pytest
@@ -116,18 +117,9 @@ def test_pole_map_of_an_identified_model_has_every_mode(small_model: IdentifiedM
 
 
 @pytest.fixture(scope="module")
-def small_model() -> IdentifiedModel:
+def small_model(report_models: ModuleType) -> IdentifiedModel:
     """Two longitudinal, one lateral and one heave response of a hover model, with 3 deg phase noise."""
-    import importlib.util
-    import sys
-    from pathlib import Path
-
-    spec = importlib.util.spec_from_file_location("_model_report_tests", Path(__file__).with_name(
-        "test_model_report.py"))
-    assert spec is not None and spec.loader is not None
-    module = sys.modules.setdefault(spec.name, importlib.util.module_from_spec(spec))
-    spec.loader.exec_module(module)
-    model: IdentifiedModel = module.small_model()
-    assert [r.pair for r in model.responses] == list(module.PAIRS)
+    model: IdentifiedModel = report_models.small_model()
+    assert [r.pair for r in model.responses] == list(report_models.PAIRS)
     return model
 

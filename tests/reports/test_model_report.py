@@ -9,13 +9,11 @@ synthetic responses), not fitted: the report is judged on what it is given.
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
 import math
 import re
-import sys
 from collections.abc import Mapping
 from importlib import resources
-from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 import pytest
@@ -26,11 +24,6 @@ from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate, Provenanc
 from sysid.model import parse_structure
 from sysid.sim.linear_flight import CALM_HOVER
 from sysid.verify import OutputSummary, Verification
-
-_HELPER = importlib.util.spec_from_file_location("_report_browser", Path(__file__).with_name("browser.py"))
-assert _HELPER is not None and _HELPER.loader is not None
-browser = sys.modules.setdefault(_HELPER.name, importlib.util.module_from_spec(_HELPER))
-_HELPER.loader.exec_module(browser)
 
 HOSTILE = '<script>alert("x")</script><img src=x onerror=alert(1)>'
 STAMP = "2024-05-01 12:00 UTC"
@@ -80,12 +73,12 @@ def verification_with(tics: Mapping[str, float]) -> Verification:
 
 
 @pytest.fixture(scope="module")
-def hostile_page() -> tuple[str, IdentifiedModel, Verification]:
+def hostile_page(report_browser: ModuleType) -> tuple[str, IdentifiedModel, Verification]:
     """A full report where every string from a log or a file is hostile."""
     model = small_model(files=(f"flight{HOSTILE}.bin", "anemometer.csv"), notes=(f"note {HOSTILE}",))
     model = dataclasses.replace(model, provenance=dataclasses.replace(
         model.provenance, options={"min_coherence": 0.5, "kind": HOSTILE}))
-    sample = browser.sample_verification()
+    sample = report_browser.sample_verification()
     records = tuple(dataclasses.replace(r, label=f"{r.label} {HOSTILE}") for r in sample.records)
     verification = dataclasses.replace(sample, records=records)
     page = model_report_html(model, verification=verification, logs_summary={"vehicle": HOSTILE},

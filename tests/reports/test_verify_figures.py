@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import importlib.util
 import re
-import sys
 from dataclasses import replace
-from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 import pytest
@@ -16,21 +14,9 @@ from reports.model_report import model_report_html
 from reports.verify_figures import display_scale, record_figure, verification_figures, wind_correction_figure
 from sysid.verify import Verification, WindCorrection
 
-_HELPER = importlib.util.spec_from_file_location("_report_browser", Path(__file__).with_name("browser.py"))
-assert _HELPER is not None and _HELPER.loader is not None
-browser = sys.modules.setdefault(_HELPER.name, importlib.util.module_from_spec(_HELPER))
-_HELPER.loader.exec_module(browser)
-
-_MODEL_SPEC = importlib.util.spec_from_file_location("_model_report_tests", Path(__file__).with_name(
-    "test_model_report.py"))
-assert _MODEL_SPEC is not None and _MODEL_SPEC.loader is not None
-fixtures = sys.modules.setdefault(_MODEL_SPEC.name, importlib.util.module_from_spec(_MODEL_SPEC))
-_MODEL_SPEC.loader.exec_module(fixtures)
-
-
 @pytest.fixture(scope="module")
-def verification() -> Verification:
-    result: Verification = browser.sample_verification()
+def verification(report_browser: ModuleType) -> Verification:
+    result: Verification = report_browser.sample_verification()
     return result
 
 
@@ -108,9 +94,10 @@ def test_figures_are_the_wind_bars_then_one_per_record(verification: Verificatio
     assert len(verification_figures(plain)) == len(verification.records)
 
 
-def test_the_report_tables_judge_on_axis_outputs_and_list_the_others(verification: Verification) -> None:
-    page = model_report_html(fixtures.small_model(responses=False), verification=verification,
-                             generated_utc=fixtures.STAMP)
+def test_the_report_tables_judge_on_axis_outputs_and_list_the_others(verification: Verification,
+                                                                     report_models: ModuleType) -> None:
+    page = model_report_html(report_models.small_model(responses=False), verification=verification,
+                             generated_utc=report_models.STAMP)
     section = page[page.index('id="verification"'):page.index('id="reduction"')]
     judged, informative = section.split("Off-axis outputs", 1)
     for summary in verification.summary:

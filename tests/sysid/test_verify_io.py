@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
 import json
-import sys
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -16,23 +15,9 @@ from flightlogs.errors import DataError
 from sysid.verify import Verification
 from sysid.verify_io import VERIFICATION_SCHEMA_VERSION, read_verification, verification_to_dict, write_verification
 
-_REPORTS = Path(__file__).resolve().parents[1] / "reports"
-
-
-def _load(name: str, file: str) -> Any:
-    spec = importlib.util.spec_from_file_location(name, _REPORTS / file)
-    assert spec is not None and spec.loader is not None
-    module = sys.modules.setdefault(spec.name, importlib.util.module_from_spec(spec))
-    spec.loader.exec_module(module)
-    return module
-
-
-browser = _load("_report_browser", "browser.py")
-
-
 @pytest.fixture(scope="module")
-def sample() -> Verification:
-    verification: Verification = browser.sample_verification()
+def sample(report_browser: ModuleType) -> Verification:
+    verification: Verification = report_browser.sample_verification()
     return verification
 
 

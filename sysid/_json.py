@@ -1,0 +1,149 @@
+"""JSON encoding shared by the files sysid writes: NaN as ``null`` and back, nested float lists, atomic write and checked read."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flightlogs.atomic import atomic_output
+from flightlogs.errors import SysidError
+
+__all__ = ["finite_or_none", "float_or_nan", "json_floats", "float_array", "write_json", "read_json_object"]
+
+
+def finite_or_none(value: float | None) -> float | None:
+    """`value` as a float, or None (JSON ``null``) when it is None, NaN or infinite.
+
+    Parameters
+    ----------
+    value : float or None
+        Any number, in its own unit.
+
+    Returns
+    -------
+    float or None
+
+    Examples
+    --------
+    >>> finite_or_none(2), finite_or_none(float("nan")), finite_or_none(None)
+    (2.0, None, None)
+    """
+    return None if value is None or not math.isfinite(value) else float(value)
+
+
+def float_or_nan(value: Any) -> float:
+    """A JSON number back as a float: ``null`` (None) reads as NaN.
+
+    Parameters
+    ----------
+    value : float, int or None
+        As read from JSON.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> float_or_nan(None), float_or_nan(3)
+    (nan, 3.0)
+    """
+    return math.nan if value is None else float(value)
+
+
+def json_floats(values: np.ndarray) -> Any:
+    """An array as nested JSON lists of floats, NaN and infinities as None.
+
+    Parameters
+    ----------
+    values : ndarray, any shape
+        Real numbers.
+
+    Returns
+    -------
+    list
+        Nested as deep as `values` has dimensions (a flat list for 0-D and 1-D).
+
+    Examples
+    --------
+    >>> json_floats(np.array([[1.0, np.nan], [np.inf, 2.0]]))
+    [[1.0, None], [None, 2.0]]
+    """
+    if np.ndim(values) > 1:
+        return [json_floats(v) for v in values]
+    return [finite_or_none(float(v)) for v in np.ravel(values)]
+
+
+def float_array(values: Any) -> np.ndarray:
+    """A JSON list of numbers back as a float array, None as NaN.
+
+    Parameters
+    ----------
+    values : sequence of (float or None)
+        As read from JSON.
+
+    Returns
+    -------
+    ndarray, shape (len(values),)
+
+    Examples
+    --------
+    >>> float_array([1, None]).tolist()
+    [1.0, nan]
+    """
+    return np.array([float_or_nan(v) for v in values], dtype=float)
+
+
+def write_json(path: str | Path, doc: Any) -> Path:
+    """Write a JSON document (no NaN allowed, one-space indent, final newline), atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination; its folder must exist.
+    doc : dict
+        JSON-compatible (non-finite numbers already None).
+
+    Returns
+    -------
+    Path
+        The path written.
+    """
+    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
+    with atomic_output(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def read_json_object(path: str | Path, error: type[SysidError], what: str) -> dict[str, Any]:
+    """Read a JSON file that must hold an object.
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file.
+    error : type of SysidError
+        Raised when the file cannot be read or holds no object.
+    what : str
+        The kind of file, for messages (``"model"`` makes "cannot read the model file").
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    SysidError
+        Of type `error`, naming `path`.
+    """
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise error(f"{path}: cannot read the {what} file ({err})") from None
+    if not isinstance(doc, dict):
+        raise error(f"{path}: not a flight-sysid {what} file")
+    return doc
