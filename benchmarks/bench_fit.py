@@ -18,36 +18,12 @@ import argparse
 import os
 import subprocess
 import sys
+from dataclasses import replace
 import tempfile
 import time
 from pathlib import Path
 
 SPEEDS = {"calm": 0.9, "light": 2.7, "strong": 5.4}
-
-
-def _scenario(condition: str, trials: int) -> str:
-    text = f"""
-[scenario]
-description = "bench: sweeps of the Table 3.3 linear model"
-vehicle = "linear-octo"
-formats = ["dataflash"]
-trials = {trials}
-seed = 1
-utc_start = "2024-05-01T10:00:00Z"
-margin_s = 3.0
-[anemometer]
-distance_m = 4.6
-rate_hz = 20.0
-clock_offset_s = 0.0
-[[condition]]
-name = "{condition}"
-mean_speed_m_s = {SPEEDS[condition]}
-direction_from_deg = 300.0
-turbulence_ratio = 0.2
-"""
-    for axis, amplitude in (("lat", 8.0), ("lon", 8.0), ("yaw", 10.0), ("thr", 4.0)):
-        text += f'[[maneuver]]\naxis = "{axis}"\nkind = "sweep"\namplitude = {amplitude}\nduration_s = 34.0\n'
-    return text
 
 
 def _timed(label: str, function, *args, **kwargs):  # type: ignore[no-untyped-def]
@@ -72,15 +48,16 @@ def main() -> None:
     from flightlogs.condition import ConditioningOptions
     from sysid.fit import FitOptions, IdentifyOptions, fit_frequency_responses, identify_flights
     from sysid.sim.campaign import run_scenario
-    from sysid.sim.scenario import read_scenario
+    from sysid.sim.scenario import WindCondition, load_builtin
 
     folder = args.folder or Path(tempfile.mkdtemp(prefix="bench-fit-"))
     folder.mkdir(parents=True, exist_ok=True)
     logs_dir = folder / args.condition
     if not any(logs_dir.glob("*.bin")):
-        (folder / "scenario.toml").write_text(_scenario(args.condition, args.trials))
+        wind = WindCondition(args.condition, SPEEDS[args.condition], direction_from_deg=300.0, turbulence_ratio=0.2)
+        scenario = replace(load_builtin("linear-sweeps"), trials=args.trials, conditions=(wind,))
         start = time.perf_counter()
-        run_scenario(read_scenario(folder / "scenario.toml"), logs_dir)
+        run_scenario(scenario, logs_dir)
         print(f"simulated {args.trials} sweeps per axis in {args.condition} wind: {time.perf_counter() - start:.1f} s "
               f"(not part of the timing)")
     logs = sorted(str(p) for p in logs_dir.glob("*.bin"))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import importlib.util
 import json
 from pathlib import Path
@@ -12,41 +14,15 @@ from scipy import io as sio
 
 from sysid.fit import read_model
 from sysid.sim.campaign import run_scenario
-from sysid.sim.scenario import read_scenario
+from sysid.sim.scenario import load_builtin
 from sysid_cli.main import cli
 
-SCENARIO = """
-[scenario]
-description = "one sweep per axis of the Table 3.3 linear model"
-vehicle = "linear-octo"
-formats = ["dataflash"]
-trials = 1
-seed = 5
-utc_start = "2024-05-01T10:00:00Z"
-margin_s = 3.0
-[anemometer]
-distance_m = 4.6
-rate_hz = 20.0
-clock_offset_s = 0.0
-[[condition]]
-name = "calm"
-mean_speed_m_s = 0.9
-direction_from_deg = 300.0
-turbulence_ratio = 0.2
-""" + "".join(f"""
-[[maneuver]]
-axis = "{axis}"
-kind = "sweep"
-amplitude = {amplitude}
-duration_s = 34.0
-""" for axis, amplitude in (("lat", 8.0), ("lon", 8.0), ("yaw", 10.0), ("thr", 4.0)))
 
 
 @pytest.fixture(scope="module")
 def flights(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("fit-cli")
-    (folder / "calm.toml").write_text(SCENARIO)
-    run_scenario(read_scenario(folder / "calm.toml"), folder / "calm")
+    run_scenario(replace(load_builtin("linear-sweeps"), trials=1, seed=5), folder / "calm")
     return folder / "calm"
 
 

@@ -6,6 +6,8 @@ ArduPilot logs with a ground anemometer 4.6 m upstream, read, conditioned, fitte
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from pathlib import Path
 
 import pytest
@@ -14,35 +16,8 @@ from flightlogs.condition import ConditioningOptions
 from sysid.fit import IdentifiedModel, identify_logs
 from sysid.sim.campaign import run_scenario
 from sysid.sim.linear_flight import CALM_HOVER, STRONG_WIND_TERMS
-from sysid.sim.scenario import read_scenario
+from sysid.sim.scenario import WindCondition, load_builtin
 
-SCENARIO = """
-[scenario]
-description = "Table 3.3 linear model, sweeps on every axis"
-vehicle = "linear-octo"
-formats = ["dataflash"]
-trials = 5
-seed = {seed}
-utc_start = "2024-05-01T10:00:00Z"
-margin_s = 3.0
-
-[anemometer]
-distance_m = 4.6
-rate_hz = 20.0
-clock_offset_s = 0.0
-
-[[condition]]
-name = "{name}"
-mean_speed_m_s = {speed}
-direction_from_deg = 300.0
-turbulence_ratio = 0.2
-""" + "".join(f"""
-[[maneuver]]
-axis = "{axis}"
-kind = "sweep"
-amplitude = {amplitude}
-duration_s = 34.0
-""" for axis, amplitude in (("lat", 8.0), ("lon", 8.0), ("yaw", 10.0), ("thr", 4.0)))
 
 CONTROLS = ("X_lon", "M_lon", "Y_lat", "L_lat", "N_yaw", "Z_thr")
 STEP_S = 1.0 / 500.0  # the simulator integrates at 5 x 100 Hz
@@ -59,9 +34,9 @@ TRUTH = {k: v * 100.0 if k in CONTROLS else v for k, v in CALM_HOVER.items()} | 
 
 
 def _identify(folder: Path, name: str, speed: float, seed: int, structure: str) -> IdentifiedModel:
-    path = folder / f"{name}.toml"
-    path.write_text(SCENARIO.format(name=name, speed=speed, seed=seed))
-    written = run_scenario(read_scenario(path), folder / name)
+    scenario = replace(load_builtin("linear-sweeps"), seed=seed,
+                       conditions=(WindCondition(name, speed, direction_from_deg=300.0, turbulence_ratio=0.2),))
+    written = run_scenario(scenario, folder / name)
     logs = [log for trial in written for log in trial.logs]
     return identify_logs(logs, structure, wind_paths=[folder / name],
                          conditioning=ConditioningOptions(wind_distance_m=4.6))
