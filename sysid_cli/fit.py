@@ -110,24 +110,15 @@ def fit(logs: tuple[Path, ...], model_name: str, wind_paths: tuple[Path, ...], w
         write_model(out, model)
     if mat is not None:
         write_mat(mat, model)
-    report_note = _write_report(report, model) if report is not None else None
+    if report is not None:
+        from reports.model_report import write_model_report
+
+        write_model_report(report, model)
     summary = fit_summary(model) | {"output": str(out) if out else None, "mat": str(mat) if mat else None,
-                                    "report": str(report) if report and report_note is None else None}
+                                    "report": str(report) if report else None}
     if not quiet:
         _print_fit(summary, (max_cr, max_insensitivity), to_stderr=json_path == "-")
-    if report_note:
-        click.secho(f"warning: {report_note}", fg="yellow", err=True)
     emit_json(summary, json_path)
-
-
-def _write_report(path: Path, model: Any) -> str | None:
-    """Write the fit report if the report module exists; otherwise say why not."""
-    try:
-        from reports.model_report import write_model_report as write_fit_report
-    except ImportError:
-        return f"--report {path}: the HTML fit report is not available in this version; nothing written"
-    write_fit_report(path, model)
-    return None
 
 
 def _fmt(value: float | None, spec: str = ".3g") -> str:

@@ -7,7 +7,7 @@ from typing import Any
 from .._json import finite_or_none
 from .result import ParameterEstimate
 
-__all__ = ["finite_or_none", "parameter_entry"]  # finite_or_none lives in sysid._json
+__all__ = ["parameter_entry"]
 
 
 def parameter_entry(p: ParameterEstimate) -> dict[str, Any]:

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..modes import Mode, modes
-from ._json import finite_or_none as _num
+from .._json import finite_or_none as _num
 from ._json import parameter_entry
 from .result import IdentifiedModel
 

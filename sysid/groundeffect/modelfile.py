@@ -6,7 +6,6 @@ file back with :func:`read_ground_effect_model` and calls ``ratio(Z/R)``.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from flightlogs.atomic import atomic_output
 from flightlogs.errors import ModelError
 
+from .._json import read_json_object, write_json
 from .models import PARAMETER_NAMES, GroundEffectFit, evaluate_model
 
 __all__ = ["FittedGroundEffect", "fit_summary", "write_ground_effect_model", "read_ground_effect_model",
@@ -166,10 +165,7 @@ def write_ground_effect_model(fit: GroundEffectFit, path: str | Path) -> Path:
         "rotor_radius_m": chosen.rotor_radius_m, "min_height_ratio": chosen.min_height_ratio,
         "source": chosen.source, "fit": _finite(fit_summary(fit)),
     }
-    path = Path(path)
-    with atomic_output(path) as tmp:
-        tmp.write_text(json.dumps(document, indent=2, allow_nan=False) + "\n")
-    return path
+    return write_json(path, document)
 
 
 def read_ground_effect_model(path: str | Path) -> FittedGroundEffect:
@@ -202,11 +198,8 @@ def read_ground_effect_model(path: str | Path) -> FittedGroundEffect:
     ('corrected', 1.0492)
     """
     path = Path(path)
-    try:
-        document = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise ModelError(f"{path}: not a readable JSON ground-effect model ({err})") from err
-    if not isinstance(document, dict) or document.get("format") != MODEL_FILE_FORMAT:
+    document = read_json_object(path, ModelError, "ground-effect model")
+    if document.get("format") != MODEL_FILE_FORMAT:
         raise ModelError(f"{path}: not a ground-effect model (no \"format\": {MODEL_FILE_FORMAT!r})")
     if document.get("version") != _VERSION:
         raise ModelError(f"{path}: ground-effect model version {document.get('version')!r}; this tool reads {_VERSION}")

@@ -9,7 +9,7 @@ reference model :data:`REFERENCE_EQ_2_20`, and the experiment of Tables
 
 from __future__ import annotations
 
-from .adaptive import Regressor, adaptive_law, linear_regressor, lyapunov_function, rbf_regressor
+from .adaptive import Regressor, adaptive_law, lyapunov_function
 from .analysis import LoopAnalysis, loop_analysis
 from .compare import (
     CONTROLLERS,
@@ -28,8 +28,6 @@ from .summary import comparison_json
 __all__ = [
     "Regressor",
     "adaptive_law",
-    "linear_regressor",
-    "rbf_regressor",
     "lyapunov_function",
     "LoopAnalysis",
     "loop_analysis",

@@ -7,7 +7,7 @@ from typing import Literal
 
 import numpy as np
 
-__all__ = ["Regressor", "linear_regressor", "rbf_regressor", "adaptive_law", "lyapunov_function"]
+__all__ = ["Regressor", "adaptive_law", "lyapunov_function"]
 
 RegressorKind = Literal["linear", "rbf"]
 
@@ -79,34 +79,6 @@ class Regressor:
             return np.column_stack([z, ones])
         centres = np.asarray(self.centres_m)
         return np.column_stack([np.exp(-(self.epsilon_1_m**2) * (z[:, None] - centres[None, :]) ** 2), ones])
-
-
-def linear_regressor() -> Regressor:
-    """The linear regressor ``[z, 1]`` of eq. 2.21.
-
-    Returns
-    -------
-    Regressor
-    """
-    return Regressor("linear")
-
-
-def rbf_regressor(centres_m: tuple[float, ...] = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0),
-                  epsilon_1_m: float = 6.67) -> Regressor:
-    """Gaussian radial basis functions plus a bias, eqs. 2.23-2.24.
-
-    Parameters
-    ----------
-    centres_m : tuple of float, optional
-        Centres, m.
-    epsilon_1_m : float, optional
-        Shape parameter, 1/m.
-
-    Returns
-    -------
-    Regressor
-    """
-    return Regressor("rbf", centres_m, epsilon_1_m)
 
 
 def adaptive_law(phi: np.ndarray, error: np.ndarray, p_b: np.ndarray, gamma: np.ndarray | float) -> np.ndarray:

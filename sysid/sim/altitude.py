@@ -352,7 +352,7 @@ def simulate_altitude(
         out["z"][k], out["v"][k], out["zm"][k], out["pwm"][k] = z, v, measured, pwm
         queue.append(pwm)
         applied = queue.pop(0)
-        ratio = law.ratio((z + vehicle.gear_height_m) * (1.0 / vehicle.rotor_radius_m))
+        ratio = law.ratio(vehicle.height_ratio(z))
         out["ratio"][k] = ratio
         for _ in range(substeps):
             lagged = applied + (lagged - applied) * decay

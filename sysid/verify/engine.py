@@ -48,7 +48,7 @@ from ..statespace import DelayedStateSpace
 from ._discrete import DiscreteModel, delayed_inputs, discretize, predict_one_step, simulate
 from .results import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, rms_error
 from .results import theil_inequality
-from .submodel import driven_part
+from .submodel import driven_part, reachable
 
 __all__ = ["VerificationOptions", "verify_record", "verify"]
 
@@ -133,14 +133,14 @@ def _initial_state(model: DelayedStateSpace, disc: DiscreteModel, record: Record
     return x0
 
 
-def _shift_responses(model: DelayedStateSpace, disc: DiscreteModel, n_samples: int) -> tuple[list[str], np.ndarray]:
-    """Distinct input names and each one's response to a unit constant, shape (n_names, n_samples, n_outputs)."""
-    names = list(dict.fromkeys(model.inputs))
+def _shift_responses(model: DelayedStateSpace, disc: DiscreteModel, names: Sequence[str],
+                     n_samples: int) -> np.ndarray:
+    """Each named input's response to a unit constant, shape (n_names, n_samples, n_outputs)."""
     responses = np.empty((len(names), n_samples, len(model.outputs)))
     for k, name in enumerate(names):
         unit = np.tile([float(n == name) for n in model.inputs], (n_samples, 1))
         responses[k] = simulate(disc, unit, np.zeros(len(model.states)))
-    return names, responses
+    return responses
 
 
 def _free_responses(model: DelayedStateSpace, disc: DiscreteModel, n_samples: int) -> np.ndarray:
@@ -164,12 +164,7 @@ def _offsets(residual: np.ndarray, regressors: list[np.ndarray], weights: np.nda
 def _growth(model: DelayedStateSpace, judged: Sequence[int], duration_s: float) -> float:
     """Open-loop growth over the record of the states the judged outputs depend on (through C and A)."""
     a, c = np.asarray(model.a, dtype=float), np.asarray(model.c, dtype=float)
-    seen = np.any(c[list(judged)] != 0, axis=0) if len(model.states) else np.zeros(0, dtype=bool)
-    while seen.size:
-        grown = seen | np.any(a[seen] != 0, axis=0)
-        if np.array_equal(grown, seen):
-            break
-        seen = grown
+    seen = reachable(a.T, np.any(c[list(judged)] != 0, axis=0))
     if not seen.any():
         return 1.0
     rate = float(np.max(np.linalg.eigvals(a[np.ix_(seen, seen)]).real))
@@ -273,9 +268,9 @@ def _fit_offsets(model: DelayedStateSpace, disc: DiscreteModel, raw: np.ndarray,
                  ) -> tuple[np.ndarray, dict[str, float], np.ndarray, np.ndarray]:
     """Reference shifts, biases and (if asked) the initial-state correction; the simulation with them applied."""
     n_samples, n_out = measured.shape
-    names, responses = _shift_responses(model, disc, n_samples)
     none = np.zeros((0, n_samples, n_out))
-    groups = [responses[:, :, outputs] if options.fit_reference_shift else none,
+    names = list(dict.fromkeys(model.inputs))
+    groups = [_shift_responses(model, disc, names, n_samples)[:, :, outputs] if options.fit_reference_shift else none,
               np.eye(n_out)[:, None, :] * np.ones((1, n_samples, 1)) if options.fit_bias else none,
               _free_responses(model, disc, n_samples)[:, :, outputs] if options.initial_state == "estimated" else none]
     shifts, biases, correction = _offsets(measured - raw, groups, weights)

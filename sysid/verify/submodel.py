@@ -17,6 +17,30 @@ if TYPE_CHECKING:
 __all__ = ["driven_part", "axis_outputs"]
 
 
+def reachable(a: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """States `start` reaches through A (``a[i, j] != 0``: state j drives state i), `start` included.
+
+    Pass ``a.T`` for the states that reach `start` instead.
+
+    Parameters
+    ----------
+    a : ndarray, shape (n_states, n_states)
+        State matrix.
+    start : ndarray of bool, shape (n_states,)
+        The states to start from.
+
+    Returns
+    -------
+    ndarray of bool, shape (n_states,)
+    """
+    reached = np.asarray(start, dtype=bool)
+    while True:
+        grown = reached | np.any(a[:, reached] != 0, axis=1)
+        if np.array_equal(grown, reached):
+            return reached
+        reached = grown
+
+
 def driven_part(model: DelayedStateSpace, excited: str) -> DelayedStateSpace:
     """The part of a decoupled model that input `excited` drives.
 
@@ -45,12 +69,7 @@ def driven_part(model: DelayedStateSpace, excited: str) -> DelayedStateSpace:
         raise ModelError(f"{excited!r} is not an input of the model ({', '.join(model.inputs)})")
     a, b, c, d = (np.asarray(m, dtype=float) for m in (model.a, model.b, model.c, model.d))
     columns = [j for j, name in enumerate(model.inputs) if name == excited]
-    reached = np.any(b[:, columns] != 0, axis=1)
-    while True:
-        grown = reached | np.any(a[:, reached] != 0, axis=1)
-        if np.array_equal(grown, reached):
-            break
-        reached = grown
+    reached = reachable(a, np.any(b[:, columns] != 0, axis=1))
     rows = np.any(c[:, reached] != 0, axis=1) | np.any(d[:, columns] != 0, axis=1)
     keep_inputs = np.any(b[reached] != 0, axis=0) | np.any(d[rows] != 0, axis=0)
     x, u, y = np.flatnonzero(reached), np.flatnonzero(keep_inputs), np.flatnonzero(rows)

@@ -41,7 +41,7 @@ def test_modes_of_a_model_file(runner: CliRunner, tmp_path: Path) -> None:
     result = runner.invoke(cli, ["modes", str(path), "--json", "-", "-q"])
     assert result.exit_code == 0, result.output
     reals = sorted(m["real"] for m in json.loads(result.stdout)["eigenvalues"] if m["mode"] == "pitch")
-    assert reals == pytest.approx([-2.073, 0.878], abs=2e-3)
+    assert reals == pytest.approx([-2.073, 0.878], abs=5e-4)  # noise-free fit: exact to the table's rounding
 
 
 @pytest.mark.parametrize(("args", "code", "message"), [

@@ -130,11 +130,11 @@ def test_a_missing_model_is_a_usage_error(tmp_path: Path) -> None:
 
 def test_fit_report_hook_writes_the_model_report(saved: tuple[Path, Path, IdentifiedModel, Verification],
                                                  tmp_path: Path) -> None:
-    """``sysid fit --report`` goes through the same function (its hook, without running a fit)."""
-    from sysid_cli.fit import _write_report
+    """``sysid fit --report`` calls ``write_model_report``: the page ``sysid report`` renders."""
+    from reports.model_report import write_model_report
 
     _, _, model, _ = saved
-    assert _write_report(tmp_path / "fit.html", model) is None
+    assert write_model_report(tmp_path / "fit.html", model) == tmp_path / "fit.html"
     assert _FOOTER.sub("", (tmp_path / "fit.html").read_text()) == _FOOTER.sub("", model_report_html(model))
 
 
