@@ -1,0 +1,54 @@
+"""Atomic output: all or nothing, with the permissions an ordinary write would give."""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+import pytest
+
+from flightlogs.atomic import atomic_output
+
+
+def _mode(path: Path) -> int:
+    return stat.S_IMODE(path.stat().st_mode)
+
+
+def _process_umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def test_a_new_file_is_readable_as_an_ordinary_write_would_be(tmp_path: Path) -> None:
+    """The report a colleague opens must not stay 0o600 like the temporary file (mkstemp)."""
+    plain = tmp_path / "plain.html"
+    plain.write_text("x")
+    target = tmp_path / "report.html"
+    with atomic_output(target) as tmp:
+        assert _mode(tmp) == 0o600
+        tmp.write_text("done")
+    assert _mode(target) == _mode(plain) == 0o666 & ~_process_umask()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain.html", "report.html"]
+
+
+def test_a_replaced_file_keeps_its_permissions(tmp_path: Path) -> None:
+    target = tmp_path / "model.json"
+    target.write_text("old")
+    target.chmod(0o640)
+    with atomic_output(target) as tmp:
+        tmp.write_text("new")
+    assert target.read_text() == "new"
+    assert _mode(target) == 0o640
+
+
+def test_a_failure_leaves_the_old_file_and_no_temporary(tmp_path: Path) -> None:
+    target = tmp_path / "model.json"
+    target.write_text("old")
+    with pytest.raises(RuntimeError, match="boom"):
+        with atomic_output(target) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("boom")
+    assert target.read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["model.json"]
