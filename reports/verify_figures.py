@@ -10,7 +10,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from sysid.verify import OutputVerification, RecordVerification, Verification, WindCorrection
+from sysid.verify import OutputVerification, RecordVerification, Verification, WindCorrection, mode_names
 
 from .model_figures import plain_text
 from .svg import figure_svg, new_figure
@@ -118,7 +118,8 @@ def record_figure(result: RecordVerification, *, without_wind: RecordVerificatio
     axes[-1].set_xlabel("time [s]")
     axes[0].set_title(plain_text(result.label), fontsize=9, loc="left")
     if result.unstable:
-        axes[0].set_title(f"unstable open loop: grows {result.growth:.0f}-fold", fontsize=8, loc="right",
+        axes[0].set_title(f"{mode_names(result.unstable_modes)} unstable: grows {result.growth:.0f}-fold", fontsize=8,
+                          loc="right",
                           color="#9a6700")
     axes[-1].legend(loc="upper center", bbox_to_anchor=(0.5, -0.45), ncol=3, frameon=False, fontsize=8)
     parts[0].align_ylabels(axes)
@@ -202,6 +203,7 @@ def verification_figures(verification: Verification) -> list[tuple[str, str]]:
         if record.off_axis:
             caption += f"; judged on {', '.join(o.name for o in record.judged)}, the others shown small below"
         if record.unstable:
-            caption += "; the model is unstable open loop over this record, see the one-step-ahead errors"
+            caption += (f"; the model's {mode_names(record.unstable_modes)} (unstable open loop) reach the judged "
+                        "outputs over this record, see the one-step-ahead errors")
         figures.append((record_figure(record, without_wind=without.get(id(record))), caption + "."))
     return figures

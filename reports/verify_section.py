@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from sysid.verify import OutputSummary, RecordVerification, Verification
+from sysid.verify import OutputSummary, RecordVerification, Verification, mode_names
 
 from .verify_figures import display_scale, verification_figures
 
@@ -78,7 +78,9 @@ def _notices(records: Sequence[RecordVerification]) -> list[str]:
     if unstable:
         growth = sorted({f"{r.growth:.0f}" for r in unstable}, key=float)
         spans = sorted({f"{r.time_s[-1] - r.time_s[0]:.1f}" for r in unstable}, key=float)
-        notices.insert(0, f"The model is unstable open loop (in modes the judged outputs depend on) and grows "
+        names = mode_names([m for r in unstable for m in r.unstable_modes])
+        notices.insert(0, f"The model is unstable open loop in its {names}, which the judged outputs depend on, "
+                          f"and grows "
                           f"{'-'.join(dict.fromkeys([growth[0], growth[-1]]))}-fold over the "
                           f"{'-'.join(dict.fromkeys([spans[0], spans[-1]]))} s of {len(unstable)} of the "
                           f"{len(records)} records ({'; '.join(r.label for r in unstable)}): small input or "

@@ -19,7 +19,7 @@ from scipy import linalg
 
 from .statespace import DelayedStateSpace
 
-__all__ = ["Mode", "modes", "STATE_GROUPS"]
+__all__ = ["Mode", "modes", "state_modes", "STATE_GROUPS"]
 
 #: Mode label of each state name.
 STATE_GROUPS: dict[str, str] = {
@@ -126,7 +126,25 @@ def modes(model: Any) -> tuple[Mode, ...]:
     >>> [(round(x.real, 3), round(x.imag, 3), x.mode, x.stability) for x in modes(m)]
     [(0.878, 1.694, 'pitch', 'unstable'), (-2.073, 0.0, 'pitch', 'stable')]
     """
-    a, states = _state_space(model)
+    return state_modes(*_state_space(model))
+
+
+def state_modes(a: np.ndarray, states: tuple[str, ...]) -> tuple[Mode, ...]:
+    """Modes of a state matrix whose states have the given names (see :func:`modes`).
+
+    Parameters
+    ----------
+    a : ndarray, shape (n_states, n_states)
+        State matrix, 1/s.
+    states : tuple of str
+        State names, ``(n_states,)``; they decide the labels.
+
+    Returns
+    -------
+    tuple of Mode
+        Ordered by label, then by real part (largest first).
+    """
+    a = np.asarray(a, dtype=float)
     if a.size == 0:
         return ()
     values, left, right = linalg.eig(a, left=True, right=True)

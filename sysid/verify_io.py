@@ -77,7 +77,8 @@ def _record_to_dict(r: RecordVerification) -> dict[str, Any]:
             "outputs": [_output_to_dict(o) for o in r.outputs],
             "reference_shifts": {k: _num(v) for k, v in r.reference_shifts.items()},
             "rmse": _num(r.rmse), "tic": _num(r.tic), "growth": _num(r.growth), "unstable": bool(r.unstable),
-            "notice": r.notice, "excited": r.excited, "off_axis": list(r.off_axis)}
+            "notice": r.notice, "excited": r.excited, "off_axis": list(r.off_axis),
+            "unstable_modes": list(r.unstable_modes)}
 
 
 def verification_to_dict(verification: Verification, *, model: str = "", options: Mapping[str, Any] | None = None,
@@ -132,7 +133,7 @@ def _record_from_dict(d: Mapping[str, Any]) -> RecordVerification:
         tuple(_output_from_dict(o) for o in d["outputs"]),
         {k: _float(v) for k, v in d["reference_shifts"].items()}, _float(d["rmse"]), _float(d["tic"]),
         _float(d["growth"]), bool(d["unstable"]), d.get("notice", ""), d.get("excited"),
-        tuple(d.get("off_axis", ())))
+        tuple(d.get("off_axis", ())), tuple(d.get("unstable_modes", ())))
 
 
 def _summary_from_dict(s: Mapping[str, Any]) -> OutputSummary:

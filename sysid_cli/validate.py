@@ -97,7 +97,7 @@ def _summary(verification: Any, model_path: Path, logs: tuple[Path, ...], report
         "logs": [str(p) for p in logs],
         "records": [{"label": r.label, "source": str(r.source), "start_s": float(r.time_s[0]),
                      "end_s": float(r.time_s[-1]), "rmse": r.rmse, "tic": r.tic, "unstable": r.unstable,
-                     "growth": r.growth, "notice": r.notice, "reference_shifts": dict(r.reference_shifts),
+                     "growth": r.growth, "unstable_modes": list(r.unstable_modes), "notice": r.notice, "reference_shifts": dict(r.reference_shifts),
                      "bias": {o.name: o.bias for o in r.outputs}, "excited": r.excited,
                      "on_axis": [o.name for o in r.judged], "off_axis": list(r.off_axis)}
                     for r in verification.records],
@@ -132,10 +132,14 @@ def _print(summary: dict[str, Any], *, to_stderr: bool) -> None:
             reduction = wind[name]["reduction_percent"]
             line += f" {wind[name]['rmse_without']:>12.4g} {reduction:>8.1f}%" if math.isfinite(reduction) else ""
         say(line)
+    from sysid.verify import mode_names
+
     unstable = [r for r in summary["records"] if r["unstable"]]
     if len(unstable) > 1:  # one note, not the same sentence per record
         growth = max(r["growth"] for r in unstable)
-        say(f"  note: the model is unstable open loop and grows up to {growth:.0f}-fold over {len(unstable)} records "
+        names = mode_names([m for r in unstable for m in r["unstable_modes"]])
+        say(f"  note: the model is unstable open loop in its {names} and grows up to {growth:.0f}-fold over "
+            f"{len(unstable)} records "
             f"({'; '.join(r['label'] for r in unstable)}): small input or initial-state errors diverge there, so "
             "judge them also by the one-step-ahead prediction error (one_step_* in --json)")
     for record in summary["records"]:

@@ -11,9 +11,9 @@ from .engine import VerificationOptions, verify, verify_record
 from .logs import verify_logs
 from .records import DoubletRecords, doublet_records
 from .submodel import axis_outputs, driven_part
-from .results import (OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, rms_error,
-                      theil_inequality)
+from .results import (OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, mode_names,
+                      rms_error, theil_inequality)
 
 __all__ = ["VerificationOptions", "verify_record", "verify", "verify_logs", "driven_part", "axis_outputs",
            "doublet_records", "DoubletRecords", "OutputVerification", "RecordVerification", "OutputSummary",
-           "WindCorrection", "Verification", "rms_error", "theil_inequality"]
+           "WindCorrection", "Verification", "rms_error", "theil_inequality", "mode_names"]

@@ -20,7 +20,12 @@ Per record:
    ``b`` per output are estimated by linear least squares on
    ``y_meas ≈ y_model(u) + Σ Δu_j s_j + b``, where ``s_j`` is the
    simulated response to a unit constant on input j from zero state, so a
-   trim or sensor offset is not blamed on the dynamics;
+   trim or sensor offset is not blamed on the dynamics. The shifts (and the
+   initial-state correction) are fitted on the judged outputs only: the
+   trim terms couple the axes (``w' = U0 q - V0 p``), and an off-axis output
+   the model predicts poorly, or a misaligned wind on it, would otherwise
+   move the shifts and so the on-axis verdict; each off-axis output gets its
+   own bias;
 5. RMS error and Theil inequality coefficient per output; a record that
    excites one axis is judged on that axis' outputs only (`on_axis`; the
    others are kept for information as off-axis), overall as Tischler's
@@ -44,10 +49,11 @@ import numpy as np
 from flightlogs.errors import DataError
 from flightlogs.record import Record
 
+from ..modes import state_modes
 from ..statespace import DelayedStateSpace
 from ._discrete import DiscreteModel, delayed_inputs, discretize, predict_one_step, simulate
-from .results import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, rms_error
-from .results import theil_inequality
+from .results import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, mode_names
+from .results import rms_error, theil_inequality
 from .submodel import driven_part, reachable
 
 __all__ = ["VerificationOptions", "verify_record", "verify"]
@@ -161,14 +167,18 @@ def _offsets(residual: np.ndarray, regressors: list[np.ndarray], weights: np.nda
     return [solution[a:b] for a, b in zip(bounds[:-1], bounds[1:])]
 
 
-def _growth(model: DelayedStateSpace, judged: Sequence[int], duration_s: float) -> float:
-    """Open-loop growth over the record of the states the judged outputs depend on (through C and A)."""
+def _growth(model: DelayedStateSpace, judged: Sequence[int], duration_s: float) -> tuple[float, tuple[str, ...]]:
+    """Open-loop growth over the record of the states the judged outputs depend on (through C and A), and the
+    labels of its unstable modes (``("pitch",)``), largest real part first."""
     a, c = np.asarray(model.a, dtype=float), np.asarray(model.c, dtype=float)
     seen = reachable(a.T, np.any(c[list(judged)] != 0, axis=0))
-    if not seen.any():
-        return 1.0
-    rate = float(np.max(np.linalg.eigvals(a[np.ix_(seen, seen)]).real))
-    return float(np.exp(min(max(rate, 0.0) * duration_s, 700.0)))
+    unstable = [m for m in state_modes(a[np.ix_(seen, seen)], tuple(np.asarray(model.states)[seen]))
+                if m.unstable]
+    if not unstable:
+        return 1.0, ()
+    rate = max(m.real for m in unstable)
+    labels = tuple(dict.fromkeys(m.mode for m in sorted(unstable, key=lambda m: -m.real)))
+    return float(np.exp(min(rate * duration_s, 700.0))), labels
 
 
 def _one_step(model: DelayedStateSpace, disc: DiscreteModel, record: Record, inputs: np.ndarray, x0: np.ndarray,
@@ -244,8 +254,8 @@ def verify_record(model: DelayedStateSpace, record: Record, *, on_axis: Sequence
     weights = np.array([_weight(unit) for unit in units])
     x0 = _initial_state(model, disc, record, inputs, options)
     raw = simulate(disc, inputs, x0)[:, outputs]
-    simulated, shifts, biases, correction = _fit_offsets(model, disc, raw, measured, outputs, weights, options)
-    growth = _growth(model, [outputs[j] for j in judged], record.end_s - record.start_s)
+    simulated, shifts, biases, correction = _fit_offsets(model, disc, raw, measured, outputs, weights, judged, options)
+    growth, unstable_modes = _growth(model, [outputs[j] for j in judged], record.end_s - record.start_s)
     unstable = growth > options.max_growth
     predicted = None
     if options.one_step == "always" or (options.one_step == "auto" and unstable):
@@ -255,29 +265,39 @@ def verify_record(model: DelayedStateSpace, record: Record, *, on_axis: Sequence
     rmse, tic = _overall(measured[:, judged], simulated[:, judged], weights[judged])
     notice = ""
     if unstable:
-        notice = (f"the model is unstable open loop and grows {growth:.0f}-fold over this "
+        reach = ", ".join(model.outputs[outputs[j]] for j in judged)
+        notice = (f"the model is unstable open loop in its {mode_names(unstable_modes)}, which {reach} depend"
+                  f"{'s' if len(judged) == 1 else ''} on, and grows {growth:.0f}-fold over this "
                   f"{record.end_s - record.start_s:.1f} s record (limit {options.max_growth:g}): small input or "
                   "initial-state errors diverge, so judge it also by the one-step-ahead prediction error")
     off_axis = tuple(o.name for j, o in enumerate(results) if j not in judged)
     return RecordVerification(record.label, record.source, record.time_s, tuple(model.inputs), results, shifts,
-                              rmse, tic, growth, unstable, notice, excited, off_axis)
+                              rmse, tic, growth, unstable, notice, excited, off_axis, unstable_modes)
 
 
 def _fit_offsets(model: DelayedStateSpace, disc: DiscreteModel, raw: np.ndarray, measured: np.ndarray,
-                 outputs: list[int], weights: np.ndarray, options: VerificationOptions
+                 outputs: list[int], weights: np.ndarray, judged: list[int], options: VerificationOptions
                  ) -> tuple[np.ndarray, dict[str, float], np.ndarray, np.ndarray]:
-    """Reference shifts, biases and (if asked) the initial-state correction; the simulation with them applied."""
+    """Reference shifts, biases and (if asked) the initial-state correction; the simulation with them applied.
+
+    Shifts and the correction are fitted on the judged outputs only, so that an off-axis output the model
+    predicts poorly cannot move the on-axis verdict; each off-axis output then gets its own bias.
+    """
     n_samples, n_out = measured.shape
     none = np.zeros((0, n_samples, n_out))
     names = list(dict.fromkeys(model.inputs))
     groups = [_shift_responses(model, disc, names, n_samples)[:, :, outputs] if options.fit_reference_shift else none,
               np.eye(n_out)[:, None, :] * np.ones((1, n_samples, 1)) if options.fit_bias else none,
               _free_responses(model, disc, n_samples)[:, :, outputs] if options.initial_state == "estimated" else none]
-    shifts, biases, correction = _offsets(measured - raw, groups, weights)
-    simulated = raw + sum((np.tensordot(c, g, axes=1) for c, g in zip((shifts, biases, correction), groups)),
+    on_axis = np.isin(np.arange(n_out), judged)
+    shifts, biases, correction = _offsets(measured - raw, groups, np.where(on_axis, weights, 0.0))
+    simulated = raw + sum((np.tensordot(c, g, axes=1) for c, g in zip((shifts, correction), groups[::2])),
                           np.zeros_like(raw))
-    shifts = shifts if options.fit_reference_shift else np.zeros(len(names))
     biases = biases if options.fit_bias else np.zeros(n_out)
+    if options.fit_bias:
+        biases[~on_axis] = (measured - simulated)[:, ~on_axis].mean(axis=0)
+    simulated = simulated + biases
+    shifts = shifts if options.fit_reference_shift else np.zeros(len(names))
     correction = correction if options.initial_state == "estimated" else np.zeros(len(model.states))
     return simulated, dict(zip(names, (float(v) for v in shifts))), biases, correction
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -10,7 +10,7 @@ from typing import Protocol, TypeVar
 
 import numpy as np
 
-__all__ = ["rms_error", "theil_inequality", "OutputVerification", "RecordVerification", "OutputSummary",
+__all__ = ["rms_error", "theil_inequality", "mode_names", "OutputVerification", "RecordVerification", "OutputSummary",
            "WindCorrection", "Verification"]
 
 
@@ -87,6 +87,27 @@ def _vector(value: np.ndarray, name: str, n: int) -> np.ndarray:
     if array.shape != (n,):
         raise ValueError(f"{name} has shape {array.shape}, expected ({n},) like time_s")
     return array
+
+
+def mode_names(labels: Sequence[str]) -> str:
+    """Mode labels as words: ``"pitch mode"``, ``"pitch and roll modes"``; ``"modes"`` for none.
+
+    Parameters
+    ----------
+    labels : sequence of str
+        Mode labels (``"pitch"``, ``"roll"``).
+
+    Examples
+    --------
+    >>> mode_names(("pitch",)), mode_names(("pitch", "roll", "heave"))
+    ('pitch mode', 'pitch, roll and heave modes')
+    """
+    labels = list(dict.fromkeys(labels))
+    if not labels:
+        return "modes"
+    if len(labels) == 1:
+        return f"{labels[0]} mode"
+    return f"{', '.join(labels[:-1])} and {labels[-1]} modes"
 
 
 @dataclass(frozen=True, slots=True)
@@ -172,6 +193,10 @@ class RecordVerification:
     off_axis : tuple of str, optional
         Outputs shown for information only: not of the excited axis, so not
         judged (left out of `rmse`, `tic` and the pooled summary); default none.
+    unstable_modes : tuple of str, optional
+        Labels of the unstable modes the judged outputs depend on
+        (``("pitch",)``; see :func:`sysid.modes.modes`), largest growth first;
+        a heave record names pitch when the trim couples it in (``w' = U0 q``).
     """
 
     label: str
@@ -187,6 +212,7 @@ class RecordVerification:
     notice: str = ""
     excited: str | None = None
     off_axis: tuple[str, ...] = ()
+    unstable_modes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         time_s = np.asarray(self.time_s, dtype=float)
@@ -198,6 +224,7 @@ class RecordVerification:
             raise ValueError(f"record {self.label!r}: off_axis {tuple(self.off_axis)} must name some, not all, of "
                              f"its outputs {tuple(names)}")
         object.__setattr__(self, "off_axis", tuple(self.off_axis))
+        object.__setattr__(self, "unstable_modes", tuple(self.unstable_modes))
         for output in self.outputs:
             if output.measured.shape != time_s.shape:
                 raise ValueError(f"record {self.label!r}: output {output.name} has {output.measured.size} samples, "

@@ -41,8 +41,8 @@ def test_record_figure_stacks_the_judged_outputs_and_shows_the_others_small(veri
 
 
 def test_unstable_records_say_so_in_the_title(verification: Verification) -> None:
-    record = replace(verification.records[0], unstable=True, growth=21.4, notice="grows")
-    assert "unstable open loop: grows 21-fold" in record_figure(record)
+    record = replace(verification.records[0], unstable=True, growth=21.4, notice="grows", unstable_modes=("pitch",))
+    assert "pitch mode unstable: grows 21-fold" in record_figure(record)
 
 
 def test_a_dollar_in_a_record_label_is_drawn_as_it_is(verification: Verification) -> None:

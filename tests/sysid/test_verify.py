@@ -213,13 +213,53 @@ def test_unstable_model_is_flagged_and_predicted_one_step_ahead(calm_flights: li
     result = verify_record(model, record)
     growth = np.exp(np.max(np.linalg.eigvals(model.a).real) * (record.end_s - record.start_s))
     assert result.unstable and result.growth == pytest.approx(growth)
-    assert "unstable open loop" in result.notice
+    assert result.unstable_modes == ("pitch",) and "unstable open loop in its pitch mode" in result.notice
     q = result.output("q")
     assert q.tic > 0.5
     # q[k+1] predicted from the measured q[k]: error about sqrt(2) x the 0.005 rad/s gyro noise
     assert q.prediction_rmse is not None and q.prediction_rmse < 2 * np.sqrt(2) * 0.005
     quiet = verify_record(model, record, options=VerificationOptions(max_growth=1e6))
     assert not quiet.unstable and quiet.output("q").predicted is None
+
+
+@pytest.mark.parametrize("trim_u", [0.0, 1.5])
+def test_a_heave_record_names_the_pitch_mode_the_trim_couples_in(trim_u: float) -> None:
+    """w' = Z_thr d + U0 q: at U0 = 0 heave is neutral and the record is not flagged; with U0 the judged w
+    depends on the unstable pitch pair (0.878 +- 1.694i, Table 3.3), which the notice names."""
+    a = np.array([[-0.3172, 0.0, -9.81, 0.0], [0.769, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, trim_u, 0.0, 0.0]])
+    model = DelayedStateSpace(a, np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, -5.0]]),
+                              np.eye(4)[3:], np.zeros((1, 2)), ("u", "q", "theta", "w"), ("delta_lon", "delta_thr"),
+                              ("w",), np.zeros(2))
+    t = np.arange(500) * 0.01
+    result = verify_record(model, _record({"delta_lon": np.zeros(500), "delta_thr": np.sin(2 * t),
+                                           "w": -5 * (1 - np.cos(2 * t)) / 2}))
+    if trim_u == 0:
+        assert result.growth == 1.0 and result.unstable_modes == () and not result.unstable
+    else:
+        assert 79 < result.growth == pytest.approx(np.exp(np.max(np.linalg.eigvals(a).real) * 4.99), rel=1e-9)
+        assert result.unstable_modes == ("pitch",)
+        assert result.notice.startswith("the model is unstable open loop in its pitch mode, which w depends on")
+
+
+def test_an_off_axis_output_cannot_move_the_on_axis_verdict() -> None:
+    """The trim couples q into w (w' = U0 q): a heave record judged on w must come out the same whether the
+    off-axis q is logged well or with a drift the model cannot explain."""
+    a = np.array([[-2.0, 0.0], [1.5, 0.0]])  # q' = -2 q + 4 delta_lon, w' = 1.5 q - 5 delta_thr
+    model = DelayedStateSpace(a, np.array([[4.0, 0.0], [0.0, -5.0]]), np.eye(2), np.zeros((2, 2)), ("q", "w"),
+                              ("delta_lon", "delta_thr"), ("q", "w"), np.zeros(2))
+    t = np.arange(600) * 0.01
+    u = np.column_stack([0.02 + 0.1 * np.sin(1.3 * t), 0.2 * np.sign(np.sin(2.0 * t))])
+    y = simulate(discretize(model, 0.01), u, np.zeros(2))
+    base = {"delta_lon": u[:, 0] - 0.02, "delta_thr": u[:, 1], "w": y[:, 1]}  # delta_lon logged 0.02 low: a shift
+    zero = VerificationOptions(initial_state="zero")  # as simulated: the shift is then exact
+    results = [verify_record(model, _record(base | extra), on_axis=("w",), options=zero)
+               for extra in ({"q": y[:, 0]}, {"q": y[:, 0] + 0.3 * t})]
+    np.testing.assert_allclose(results[1].output("w").simulated, results[0].output("w").simulated, atol=1e-12)
+    assert results[1].reference_shifts == pytest.approx(results[0].reference_shifts, abs=1e-12)
+    assert results[0].reference_shifts["delta_lon"] == pytest.approx(0.02, abs=1e-9)
+    assert results[0].output("w").rmse < 1e-9
+    assert results[1].output("q").tic > 0.1  # the drifting q is shown, badly predicted, as off-axis
+    assert results[1].off_axis == ("q",)
 
 
 def test_driven_part_keeps_one_axis_and_its_wind() -> None:
