@@ -38,6 +38,24 @@ class Campaign:
     conditioned: tuple[ConditionedFlight | None, ...]
     notes: tuple[tuple[str, ...], ...]
 
+    @property
+    def flights(self) -> tuple[ConditionedFlight, ...]:
+        """The flights that could be conditioned, in the order given."""
+        return tuple(flight for flight in self.conditioned if flight is not None)
+
+    def require_flights(self) -> tuple[ConditionedFlight, ...]:
+        """`flights`, or DataError saying why no log could be conditioned.
+
+        Raises
+        ------
+        DataError
+            If no log could be conditioned (the message gives each log's reason).
+        """
+        if not self.flights:
+            reasons = "; ".join(note for notes in self.notes for note in notes)
+            raise DataError(f"no log could be conditioned ({reasons})")
+        return self.flights
+
 
 def expand_wind_paths(paths: Sequence[Path]) -> list[Path]:
     """Files given as they are, folders as the ``*.csv`` files inside them (sorted).

@@ -141,11 +141,7 @@ def _flights(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_dista
         campaign = ingest_campaign(list(sources), list(wind_paths),
                                    options=ConditioningOptions(wind_distance_m=wind_distance, wind_offset_s=wind_offset),
                                    progress=lambda _n, done, total: bar(done, total))
-    flights = [flight for flight in campaign.conditioned if flight is not None]
-    if not flights:
-        reasons = "; ".join(note for notes in campaign.notes for note in notes)
-        raise DataError(f"no log could be conditioned ({reasons})")
-    return flights
+    return list(campaign.require_flights())
 
 
 def _summary(responses: list[Any], dropped: tuple[Any, ...], pieces: dict[str, int], options: Any,

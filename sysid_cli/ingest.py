@@ -85,7 +85,7 @@ def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[s
         campaign = ingest_campaign(list(logs), list(wind_paths), columns=columns, options=options,
                                    progress=lambda _name, done, total: bar(done, total))
     if out is not None:
-        write_dataset(out, campaign.logs, campaign.winds, [c for c in campaign.conditioned if c is not None])
+        write_dataset(out, campaign.logs, campaign.winds, list(campaign.flights))
     summary = _summary(campaign, out)
     if not quiet:
         _print_summary(summary, to_stderr=json_path == "-")

@@ -247,7 +247,7 @@ def identify_logs(
 
     campaign = ingest_campaign([Path(p) for p in log_paths], [Path(p) for p in wind_paths], options=conditioning,
                                progress=reading)
-    flights = [c for c in campaign.conditioned if c is not None]
+    flights = list(campaign.require_flights())
     winds = expand_wind_paths([Path(p) for p in wind_paths])
     return identify_flights(flights, structure, options=options, files=[*log_paths, *winds], progress=progress)
 

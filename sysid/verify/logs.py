@@ -68,7 +68,7 @@ def verify_logs(
         raise DataError("the model has wind terms but no anemometer file was given (--wind); "
                         "without wind only the model without G_w can be verified")
     campaign = ingest_campaign(list(log_paths), list(wind_paths), options=conditioning, progress=progress)
-    flights = [flight for flight in campaign.conditioned if flight is not None]
+    flights = list(campaign.require_flights())
     cut = doublet_records(flights, before_s=before_s, after_s=after_s)
     kept = [k for k, name in enumerate(cut.excited) if name in model.inputs]  # axes the model does not have
     if not kept:
