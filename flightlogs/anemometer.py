@@ -266,7 +266,7 @@ def _resolve_columns(path: Path, header: list[str], explicit: Mapping[str, str])
             hits = [h for h, k in zip(header, keys) if k == synonym and h not in used.values()]
             if len(hits) > 1:
                 raise LogFormatError(f"{path}: columns {hits} all look like {quantity}; "
-                                     f"name one with columns={{'{quantity}': ...}}")
+                                     f"name one with --columns {quantity}=COL")
             if hits:
                 used[quantity] = hits[0]
                 break
@@ -280,12 +280,11 @@ def _resolve_columns(path: Path, header: list[str], explicit: Mapping[str, str])
     found = ", ".join(repr(h) for h in header)
     if "time" not in used:
         raise LogFormatError(f"{path}: no time column recognised among {found}; "
-                             "name it with columns={'time': ...}")
+                             "name it with --columns time=COL")
     if not ({"speed", "direction"} <= used.keys() or {"u", "v"} <= used.keys()):
         raise LogFormatError(
             f"{path}: no wind columns recognised (need speed and direction, or u and v) among "
-            f"{found}; name them with columns={{'speed': ..., 'direction': ...}} or "
-            "{'u': ..., 'v': ...}"
+            f"{found}; name them with --columns speed=COL,direction=COL (or u=COL,v=COL)"
         )
     return used
 

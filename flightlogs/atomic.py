@@ -10,6 +10,8 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from .errors import DataError
+
 __all__ = ["atomic_output"]
 
 
@@ -27,6 +29,11 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     path : str or Path
         Final destination. Its folder must exist.
 
+    Raises
+    ------
+    DataError
+        If the folder of `path` does not exist or is not a folder.
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -38,6 +45,9 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     """
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise DataError(f"{folder}: the output folder does not exist" if not folder.exists()
+                        else f"{folder}: the output folder is a file")
     fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=folder)
     os.close(fd)
     tmp = Path(name)

@@ -283,20 +283,20 @@ def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None) -
         ) from err
     finally:
         tracked.close()
-    notes = _damage_notes(ulog, tracked, size)
+    notes = _damage_notes(ulog, tracked, size, path.name)
     notes += [f"pyulog: {line.strip()}" for line in printed.getvalue().splitlines() if line.strip()]
     notes += [f"pyulog: {w.message}" for w in caught if not issubclass(w.category, DeprecationWarning)]
     return ulog, notes
 
 
-def _damage_notes(ulog: _CountingULog, tracked: _TrackedFile, size: int) -> list[str]:
+def _damage_notes(ulog: _CountingULog, tracked: _TrackedFile, size: int, name: str) -> list[str]:
     """Sentences saying what pyulog skipped, from our counters, its flag and its dropouts."""
     notes = []
     if tracked.stalled_at is not None:
-        notes.append(f"pyulog lost its place in damaged data near byte {tracked.stalled_at} "
+        notes.append(f"{name}: pyulog lost its place in damaged data near byte {tracked.stalled_at} "
                      f"of {size}; the rest of the file was not read")
     if tracked.cut_at is not None:
-        notes.append(f"the file is truncated: it ends inside a message at byte {tracked.cut_at} "
+        notes.append(f"{name}: the file is truncated: it ends inside a message at byte {tracked.cut_at} "
                      f"of {size}; that last message was skipped")
     if tracked.zero_tail > _MAX_PAYLOAD:
         notes.append(f"the last {tracked.zero_tail} bytes of the file are zeros (space the logger "

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -14,12 +15,61 @@ import click
 
 from flightlogs.atomic import atomic_output
 
-__all__ = ["json_option", "emit_json", "progress_bar"]
+__all__ = ["OutputPath", "json_option", "emit_json", "progress_bar"]
+
+
+class OutputPath(click.Path):
+    """Click type of a path a command writes: its folder must exist, checked before any work (exit 2).
+
+    A file output must not be an existing folder; a folder output (which the
+    command creates) must not be an existing file. Either way its parent
+    folder must exist and be writable, so a typo fails at once instead of
+    after the work, and no other output of the command is written.
+
+    Parameters
+    ----------
+    folder : bool
+        The output is a folder rather than a file.
+    allow_dash : bool
+        Accept ``-`` (standard output) as it is.
+    path_type : type
+        What the value converts to: `Path` or `str`.
+
+    Examples
+    --------
+    >>> import click
+    >>> OutputPath().convert("x.json", None, None).name
+    'x.json'
+    >>> try:
+    ...     OutputPath().convert("nodir/x.json", None, None)
+    ... except click.BadParameter as err:
+    ...     print(err.message)
+    nodir/x.json: folder nodir does not exist
+    """
+
+    def __init__(self, *, folder: bool = False, allow_dash: bool = False, path_type: type = Path) -> None:
+        super().__init__(file_okay=not folder, dir_okay=folder, allow_dash=allow_dash, path_type=path_type)
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        """The path, once its folder is known to exist (click.BadParameter otherwise)."""
+        converted = super().convert(value, param, ctx)
+        if self.allow_dash and value in ("-", b"-"):
+            return converted
+        path = Path(os.fsdecode(converted))
+        parent = path.parent
+        if not parent.exists():
+            self.fail(f"{path}: folder {parent} does not exist", param, ctx)
+        if not parent.is_dir():
+            self.fail(f"{path}: {parent} is a file, not a folder", param, ctx)
+        if not os.access(parent, os.W_OK | os.X_OK):
+            self.fail(f"{path}: folder {parent} is not writable", param, ctx)
+        return converted
+
 
 json_option = click.option(
     "--json",
     "json_path",
-    type=click.Path(dir_okay=False, allow_dash=True, path_type=str),
+    type=OutputPath(allow_dash=True, path_type=str),
     default=None,
     help="Write a machine-readable summary to PATH ('-' for stdout).",
 )

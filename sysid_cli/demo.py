@@ -7,6 +7,8 @@ from pathlib import Path
 
 import click
 
+from ._common import OutputPath
+
 __all__ = ["demo"]
 
 _EPILOG = """\b
@@ -51,7 +53,7 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
 
 
 @click.command(epilog=_EPILOG)
-@click.option("-o", "--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+@click.option("-o", "--out", "out_dir", type=OutputPath(folder=True),
               default=Path("sysid-demo"), show_default=True, help="Folder for the demo's files.")
 @click.pass_context
 def demo(ctx: click.Context, out_dir: Path) -> None:

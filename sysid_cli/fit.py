@@ -8,7 +8,8 @@ from typing import Any
 
 import click
 
-from ._common import emit_json, json_option, progress_bar
+from ._common import OutputPath, emit_json, json_option, progress_bar
+from ._flights import check_sources, conditioned_flights
 from ._wind_options import (anemometer_at_option, transport_delay_option, wind_distance_option, wind_offset_option,
                             wind_option)
 
@@ -47,7 +48,8 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
 @transport_delay_option("Transport delay of the wind, s.")
 @wind_offset_option("Anemometer clock minus UTC, s.")
 @click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset by cross-correlation.")
-@click.option("--kind", default="sweep", show_default=True, help="Maneuvers to fit (sweep, 3211, multisine).")
+@click.option("--kind", default="sweep", show_default=True,
+              type=click.Choice(["sweep", "multisine", "3211", "doublet"]), help="Maneuvers to fit.")
 @click.option("--set", "initial", multiple=True, callback=parse_assignments, metavar="NAME=VALUE",
               help="Starting value of a parameter (repeatable).")
 @click.option("--trim", "constants", multiple=True, callback=parse_assignments, metavar="NAME=VALUE",
@@ -63,11 +65,11 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
               help="Also remove one of two parameters correlated beyond |R| (default: correlation not used).")
 @click.option("--min-coherence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.5,
               show_default=True, help="Gating threshold on the coherence (eq. 3.8).")
-@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("-o", "--out", type=OutputPath(),
               help="Write the identified model (versioned JSON).")
-@click.option("--mat", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("--mat", type=OutputPath(),
               help="Also write the model for MATLAB (.mat).")
-@click.option("--report", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("--report", type=OutputPath(),
               help="Write the HTML fit report.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no tables.")
@@ -90,14 +92,15 @@ def fit(logs: tuple[Path, ...], model_name: str, wind_paths: tuple[Path, ...], w
         fit=FitOptions(starts=starts, reduce=not no_reduce, max_cr_percent=max_cr,
                        max_insensitivity_percent=max_insensitivity, max_correlation=max_correlation),
         kind=kind, min_coherence=min_coherence, constants=constants or None, initial=initial or None)
+    dataset = check_sources(logs, {"--wind": wind_paths, "--wind-distance": wind_distance,
+                                   "--anemometer-at": anemometer_at, "--transport-delay": transport_delay,
+                                   "--wind-offset": wind_offset, "--estimate-wind-offset": estimate_wind_offset})
     with progress_bar("identifying", quiet=quiet) as bar:
         def progress(_stage: str, done: int, total: int) -> None:
             bar(done, total)
 
-        if all(p.suffix.lower() in (".h5", ".hdf5") for p in logs):
-            from flightlogs.store import read_dataset
-
-            flights = [f for p in logs for f in read_dataset(p).conditioned]
+        if dataset:
+            flights = conditioned_flights(logs, (), None, log_only={}, quiet=True)
             model = identify_flights(flights, structure, options=options, files=list(logs), progress=progress)
         else:
             conditioning = ConditioningOptions(

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
 import click
 
-from ._common import emit_json, json_option, progress_bar
+from ._common import OutputPath, emit_json, json_option
+from ._flights import conditioned_flights
 from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["freqresp"]
@@ -26,16 +28,23 @@ def _floats(_ctx: click.Context, _param: click.Parameter, value: str | None) -> 
     if not value:
         return None
     try:
-        return tuple(float(part) for part in value.split(","))
+        lengths = tuple(float(part) for part in value.split(","))
     except ValueError:
         raise click.BadParameter(f"{value!r} is not a comma-separated list of seconds (e.g. 2,4,8,12,17)") from None
+    bad = [part.strip() for part, length in zip(value.split(","), lengths)
+           if not (math.isfinite(length) and length > 0)]
+    if bad:
+        raise click.BadParameter(f"{', '.join(bad)}: window lengths must be positive seconds (e.g. 2,4,8,12,17)")
+    return lengths
 
 
 def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> tuple[tuple[str, str], ...] | None:
     from sysid.freqresp import parse_pairs
 
-    if not value:
+    if value is None:
         return None
+    if not value.strip(" ,"):
+        raise click.BadParameter("empty: give OUTPUT/INPUT pairs, e.g. q/delta_lon,theta/delta_lon")
     try:
         return parse_pairs(value)
     except ValueError as err:
@@ -76,9 +85,9 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
 @click.option("--whole-record/--no-whole-record", default=True, show_default=True,
               help="Add the records' whole-length transforms to the composite (free of the windows' resolution "
                    "bias; needs more maneuver pieces than inputs).")
-@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("-o", "--out", type=OutputPath(),
               help="Write the responses (fit range set on those kept) to this HDF5 file.")
-@click.option("--plot", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("--plot", type=OutputPath(),
               help="Write Bode and coherence plots to this SVG file.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
@@ -93,13 +102,21 @@ def freqresp(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_dista
     from sysid.freqresp import ResponseOptions, flight_responses, gate_responses, write_responses
 
     forced = None if reference in ("auto", "none") else reference
+    if omega_min >= omega_max:
+        raise click.BadParameter(f"{omega_min:g} rad/s must be below --omega-max ({omega_max:g} rad/s)",
+                                 param_hint="'--omega-min'")
     try:
         options = ResponseOptions(omega_min=omega_min, omega_max=omega_max, n_freq=n_freq, window_lengths_s=windows,
                                   overlap=overlap, min_coherence=min_coherence, min_decades=min_decades,
                                   reference=forced, whole_record=whole_record)
     except ValueError as err:
         raise click.UsageError(str(err)) from None
-    flights = _flights(sources, wind_paths, wind_distance, wind_offset, quiet=quiet)
+    from flightlogs.condition import ConditioningOptions
+
+    flights = conditioned_flights(sources, wind_paths,
+                                  ConditioningOptions(wind_distance_m=wind_distance, wind_offset_s=wind_offset),
+                                  log_only={"--wind": wind_paths, "--wind-distance": wind_distance,
+                                            "--wind-offset": wind_offset}, quiet=quiet)
     computed = flight_responses(flights, pairs, axis=axis, kind=kind, options=options,
                                 use_excitation=reference != "none")
     gated = gate_responses(computed.responses, min_coherence=min_coherence, min_decades=min_decades)
@@ -116,32 +133,6 @@ def freqresp(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_dista
     if not quiet:
         _print_summary(summary, to_stderr=json_path == "-")
     emit_json(summary, json_path)
-
-
-def _flights(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_distance: float | None,
-             wind_offset: float | None, *, quiet: bool) -> list[Any]:
-    from flightlogs.condition import ConditioningOptions
-    from flightlogs.errors import DataError
-
-    datasets = [p for p in sources if p.suffix.lower() in (".h5", ".hdf5")]
-    if datasets and len(datasets) != len(sources):
-        raise click.UsageError("give either datasets (.h5 from `sysid ingest -o`) or logs, not both")
-    if datasets:
-        from flightlogs.store import read_dataset
-
-        if wind_paths or wind_distance is not None or wind_offset is not None:
-            raise click.UsageError("--wind options go with logs; a dataset already holds its aligned wind")
-        flights = [flight for path in datasets for flight in read_dataset(path).conditioned]
-        if not flights:
-            raise DataError(f"{', '.join(p.name for p in datasets)}: no conditioned flight in the dataset")
-        return flights
-    from flightlogs.campaign import ingest_campaign
-
-    with progress_bar("reading", quiet=quiet) as bar:
-        campaign = ingest_campaign(list(sources), list(wind_paths),
-                                   options=ConditioningOptions(wind_distance_m=wind_distance, wind_offset_s=wind_offset),
-                                   progress=lambda _n, done, total: bar(done, total))
-    return list(campaign.require_flights())
 
 
 def _summary(responses: list[Any], dropped: tuple[Any, ...], pieces: dict[str, int], options: Any,

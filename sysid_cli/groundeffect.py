@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import click
 
-from ._common import emit_json, json_option, progress_bar
+from ._common import OutputPath, emit_json, json_option, progress_bar
 from .ingest import parse_columns
 
 __all__ = ["ground_effect"]
@@ -48,12 +49,14 @@ def _float_list(_ctx: click.Context, _param: click.Parameter, value: str | None)
 def _models(_ctx: click.Context, _param: click.Parameter, value: str | None) -> tuple[str, ...] | None:
     from sysid.groundeffect import MODEL_NAMES
 
-    if not value:
+    if value is None:
         return None
     names = tuple(part.strip() for part in value.split(",") if part.strip())
+    if not names:
+        raise click.BadParameter(f"empty: choose one or more of {', '.join(MODEL_NAMES)}")
     unknown = [n for n in names if n not in MODEL_NAMES]
-    if unknown or not names:
-        raise click.BadParameter(f"{', '.join(unknown) or repr(value)}: choose from {', '.join(MODEL_NAMES)}")
+    if unknown:
+        raise click.BadParameter(f"{', '.join(unknown)}: choose from {', '.join(MODEL_NAMES)}")
     return names
 
 
@@ -115,9 +118,9 @@ def ground_effect() -> None:
 @ground_effect.command("fit", epilog=_FIT_EPILOG)
 @click.argument("data", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @_data_options
-@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("-o", "--out", type=OutputPath(),
               help="Write the chosen model (and the fit summary) as JSON, for `sysid mrac compare --ground-effect`.")
-@click.option("--report", type=click.Path(dir_okay=False, writable=True, path_type=Path), help="Write an HTML report.")
+@click.option("--report", type=OutputPath(), help="Write an HTML report.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
 def fit(data: Path, out: Path | None, report: Path | None, json_path: str | None, quiet: bool, **kw: Any) -> None:
@@ -152,7 +155,7 @@ def fit(data: Path, out: Path | None, report: Path | None, json_path: str | None
 @click.option("--rotors", type=click.IntRange(min=2), default=4, show_default=True,
               help="Rotors running: 2 reports rho of eq. 2.2; more compares piecewise linear with eq. 2.2.")
 @_data_options
-@click.option("--report", type=click.Path(dir_okay=False, writable=True, path_type=Path), help="Write an HTML report.")
+@click.option("--report", type=OutputPath(), help="Write an HTML report.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
 def spacing(data: tuple[Path, ...], spacing_mm: list[float], rotors: int, report: Path | None,
@@ -163,8 +166,7 @@ def spacing(data: tuple[Path, ...], spacing_mm: list[float], rotors: int, report
     per spacing (Table 2.2), with more the two families are compared (Table 2.3)."""
     from sysid.groundeffect import load_thrust_ratio, spacing_study, spacing_summary
 
-    if len(spacing_mm) != len(data):
-        raise click.BadParameter(f"{len(data)} files but {len(spacing_mm)} spacings", param_hint="--spacing")
+    _check_spacings(spacing_mm, data)
     data_config, fit_config = _configs(kw)
     with progress_bar("fitting", quiet=quiet) as bar:
         datasets = [load_thrust_ratio(path, data_config) for path in data]
@@ -179,6 +181,21 @@ def spacing(data: tuple[Path, ...], spacing_mm: list[float], rotors: int, report
     if not quiet:
         _print_spacing(summary, to_stderr=json_path == "-")
     emit_json(summary, json_path)
+
+
+def _check_spacings(spacing_mm: list[float], data: tuple[Path, ...]) -> None:
+    """Usage error (naming --spacing, in mm) unless there is one distinct, non-negative spacing per file."""
+    if len(data) < 2:
+        raise click.UsageError("a spacing study compares at least two DATA files, one per spacing")
+    if len(spacing_mm) != len(data):
+        raise click.BadParameter(f"{len(data)} files but {len(spacing_mm)} spacings", param_hint="'--spacing'")
+    bad = [s for s in spacing_mm if not (math.isfinite(s) and s >= 0)]
+    if bad:
+        raise click.BadParameter(f"{bad[0]:g} mm: spacings must be finite and not negative", param_hint="'--spacing'")
+    repeated = sorted({s for s in spacing_mm if spacing_mm.count(s) > 1})
+    if repeated:
+        raise click.BadParameter(f"{', '.join(f'{s:g}' for s in repeated)} mm given twice: each DATA file needs its "
+                                 "own spacing", param_hint="'--spacing'")
 
 
 def _print_fit(summary: dict[str, Any], *, to_stderr: bool) -> None:

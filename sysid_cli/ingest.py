@@ -8,7 +8,7 @@ from typing import Any
 
 import click
 
-from ._common import emit_json, json_option, progress_bar
+from ._common import OutputPath, emit_json, json_option, progress_bar
 from ._wind_options import (anemometer_at_option, parse_position, segments_from, segments_option,
                             transport_delay_option, wind_distance_option, wind_offset_option, wind_option)
 
@@ -37,10 +37,27 @@ def parse_columns(_ctx: click.Context, _param: click.Parameter, value: str | Non
     return mapping
 
 
+def _wind_columns(ctx: click.Context, param: click.Parameter, value: str | None) -> dict[str, str] | None:
+    """:func:`parse_columns`, keeping to the anemometer's keys (time, date, speed, direction, u, v, w)."""
+    from flightlogs.anemometer import COLUMN_SYNONYMS
+
+    mapping = parse_columns(ctx, param, value)
+    unknown = sorted(set(mapping or {}) - set(COLUMN_SYNONYMS))
+    if unknown:
+        raise click.BadParameter(
+            f"{', '.join(unknown)}: not a column key; use --columns "
+            + ",".join(f"{key}=COL" for key in COLUMN_SYNONYMS))
+    return mapping
+
+
+#: Highest ``--rate``, Hz: above any autopilot's logging rate, and a bound on the time base's memory.
+_MAX_RATE_HZ = 10_000.0
+
+
 @click.command(epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @wind_option("Anemometer CSV, or a folder of them (repeatable); each log takes the file overlapping it in UTC.")
-@click.option("--columns", callback=parse_columns,
+@click.option("--columns", callback=_wind_columns,
               help="Override anemometer column detection: time=,speed=,direction= or time=,u=,v=.")
 @wind_distance_option()
 @click.option("--wind-bearing", type=float, metavar="DEG",
@@ -53,10 +70,10 @@ def parse_columns(_ctx: click.Context, _param: click.Parameter, value: str | Non
               help="Correct the clock offset by cross-correlating the wind with the vehicle's response.")
 @click.option("--estimate-transport-delay", is_flag=True,
               help="Find the transport delay by that cross-correlation instead (trusting the clock offset).")
-@click.option("--rate", "rate_hz", type=click.FloatRange(min=0, min_open=True), metavar="HZ",
-              help="Rate of the common time base (default: the fastest core signal's).")
+@click.option("--rate", "rate_hz", type=click.FloatRange(min=0, min_open=True, max=_MAX_RATE_HZ), metavar="HZ",
+              help="Rate of the common time base, up to 10 kHz (default: the fastest core signal's).")
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
-@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("-o", "--out", type=OutputPath(),
               help="Write signals, records and segments to this HDF5 dataset.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
@@ -84,6 +101,7 @@ def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[s
     with progress_bar("reading", quiet=quiet) as bar:
         campaign = ingest_campaign(list(logs), list(wind_paths), columns=columns, options=options,
                                    progress=lambda _name, done, total: bar(done, total))
+    campaign.require_flights()  # nothing written when no log could be conditioned; some: warned below
     if out is not None:
         write_dataset(out, campaign.logs, campaign.winds, list(campaign.flights))
     summary = _summary(campaign, out)

@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from ._common import emit_json, json_option, progress_bar
+from ._common import OutputPath, emit_json, json_option, progress_bar
 
 __all__ = ["mrac"]
 
@@ -67,9 +67,9 @@ def mrac() -> None:
 @click.option("--ground-effect", "ground_effect_path", type=click.Path(exists=True, dir_okay=False, path_type=Path),
               help="A fitted ground-effect model (JSON from 'sysid ground-effect fit -o') acting on the vehicle "
                    "instead of eq. 2.5.")
-@click.option("--report", "report_path", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--report", "report_path", type=OutputPath(),
               help="Write the HTML report here.")
-@click.option("-o", "--out", "out_path", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("-o", "--out", "out_path", type=OutputPath(),
               help="Write the results (summary and every trial's indices) as JSON here.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")

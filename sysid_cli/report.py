@@ -9,7 +9,7 @@ from typing import Any
 
 import click
 
-from ._common import emit_json, json_option
+from ._common import OutputPath, emit_json, json_option
 
 __all__ = ["report", "ingest_card"]
 
@@ -77,7 +77,7 @@ def _read_json(path: Path) -> Any:
 @click.argument("model_path", metavar="MODEL.json", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.argument("validation_path", metavar="[VALIDATION.json]", required=False,
                 type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("-o", "--out", type=OutputPath(),
               help="HTML report to write (default: MODEL with .html).")
 @click.option("--ingest-summary", "ingest_path", type=click.Path(exists=True, dir_okay=False, path_type=Path),
               help="What 'sysid ingest --json' wrote: adds the vehicle, the flight and the wind alignment.")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from ._common import emit_json, json_option, progress_bar
+from ._common import OutputPath, emit_json, json_option, progress_bar
 
 __all__ = ["simulate"]
 
@@ -25,18 +25,31 @@ def _trial_range(_ctx: click.Context, _param: click.Parameter, value: str | None
     for part in value.split(","):
         first, sep, last = part.partition("-")
         try:
-            picked.extend(range(int(first), int(last) + 1) if sep else [int(first)])
+            low, high = (int(first), int(last)) if sep else (int(first), int(first))
         except ValueError:
             raise click.BadParameter(f"{part!r} is not a trial number or range like 0-3") from None
+        if low > high:
+            raise click.BadParameter(f"{part!r} is a reversed range: write {high}-{low}")
+        picked.extend(range(low, high + 1))
     return picked
+
+
+def _check_trials(trials: list[int] | None, n_trials: int, name: str) -> None:
+    """Usage error unless every picked trial index is one of the scenario's (0 to n_trials - 1)."""
+    outside = sorted({t for t in trials or [] if not 0 <= t < n_trials})
+    if outside:
+        valid = "0" if n_trials == 1 else f"0-{n_trials - 1}"
+        raise click.BadParameter(
+            f"{', '.join(map(str, outside))}: scenario {name} has trials {valid} only", param_hint="--trials")
 
 
 @click.command(epilog=_EPILOG)
 @click.argument("scenario", required=False)
-@click.option("-o", "--out", "out_dir", type=click.Path(file_okay=False, path_type=Path), default=None,
+@click.option("-o", "--out", "out_dir", type=OutputPath(folder=True), default=None,
               help="Folder for the logs, anemometer files, truth and campaign.json (default: the scenario name).")
 @click.option("--list", "list_only", is_flag=True, help="List the built-in scenarios and exit.")
-@click.option("--trials", callback=_trial_range, help="Only these trials, e.g. 0-3,7.")
+@click.option("--trials", callback=_trial_range,
+              help="Only these trials, e.g. 0-3,7 (numbered from 0, as `--json` lists them).")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")
 def simulate(scenario: str | None, out_dir: Path | None, list_only: bool, trials: list[int] | None,
@@ -53,6 +66,7 @@ def simulate(scenario: str | None, out_dir: Path | None, list_only: bool, trials
     if scenario is None:
         raise click.UsageError("give a SCENARIO (a built-in name or a .toml file), or --list")
     plan = read_scenario(scenario) if scenario.endswith(".toml") else load_builtin(scenario)
+    _check_trials(trials, plan.n_trials, plan.name)
     folder = out_dir if out_dir is not None else Path(plan.name)
     with progress_bar(f"simulating {plan.name}", quiet=quiet) as bar:
         written = run_scenario(plan, folder, progress=bar, trials=trials)

@@ -8,7 +8,8 @@ from typing import Any
 
 import click
 
-from ._common import emit_json, json_option, progress_bar
+from ._common import OutputPath, emit_json, json_option
+from ._flights import conditioned_flights, is_dataset
 from ._wind_options import (segments_from, segments_option, transport_delay_option, wind_distance_option,
                             wind_offset_option, wind_option)
 
@@ -38,9 +39,9 @@ Examples:
 @click.option("--initial-state", type=click.Choice(["measured", "estimated", "zero"]), default="measured",
               show_default=True, help="Start each simulation from the measured states, from those corrected by "
                                       "least squares, or from zero.")
-@click.option("-o", "--out", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("-o", "--out", type=OutputPath(),
               help="Save the verification with its time histories (JSON) for 'sysid report'.")
-@click.option("--report", type=click.Path(dir_okay=False, writable=True, path_type=Path),
+@click.option("--report", type=OutputPath(),
               help="Write the HTML model report, with this verification, here.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
@@ -48,7 +49,8 @@ def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, .
              transport_delay: float | None, wind_offset: float | None, segments_file: Path | None, before_s: float,
              after_s: float, initial_state: str, out: Path | None, report: Path | None, json_path: str | None,
              quiet: bool) -> None:
-    """Simulate MODEL.json from all the measured inputs of every doublet in LOGS and report the RMS error and
+    """Simulate MODEL.json from all the measured inputs of every doublet in LOGS (flight logs, or HDF5 datasets
+    written by ``sysid ingest -o``) and report the RMS error and
     Theil inequality coefficient per output (with bias and reference shift estimated, as VERIFY does), judging
     each doublet on the outputs of the axis it excites; with --wind, also how much the wind term G_w reduces
     the error."""
@@ -57,25 +59,21 @@ def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, .
     from flightlogs.condition import ConditioningOptions
     from reports.model_report import write_model_report
     from sysid.fit import read_model
-    from sysid.verify import VerificationOptions, axis_outputs, verify_logs
     from sysid.verify_io import write_verification
 
     identified = read_model(model_path)
-    model = identified.linear_model(include_wind=False)
-    with_wind = identified.linear_model(include_wind=True)
-    has_wind = with_wind.inputs != model.inputs
-    notes = []
-    if has_wind and not wind_paths:
-        notes.append("the model's wind term is not verified: no anemometer file was given (--wind)")
+    segments = segments_from(segments_file)
     conditioning = ConditioningOptions(
         wind_offset_s=wind_offset, wind_distance_m=wind_distance, transport_delay_s=transport_delay,
-        segments=segments_from(segments_file))
-    options = VerificationOptions(initial_state=initial_state)  # type: ignore[arg-type]
-    with progress_bar("reading", quiet=quiet) as bar:
-        verification = verify_logs(model, list(logs), wind_model=with_wind if has_wind and wind_paths else None,
-                                   wind_paths=list(wind_paths), axes=axis_outputs(identified),
-                                   conditioning=conditioning, options=options, before_s=before_s, after_s=after_s,
-                                   progress=lambda _name, done, total: bar(done, total))
+        segments=segments)
+    log_only = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset,
+                "--transport-delay": transport_delay, "--segments": segments_file}
+    flights = conditioned_flights(logs, wind_paths, conditioning, log_only=log_only, quiet=quiet)
+    if segments_file is not None and segments is not None:
+        _check_segments(segments_file, segments, flights)
+    verification, notes = _verify(identified, flights, dataset=is_dataset(logs[0]), with_wind_files=bool(wind_paths),
+                                  segments_given=segments_file is not None, before_s=before_s, after_s=after_s,
+                                  initial_state=initial_state)
     saved = {"initial_state": initial_state, "before_s": before_s, "after_s": after_s,
              "inputs": "all measured", "judged": "on-axis outputs of each doublet's axis",
              "logs": [p.name for p in logs], "wind": [p.name for p in wind_paths]}
@@ -88,6 +86,60 @@ def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, .
     if not quiet:
         _print(summary, to_stderr=json_path == "-")
     emit_json(summary, json_path)
+
+
+def _verify(identified: Any, flights: list[Any], *, dataset: bool, with_wind_files: bool, segments_given: bool,
+            before_s: float, after_s: float, initial_state: str) -> tuple[Any, list[str]]:
+    """Verify the model on the flights' doublets, with its wind term where the flights carry the wind."""
+    from sysid.verify import VerificationOptions, axis_outputs, verify_flights
+
+    model = identified.linear_model(include_wind=False)
+    with_wind = identified.linear_model(include_wind=True)
+    wind_inputs = {name for name in with_wind.inputs if name not in model.inputs}
+    signals = {name for flight in flights for record in flight.records for name in record.signals}
+    use_wind = bool(wind_inputs) and (wind_inputs <= signals if dataset else with_wind_files)
+    notes = []
+    if wind_inputs and not use_wind:
+        notes.append("the model's wind term is not verified: " + (
+            "the dataset holds no aligned wind (ingest it with --wind)" if dataset
+            else "no anemometer file was given (--wind)"))
+    hint = ("" if segments_given else "give their times to `sysid ingest --segments`" if dataset
+            else "give their times with --segments if they were not detected")
+    verification = verify_flights(model, flights, wind_model=with_wind if use_wind else None,
+                                  axes=axis_outputs(identified), before_s=before_s, after_s=after_s, hint=hint,
+                                  options=VerificationOptions(initial_state=initial_state))  # type: ignore[arg-type]
+    return verification, notes
+
+
+def _check_segments(path: Path, segments: Any, flights: list[Any]) -> None:
+    """DataError naming the first doublet of `path` that starts outside every flight's records."""
+    from flightlogs.errors import DataError
+
+    for segment in segments:
+        if segment.kind != "doublet" or segment.axis is None:
+            continue
+        if any(r.start_s <= segment.start_s <= r.end_s for f in flights for r in f.records):
+            continue
+        spans = "; ".join(f"{f.source.name} {min(r.start_s for r in f.records):.1f}-"
+                          f"{max(r.end_s for r in f.records):.1f} s" for f in flights if f.records)
+        line = _line_of(path, segment.start_s, segment.end_s)
+        where = f"{path}" + (f" line {line}" if line else "")
+        raise DataError(f"{where}: the {segment.axis} doublet at {segment.start_s:g}-{segment.end_s:g} s starts "
+                        f"outside every log's records ({spans})")
+
+
+def _line_of(path: Path, start_s: float, end_s: float) -> int | None:
+    """The CSV line (from 1) whose first two fields are `start_s`, `end_s`, if there is one."""
+    if path.suffix.lower() != ".csv":
+        return None
+    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+        fields = line.split(",")
+        try:
+            if len(fields) >= 2 and (float(fields[0]), float(fields[1])) == (start_s, end_s):
+                return number
+        except ValueError:
+            continue
+    return None
 
 
 def _summary(verification: Any, model_path: Path, logs: tuple[Path, ...], report: Path | None,

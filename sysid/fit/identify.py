@@ -163,10 +163,13 @@ def identify_flights(
     Raises
     ------
     FitError
-        If no sweep gives a response that passes gating.
+        If there is no flight, or no sweep gives a response that passes gating; naming the files.
+    ModelError
+        If ``options.constants`` names a constant the structure has no trim constant for.
     """
     if isinstance(structure, str):
         structure = load_structure(structure)
+    structure.check_constants(options.constants or {})
     used: dict[str, list[Record]] = {}
     responses: list[FrequencyResponse] = []
     notes: list[str] = []
@@ -177,8 +180,12 @@ def identify_flights(
             used[axis] = records
             responses += _axis_responses(structure, records, axis, options, notes)
     if not responses:
-        names = ", ".join(f.source.name for f in flights) or "no flight"
-        raise FitError(f"no {options.kind} in {names} gives a response the model {structure.name} can be fitted to")
+        given = ", ".join(Path(f).name for f in files) or "the data given"
+        if not flights:
+            raise FitError(f"{given}: no flight to fit the model {structure.name} to")
+        names = ", ".join(f.source.name for f in flights)
+        raise FitError(f"{given}: no {options.kind} in flight {names} gives a response the model "
+                       f"{structure.name} can be fitted to")
     gated = gate_responses(responses, min_coherence=options.min_coherence, min_decades=options.min_decades)
     notes += [d.reason for d in gated.dropped]
     if not gated.kept:

@@ -7,6 +7,7 @@ outside Python. NaN is written as ``null``. Files are written atomically.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -19,7 +20,6 @@ from flightlogs.errors import ModelError
 
 from .._json import finite_or_none as _num
 from .._json import float_array as _vector
-from .._json import float_or_nan as _float
 from .._json import json_floats as _array
 from .._json import read_json_object, write_json
 from ..freqresp import FrequencyResponse
@@ -90,15 +90,141 @@ def _response_to_dict(r: FrequencyResponse) -> dict[str, Any]:
             "reference": r.reference, "whole_record": r.whole_record}
 
 
-def _response_from_dict(d: Mapping[str, Any]) -> FrequencyResponse:
-    fit_range = d.get("fit_range")
-    return FrequencyResponse(
-        d["input"], d["output"], _vector(d["omega"]), _vector(d["response_real"]) + 1j * _vector(d["response_imag"]),
-        _vector(d["coherence"]), _vector(d["random_error"]), _vector(d["input_autospectrum"]),
-        _vector(d["output_autospectrum"]), _vector(d["cross_spectrum_real"]) + 1j * _vector(d["cross_spectrum_imag"]),
-        tuple(float(v) for v in d["windows_s"]), tuple(d.get("conditioned_on", ())), d.get("input_unit", ""),
-        d.get("output_unit", ""), None if fit_range is None else (float(fit_range[0]), float(fit_range[1])),
-        reference=d.get("reference"), whole_record=bool(d.get("whole_record", False)))
+_REQUIRED: Any = object()
+_KINDS = {dict: "an object", list: "a list", str: "text", int: "a whole number", bool: "true or false"}
+
+
+class _Fields:
+    """Reads a model document field by field; a missing or bad field raises a ModelError naming file and field."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, message: str) -> ModelError:
+        return ModelError(f"{self.source}: {message}")
+
+    def get(self, parent: Mapping[str, Any], key: str, where: str, kind: type, default: Any = _REQUIRED) -> Any:
+        if key not in parent:
+            if default is _REQUIRED:
+                raise self.fail(f"{where} has no {key}")
+            return default
+        return self.check(parent[key], f"{where}: {key}", kind)
+
+    def check(self, value: Any, what: str, kind: type) -> Any:
+        if not isinstance(value, kind) or (isinstance(value, bool) and kind is int):
+            raise self.fail(f"{what} is {_show(value)}, not {_KINDS[kind]}")
+        return value
+
+    def number(self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False) -> float:
+        value = self.get(parent, key, where, object)
+        if value is None:
+            if finite:
+                raise self.fail(f"{where}: {key} is null, not a finite number")
+            return math.nan
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(f"{where}: {key} is {_show(value)}, not a number")
+        if finite and not math.isfinite(value):
+            raise self.fail(f"{where}: {key} is {_show(value)}, not a finite number")
+        return float(value)
+
+    def numbers(self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False) -> np.ndarray:
+        values = self.get(parent, key, where, list)
+        bad = [v for v in values if (isinstance(v, bool) or not isinstance(v, (int, float))) and v is not None]
+        if bad:
+            raise self.fail(f"{where}: {key} holds {_show(bad[0])}, not a number")
+        out = _vector(values)
+        if finite and not np.all(np.isfinite(out)):
+            raise self.fail(f"{where}: {key} holds a missing or non-finite value")
+        return out
+
+    def table(self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False) -> dict[str, float]:
+        table = self.get(parent, key, where, dict, {})
+        label = key if where == "the file" else f"{where} {key}"
+        return {k: self.number(table, k, label, finite=finite) for k in table}
+
+
+def _show(value: Any) -> str:
+    text = "null" if value is None else repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _response_from_dict(d: Mapping[str, Any], f: _Fields, where: str) -> FrequencyResponse:
+    d = f.check(d, where, dict)
+    fit_range = f.get(d, "fit_range", where, object, None)
+    if fit_range is not None:
+        fit_range = f.numbers(d, "fit_range", where, finite=True)
+        if fit_range.size != 2:
+            raise f.fail(f"{where}: fit_range must hold two numbers")
+    windows = f.numbers(d, "windows_s", where, finite=True)
+    try:
+        return FrequencyResponse(
+            f.get(d, "input", where, str), f.get(d, "output", where, str), f.numbers(d, "omega", where),
+            f.numbers(d, "response_real", where) + 1j * f.numbers(d, "response_imag", where),
+            f.numbers(d, "coherence", where), f.numbers(d, "random_error", where),
+            f.numbers(d, "input_autospectrum", where), f.numbers(d, "output_autospectrum", where),
+            f.numbers(d, "cross_spectrum_real", where) + 1j * f.numbers(d, "cross_spectrum_imag", where),
+            tuple(float(v) for v in windows), tuple(f.get(d, "conditioned_on", where, list, [])),
+            f.get(d, "input_unit", where, str, ""), f.get(d, "output_unit", where, str, ""),
+            None if fit_range is None else (float(fit_range[0]), float(fit_range[1])),
+            reference=f.get(d, "reference", where, object, None),
+            whole_record=bool(f.get(d, "whole_record", where, bool, False)))
+    except (TypeError, ValueError) as err:
+        raise f.fail(f"{where} is inconsistent: {err}") from None
+
+
+def _parameters(doc: Mapping[str, Any], f: _Fields) -> tuple[ParameterEstimate, ...]:
+    out = []
+    for name, p in f.get(doc, "parameters", "the file", dict).items():
+        where = f"parameter {name}"
+        p = f.check(p, where, dict)
+        status, stage = f.get(p, "status", where, str), f.get(p, "stage", where, str, "frequency")
+        if status not in ("estimated", "fixed", "dropped"):
+            raise f.fail(f"{where}: status is {status!r}, not estimated, fixed or dropped")
+        if stage not in ("frequency", "wind"):
+            raise f.fail(f"{where}: stage is {stage!r}, not frequency or wind")
+        out.append(ParameterEstimate(name, f.number(p, "value", where, finite=True), f.number(p, "cr_percent", where),
+                                     f.number(p, "insensitivity_percent", where), status,  # type: ignore[arg-type]
+                                     f.get(p, "unit", where, str, ""), stage))  # type: ignore[arg-type]
+    return tuple(out)
+
+
+def _correlation(doc: Mapping[str, Any], f: _Fields) -> tuple[tuple[str, ...], np.ndarray]:
+    section = f.get(doc, "correlation", "the file", dict)
+    names = tuple(f.get(section, "names", "correlation", list))
+    rows = f.get(section, "matrix", "correlation", list)
+    if len(rows) != len(names):
+        raise f.fail(f"correlation: matrix has {len(rows)} rows for {len(names)} names")
+    matrix = [f.numbers({f"row {k + 1}": row}, f"row {k + 1}", "correlation matrix") for k, row in enumerate(rows)]
+    if any(row.size != len(names) for row in matrix):
+        raise f.fail(f"correlation: matrix is not {len(names)} by {len(names)}")
+    return names, np.array(matrix, dtype=float).reshape(len(names), len(names))
+
+
+def _reduction(doc: Mapping[str, Any], f: _Fields) -> tuple[ReductionStep, ...]:
+    steps = []
+    for k, s in enumerate(f.get(doc, "reduction", "the file", list)):
+        where = f"reduction step {k + 1}"
+        s = f.check(s, where, dict)
+        n = {key: f.number(s, key, where) for key in ("value", "estimate", "cr_percent", "insensitivity_percent",
+                                                      "cost_average", "cost_average_after")}
+        steps.append(ReductionStep(f.get(s, "step", where, int), f.get(s, "parameter", where, str),
+                                   f.get(s, "action", where, str), n["value"], n["estimate"], n["cr_percent"],
+                                   n["insensitivity_percent"], f.get(s, "reason", where, str), n["cost_average"],
+                                   n["cost_average_after"]))
+    return tuple(steps)
+
+
+def _wind(doc: Mapping[str, Any], f: _Fields) -> WindFit | None:
+    wind = f.get(doc, "wind", "the file", object, None)
+    if wind is None:
+        return None
+    wind = f.get(doc, "wind", "the file", dict)
+    outputs = tuple(f.get(wind, "outputs", "wind", list))
+    before, after = f.numbers(wind, "rms_before", "wind"), f.numbers(wind, "rms_after", "wind")
+    if not len(outputs) == len(before) == len(after):
+        raise f.fail("wind: outputs, rms_before and rms_after differ in length")
+    return WindFit(outputs, tuple(float(v) for v in before), tuple(float(v) for v in after),
+                   f.get(wind, "samples", "wind", int))
 
 
 def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> IdentifiedModel:
@@ -114,40 +240,64 @@ def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Identi
     Raises
     ------
     ModelError
-        If the document is not an identified model of a known schema version.
+        If the document is not an identified model of a known schema version, or a field is missing, of the
+        wrong type or (for parameter values and trim constants) not finite; the message names `source` and
+        the field.
     """
-    if doc.get("schema") != SCHEMA:
-        raise ModelError(f"{source}: not a flight-sysid model file (schema {doc.get('schema')!r})")
+    schema = doc.get("schema")
+    if schema is None:
+        raise ModelError(f"{source}: not a flight-sysid model file (it has no schema field)")
+    if schema != SCHEMA:
+        raise ModelError(f"{source}: not a flight-sysid model file (it is a {_show(schema)} file, "
+                         f"not {SCHEMA!r})")
     if doc.get("schema_version") != SCHEMA_VERSION:
-        raise ModelError(f"{source}: model schema version {doc.get('schema_version')!r} is not supported "
+        raise ModelError(f"{source}: model schema version {_show(doc.get('schema_version'))} is not supported "
                          f"(this version reads {SCHEMA_VERSION})")
+    f = _Fields(source)
+    head = f.get(doc, "structure", "the file", dict)
+    cost = f.get(doc, "cost", "the file", dict)
+    prov = f.get(doc, "provenance", "the file", dict, {})
+    names, matrix = _correlation(doc, f)
     try:
-        parameters = tuple(ParameterEstimate(name, _float(p["value"]), _float(p["cr_percent"]),
-                                             _float(p["insensitivity_percent"]), p["status"], p.get("unit", ""),
-                                             p.get("stage", "frequency")) for name, p in doc["parameters"].items())
-        names = tuple(doc["correlation"]["names"])
-        matrix = np.array([[_float(v) for v in row] for row in doc["correlation"]["matrix"]]).reshape(len(names),
-                                                                                                      len(names))
-        reduction = tuple(ReductionStep(s["step"], s["parameter"], s["action"], _float(s["value"]),
-                                        _float(s["estimate"]), _float(s["cr_percent"]),
-                                        _float(s["insensitivity_percent"]), s["reason"], _float(s["cost_average"]),
-                                        _float(s["cost_average_after"])) for s in doc["reduction"])
-        wind = doc.get("wind")
-        prov = doc.get("provenance", {})
-        return IdentifiedModel(
-            doc["structure"]["name"], doc["structure"]["text"], parameters, names, matrix,
-            CostSummary(_float(doc["cost"]["average"]), {k: _float(v) for k, v in doc["cost"]["responses"].items()}),
-            tuple(_response_from_dict(r) for r in doc.get("responses", [])),
-            {k: _float(v) for k, v in doc.get("trim", {}).items()},
-            {k: _float(v) for k, v in doc.get("constants", {}).items()}, reduction,
-            Provenance(tuple(prov.get("files", ())), prov.get("sha256", {}), prov.get("options", {}),
-                       prov.get("versions", {}), prov.get("created_utc", "")),
-            None if wind is None else WindFit(tuple(wind["outputs"]), tuple(_float(v) for v in wind["rms_before"]),
-                                              tuple(_float(v) for v in wind["rms_after"]), int(wind["samples"])),
-            dict(doc.get("input_units", {})), tuple(doc.get("notes", ())),
+        model = IdentifiedModel(
+            f.get(head, "name", "structure", str), f.get(head, "text", "structure", str), _parameters(doc, f),
+            names, matrix, CostSummary(f.number(cost, "average", "cost"), f.table(cost, "responses", "cost")),
+            tuple(_response_from_dict(r, f, f"response {k + 1}")
+                  for k, r in enumerate(f.get(doc, "responses", "the file", list, []))),
+            f.table(doc, "trim", "the file"), f.table(doc, "constants", "the file", finite=True),
+            _reduction(doc, f),
+            Provenance(tuple(f.get(prov, "files", "provenance", list, [])),
+                       f.get(prov, "sha256", "provenance", dict, {}), f.get(prov, "options", "provenance", dict, {}),
+                       f.get(prov, "versions", "provenance", dict, {}),
+                       f.get(prov, "created_utc", "provenance", str, "")),
+            _wind(doc, f), dict(f.get(doc, "input_units", "the file", dict, {})),
+            tuple(f.get(doc, "notes", "the file", list, [])),
         )
-    except (KeyError, TypeError, ValueError) as err:
-        raise ModelError(f"{source}: model file is incomplete or damaged ({type(err).__name__}: {err})") from None
+    except (TypeError, ValueError) as err:
+        if isinstance(err, ModelError):
+            raise
+        raise ModelError(f"{source}: model file is inconsistent: {err}") from None
+    _check_structure(model, f)
+    return model
+
+
+def _check_structure(model: IdentifiedModel, f: _Fields) -> None:
+    """The structure parses, every parameter it reads has a value and the matrices assemble."""
+    try:
+        structure = model.structure
+    except ModelError as err:
+        raise f.fail(f"the structure text does not read: {err}") from None
+    have = {p.name for p in model.parameters}
+    missing = [n for n in structure.parameter_names if n not in have]
+    if missing:
+        raise f.fail(f"parameter {', '.join(missing)} of structure {structure.name} is missing")
+    extra = sorted(have - set(structure.parameter_names))
+    if extra:
+        raise f.fail(f"parameter {', '.join(extra)} is not a parameter of structure {structure.name}")
+    try:
+        model.linear_model()
+    except ModelError as err:
+        raise f.fail(str(err)) from None
 
 
 def write_model(path: str | Path, model: IdentifiedModel) -> Path:

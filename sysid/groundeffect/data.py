@@ -19,6 +19,9 @@ __all__ = [
     "load_thrust_ratio",
 ]
 
+_PLAUSIBLE_MEDIAN = (0.5, 2.0)  # median F/F0 of rig readings: ground effect moves thrust by tens of percent at most
+_LOG_SUFFIXES = (".ulg", ".bin", ".tlog")
+
 
 @dataclass(frozen=True, slots=True)
 class HoverStep:
@@ -237,7 +240,9 @@ def rig_thrust_ratio(
     Raises
     ------
     DataError
-        If F0 is not given and no row lies above `reference_height_ratio`.
+        If F0 is not given and no row lies above `reference_height_ratio`, or
+        if the median F/F0 of the readings lies outside 0.5-2 (F0 or the
+        thrust unit is wrong: ground effect changes thrust by tens of percent).
 
     Notes
     -----
@@ -262,7 +267,13 @@ def rig_thrust_ratio(
         how = f"mean of {int(reference.sum())} row{'s' if reference.sum() > 1 else ''} with Z/R > {reference_height_ratio:g}"
     else:
         f0, how = float(f0_n), "given"
-    return ThrustRatioData(x, thrust / f0, rotor_radius_m, source, how, f0)
+    ratio = thrust / f0
+    median = float(np.median(ratio)) if ratio.size else 1.0
+    if not _PLAUSIBLE_MEDIAN[0] <= median <= _PLAUSIBLE_MEDIAN[1]:
+        raise DataError(f"{source or 'rig data'}: with F0 = {f0:.4g} N ({how}) the median F/F0 of the readings is "
+                        f"{median:.3g}, far from 1 out of ground effect; check F0 (--f0) and the thrust unit "
+                        f"(median thrust {float(np.median(thrust)):.4g} N)")
+    return ThrustRatioData(x, ratio, rotor_radius_m, source, how, f0)
 
 
 def load_thrust_ratio(path: str | Path, config: GroundEffectDataConfig, *,
@@ -271,7 +282,8 @@ def load_thrust_ratio(path: str | Path, config: GroundEffectDataConfig, *,
 
     A file that reads as a PX4 ULog, ArduPilot DataFlash or MAVLink
     telemetry log is a flight log (:func:`sysid.groundeffect.flight.flight_thrust_ratio`);
-    any other text file is a rig CSV (:func:`flightlogs.rig.read_rig_csv`).
+    any other text file is a rig CSV (:func:`flightlogs.rig.read_rig_csv`), unless
+    it is named ``.ulg``, ``.bin`` or ``.tlog``: then the log reader's error stands.
 
     Parameters
     ----------
@@ -298,7 +310,7 @@ def load_thrust_ratio(path: str | Path, config: GroundEffectDataConfig, *,
     try:
         detect_format(path)
     except LogFormatError:
-        if _is_text(path):
+        if _is_text(path) and path.suffix.lower() not in _LOG_SUFFIXES:
             return _rig(path, config)
         raise
     from flightlogs.reader import read_log

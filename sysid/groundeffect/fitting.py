@@ -106,7 +106,10 @@ def fit_ground_effect(data: ThrustRatioData, config: FitConfig | None = None) ->
     """
     config = config or FitConfig()
     if data.n_points < 3:
-        raise FitError(f"{data.source or 'data'}: {data.n_points} point(s); at least 3 are needed to fit")
+        what = "hover steps near the ground were found" if data.steps is not None else "points were given"
+        if data.n_points == 1:
+            what = what.replace("steps", "step").replace("points", "point").replace("were", "was")
+        raise FitError(f"{data.source or 'data'}: {data.n_points} {what}; at least 3 are needed to fit")
     fits = tuple(fit_model(name, data.height_ratio, data.thrust_ratio, confidence=config.confidence)
                  for name in config.models)
     scores = np.array([f.criterion(config.criterion) for f in fits])

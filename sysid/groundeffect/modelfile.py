@@ -203,17 +203,45 @@ def read_ground_effect_model(path: str | Path) -> FittedGroundEffect:
         raise ModelError(f"{path}: not a ground-effect model (no \"format\": {MODEL_FILE_FORMAT!r})")
     if document.get("version") != _VERSION:
         raise ModelError(f"{path}: ground-effect model version {document.get('version')!r}; this tool reads {_VERSION}")
+    model = document.get("model")
+    if not isinstance(model, str):
+        raise ModelError(f"{path}: no ground-effect model named (\"model\" is {_show(model)})")
+    if model not in PARAMETER_NAMES:
+        raise ModelError(f"{path}: unknown ground-effect model {model!r}; choose from {', '.join(PARAMETER_NAMES)}")
+    params = document.get("params")
+    if not isinstance(params, dict):
+        raise ModelError(f"{path}: the {model} model has no parameters (\"params\" is {_show(params)})")
+    values = [_number(path, params, name, f"the {model} model needs parameter {name}",
+                      label=f"parameter {name} of the {model} model") for name in PARAMETER_NAMES[model]]
+    extra = sorted(set(params) - set(PARAMETER_NAMES[model]))
+    if extra:
+        raise ModelError(f"{path}: {', '.join(extra)} is not a parameter of the {model} model "
+                         f"(it takes {', '.join(PARAMETER_NAMES[model]) or 'none'})")
+    radius = _number(path, document, "rotor_radius_m", "the rotor radius (rotor_radius_m) is missing")
+    lowest = _number(path, document, "min_height_ratio", "", default=0.0)
     try:
-        model = str(document["model"])
-        params = document["params"]
-        names = PARAMETER_NAMES.get(model, tuple(params))
-        values = [float(params[n]) for n in names]
-        return FittedGroundEffect(model, tuple(names), np.array(values), float(document["rotor_radius_m"]),
-                                  float(document.get("min_height_ratio", 0.0)), str(document.get("source", "")))
-    except (KeyError, TypeError, ValueError) as err:
-        if isinstance(err, ModelError):
-            raise ModelError(f"{path}: {err}") from err
-        raise ModelError(f"{path}: ground-effect model field missing or not a number ({err!r})") from err
+        return FittedGroundEffect(model, PARAMETER_NAMES[model], np.array(values), radius, lowest,
+                                  str(document.get("source", "")))
+    except ModelError as err:
+        raise ModelError(f"{path}: {err}") from None
+
+
+def _number(path: Path, table: dict[str, Any], key: str, missing: str, *, default: float | None = None,
+            label: str = "") -> float:
+    """A finite number from a JSON object, or a ModelError naming the file and the key."""
+    if key not in table and default is not None:
+        return default
+    if key not in table:
+        raise ModelError(f"{path}: {missing}")
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ModelError(f"{path}: {label or key} is {_show(value)}, not a finite number")
+    return float(value)
+
+
+def _show(value: Any) -> str:
+    text = "null" if value is None else repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def _finite(value: Any) -> Any:

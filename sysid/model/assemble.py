@@ -252,7 +252,7 @@ def structure_model(structure: ModelStructure, values: Mapping[str, float], *,
     Raises
     ------
     ModelError
-        If a value names no parameter of the structure.
+        If a value names no parameter of the structure, or a constant no trim constant of it.
 
     Examples
     --------
@@ -263,6 +263,7 @@ def structure_model(structure: ModelStructure, values: Mapping[str, float], *,
     """
     for name in values:
         structure.parameter(name)
+    structure.check_constants(constants or {})
     unset = tuple(p.name for p in structure.parameters if p.name not in values)
     full = {p.name: (p.drop_value if p.reduce == "drop" else p.value) for p in structure.parameters}
     full |= {k: float(v) for k, v in values.items()}

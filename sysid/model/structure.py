@@ -13,7 +13,7 @@ theta0``). Structures are read from TOML (:mod:`sysid.model.toml_format`);
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Literal
@@ -247,6 +247,34 @@ class ModelStructure:
     def default_constants(self) -> dict[str, float]:
         """Constant values as declared (trim zero), by name."""
         return {c.name: c.value for c in self.constants}
+
+    def check_constants(self, names: Iterable[str]) -> None:
+        """Raise unless every name is a trim constant of the structure (``--trim NAME=VALUE``).
+
+        Parameters
+        ----------
+        names : iterable of str
+            Constant names given by the user.
+
+        Raises
+        ------
+        ModelError
+            Naming the first unknown name and the structure's trim constants.
+
+        Examples
+        --------
+        >>> from sysid.model import load_structure
+        >>> load_structure("hover").check_constants(["U0", "theta0"])
+        >>> load_structure("hover").check_constants(["Q0"])  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        flightlogs.errors.ModelError: structure hover has no trim constant 'Q0' (its trim constants: g, U0, ...)
+        """
+        known = [c.name for c in self.constants]
+        unknown = [n for n in names if n not in known]
+        if unknown:
+            raise ModelError(f"structure {self.name} has no trim constant {unknown[0]!r} "
+                             f"(its trim constants: {', '.join(known) or 'none'})")
 
     def constants_from_trim(self, trim: Mapping[str, float]) -> dict[str, float]:
         """Constant values with each trim-linked constant set from `trim`.

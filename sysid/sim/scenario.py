@@ -36,7 +36,7 @@ log file with trim margins before and after the maneuver.
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import MISSING, dataclass, field, fields
 from datetime import datetime, timezone
 from importlib import resources
 from pathlib import Path
@@ -239,30 +239,75 @@ def read_scenario(path: str | Path) -> Scenario:
     return _scenario_from(raw, path)
 
 
+_TABLES = ("scenario", "condition", "maneuver", "anemometer", "effects")
+_SIMPLE = {"float": ((int, float), "a number"), "int": ((int,), "a whole number"), "str": ((str,), "text"),
+           "VehicleName": ((str,), "text"), "ManeuverKind": ((str,), "text")}
+
+
 def _scenario_from(raw: dict[str, Any], path: Path) -> Scenario:
-    def build(kind: type, table: dict[str, Any], where: str) -> Any:
+    def build(kind: type, table: Any, where: str, inner: dict[str, Any] | None = None) -> Any:
+        _check_table(path, kind, table, where, tuple(inner or ()))
         try:
-            return kind(**table)
-        except TypeError as err:
-            raise DataError(f"{path}: [{where}] {err}") from None
+            return kind(**table, **(inner or {}))
+        except TypeError:
+            raise DataError(f"{path}: [{where}] has a value of the wrong type") from None
         except DataError as err:
             raise DataError(f"{path}: [{where}] {err}") from None
 
-    head = dict(raw.get("scenario", {}))
-    if "utc_start" in head and isinstance(head["utc_start"], str):
-        head["utc_start"] = datetime.fromisoformat(head["utc_start"].replace("Z", "+00:00"))
-    head["formats"] = tuple(head.get("formats", ("dataflash",)))
-    head.setdefault("name", path.stem)
-    head.setdefault("description", "")
-    conditions = tuple(build(WindCondition, c, "condition") for c in raw.get("condition", []))
-    maneuvers = tuple(build(ManeuverSpec, m, "maneuver") for m in raw.get("maneuver", []))
+    head = raw.get("scenario", {})
+    head = dict(head) if isinstance(head, dict) else head
+    if isinstance(head, dict):
+        if "utc_start" in head and isinstance(head["utc_start"], str):
+            try:
+                head["utc_start"] = datetime.fromisoformat(head["utc_start"].replace("Z", "+00:00"))
+            except ValueError:
+                raise DataError(f"{path}: [scenario] utc_start {head['utc_start']!r} is not an ISO 8601 time "
+                                "(e.g. 2024-05-01T10:00:00Z)") from None
+        if isinstance(head.get("formats", ()), (list, tuple)):
+            head["formats"] = tuple(head.get("formats", ("dataflash",)))
+        head.setdefault("name", path.stem)
+        head.setdefault("description", "")
+    conditions = tuple(build(WindCondition, c, "condition") for c in _tables(path, raw, "condition"))
+    maneuvers = tuple(build(ManeuverSpec, m, "maneuver") for m in _tables(path, raw, "maneuver"))
     anemometer = build(AnemometerSpec, raw["anemometer"], "anemometer") if "anemometer" in raw else None
-    return build(
-        Scenario,
-        {**head, "conditions": conditions, "maneuvers": maneuvers, "anemometer": anemometer,
-         "effects": dict(raw.get("effects", {}))},
-        "scenario",
-    )
+    effects = raw.get("effects", {})
+    if not isinstance(effects, dict):
+        raise DataError(f"{path}: effects must be a table ([effects])")
+    scenario = build(Scenario, head, "scenario", {"conditions": conditions, "maneuvers": maneuvers,
+                                                  "anemometer": anemometer, "effects": dict(effects)})
+    stray = [k for k in raw if k not in _TABLES]
+    if stray:
+        raise DataError(f"{path}: {stray[0]} is outside any table; a scenario file has "
+                        "[scenario], [[condition]], [[maneuver]], [anemometer] and [effects]")
+    return scenario
+
+
+def _tables(path: Path, raw: dict[str, Any], key: str) -> list[Any]:
+    """The array of tables ``[[key]]``."""
+    tables = raw.get(key, [])
+    if not isinstance(tables, list):
+        raise DataError(f"{path}: {key} must be an array of tables ([[{key}]])")
+    return tables
+
+
+def _check_table(path: Path, kind: type, table: Any, where: str, inner: tuple[str, ...]) -> None:
+    """Every required field of `kind` given, no unknown key, simple fields of their type; else a DataError."""
+    if not isinstance(table, dict):
+        raise DataError(f"{path}: {where} must be a table ([{where}])")
+    known = {f.name: f for f in fields(kind) if f.init and f.name not in inner}
+    unknown = [k for k in table if k not in known]
+    if unknown:
+        raise DataError(f"{path}: [{where}] has no field {unknown[0]!r} (fields: {', '.join(known)})")
+    missing = [name for name, f in known.items()
+               if name not in table and f.default is MISSING and f.default_factory is MISSING]
+    if missing:
+        needs = " and ".join(("an " if m[0] in "aeiou" else "a ") + m for m in missing)
+        raise DataError(f"{path}: [{where}] needs {needs}")
+    for name, value in table.items():
+        types, what = _SIMPLE.get(str(known[name].type), ((object,), ""))
+        if isinstance(value, bool) or not isinstance(value, types):
+            if what:
+                raise DataError(f"{path}: [{where}] {name} is {value!r}, not {what}")
 
 
 def builtin_scenarios() -> dict[str, Path]:

@@ -8,12 +8,13 @@ excites (:func:`axis_outputs`).
 """
 
 from .engine import VerificationOptions, verify, verify_record
-from .logs import verify_logs
+from .logs import verify_flights, verify_logs
 from .records import DoubletRecords, doublet_records
 from .submodel import axis_outputs, driven_part
 from .results import (OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, mode_names,
                       rms_error, theil_inequality)
 
-__all__ = ["VerificationOptions", "verify_record", "verify", "verify_logs", "driven_part", "axis_outputs",
+__all__ = ["VerificationOptions", "verify_record", "verify", "verify_logs", "verify_flights", "driven_part",
+           "axis_outputs",
            "doublet_records", "DoubletRecords", "OutputVerification", "RecordVerification", "OutputSummary",
            "WindCorrection", "Verification", "rms_error", "theil_inequality", "mode_names"]

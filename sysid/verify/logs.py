@@ -1,4 +1,4 @@
-"""Verify a model on flight logs: read, condition, cut the doublets, simulate (what ``sysid validate`` runs)."""
+"""Verify a model on flight logs or conditioned flights: cut the doublets, simulate (what ``sysid validate`` runs)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from flightlogs.campaign import ingest_campaign
-from flightlogs.condition import ConditioningOptions
+from flightlogs.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import DataError
 
 from ..statespace import DelayedStateSpace
@@ -14,7 +14,7 @@ from .engine import VerificationOptions, verify
 from .records import doublet_records
 from .results import Verification
 
-__all__ = ["verify_logs"]
+__all__ = ["verify_logs", "verify_flights"]
 
 
 def verify_logs(
@@ -68,13 +68,54 @@ def verify_logs(
         raise DataError("the model has wind terms but no anemometer file was given (--wind); "
                         "without wind only the model without G_w can be verified")
     campaign = ingest_campaign(list(log_paths), list(wind_paths), options=conditioning, progress=progress)
-    flights = list(campaign.require_flights())
+    return verify_flights(model, campaign.require_flights(), wind_model=wind_model, axes=axes, options=options,
+                          before_s=before_s, after_s=after_s)
+
+
+def verify_flights(
+    model: DelayedStateSpace,
+    flights: Sequence[ConditionedFlight],
+    *,
+    wind_model: DelayedStateSpace | None = None,
+    axes: Mapping[str, Sequence[str]] | None = None,
+    options: VerificationOptions = VerificationOptions(),
+    before_s: float = 0.5,
+    after_s: float = 1.0,
+    hint: str = "give their times with --segments if they were not detected",
+) -> Verification:
+    """Verify `model` (and `wind_model`) on every doublet of conditioned flights (see :func:`verify_logs`).
+
+    Parameters
+    ----------
+    model : DelayedStateSpace
+        The model without the wind term (or the only one).
+    flights : sequence of ConditionedFlight
+        Flights with doublets not used in the fit (from logs or a dataset).
+    wind_model : DelayedStateSpace, optional
+        The model with G_w; the flights must hold its wind inputs.
+    axes : Mapping[str, sequence of str], optional
+        On-axis outputs of each mixer input.
+    options : VerificationOptions, optional
+        Bias, reference shift, initial state and instability choices.
+    before_s, after_s : float, optional
+        Quiet stretch kept before and response after each doublet, s.
+    hint : str, optional
+        What the message says to do when no doublet is found ("" for nothing).
+
+    Returns
+    -------
+    Verification
+
+    Raises
+    ------
+    DataError
+        If no flight holds a doublet on an axis of the model.
+    """
     cut = doublet_records(flights, before_s=before_s, after_s=after_s)
     kept = [k for k, name in enumerate(cut.excited) if name in model.inputs]  # axes the model does not have
     if not kept:
-        names = ", ".join(Path(p).name for p in log_paths)
+        names = ", ".join(dict.fromkeys(flight.source.name for flight in flights))
         raise DataError(f"no doublet found in {names} on an axis of the model ({', '.join(model.inputs)}): "
-                        "validation needs doublets not used in the fit (give their times with --segments if "
-                        "they were not detected)")
+                        "validation needs doublets not used in the fit" + (f" ({hint})" if hint else ""))
     return verify(model, [cut.records[k] for k in kept], wind_model=wind_model,
                   excited=[cut.excited[k] for k in kept], axes=axes, options=options)

@@ -120,8 +120,8 @@ def test_bad_data_is_exit_1_with_one_sentence_and_no_file(demo: dict[str, Path],
 @pytest.mark.parametrize(("args", "fragment"), [
     (["--pairs", "q"], "OUTPUT/INPUT"),
     (["--windows", "2,x"], "comma-separated list of seconds"),
-    (["--omega-min", "50", "--omega-max", "10"], "omega_min < omega_max"),
-    (["--wind-distance", "4.6"], "go with logs"),
+    (["--omega-min", "50", "--omega-max", "10"], "must be below --omega-max"),
+    (["--wind-distance", "4.6"], "--wind-distance goes with logs"),
 ])
 def test_usage_errors_are_exit_2(demo: dict[str, Path], args: list[str], fragment: str) -> None:
     result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), *args])

@@ -52,3 +52,21 @@ def test_a_failure_leaves_the_old_file_and_no_temporary(tmp_path: Path) -> None:
             raise RuntimeError("boom")
     assert target.read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["model.json"]
+
+
+def test_a_missing_folder_is_a_data_error_naming_it(tmp_path: Path) -> None:
+    from flightlogs.errors import DataError
+
+    with pytest.raises(DataError, match="nodir: the output folder does not exist"):
+        with atomic_output(tmp_path / "nodir" / "x.h5"):
+            pass  # pragma: no cover - never entered
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_file_in_place_of_the_folder_is_a_data_error(tmp_path: Path) -> None:
+    from flightlogs.errors import DataError
+
+    (tmp_path / "plain").write_text("x")
+    with pytest.raises(DataError, match="plain: the output folder is a file"):
+        with atomic_output(tmp_path / "plain" / "x.h5"):
+            pass  # pragma: no cover - never entered

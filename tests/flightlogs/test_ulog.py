@@ -250,8 +250,8 @@ def test_truncated_copy_reads_the_intact_part(real_data: Path, tmp_path: Path) -
     cut = tmp_path / "cut.ulg"
     cut.write_bytes(data[: len(data) * 6 // 10])
     log = read_ulog(cut)
-    assert any(re.fullmatch(rf"the file is truncated: it ends inside a message at byte \d+ of {len(data) * 6 // 10};"
-                            " that last message was skipped", w) for w in log.warnings)
+    assert any(re.fullmatch(rf"cut\.ulg: the file is truncated: it ends inside a message at byte \d+ of "
+                            rf"{len(data) * 6 // 10}; that last message was skipped", w) for w in log.warnings)
     n = log["p"].samples
     assert 0.4 * full["p"].samples < n < 0.8 * full["p"].samples
     np.testing.assert_array_equal(log["p"].values, full["p"].values[:n])

@@ -72,7 +72,7 @@ def test_bad_model_files_are_refused(model: IdentifiedModel, tmp_path) -> None:
     path = write_model(tmp_path / "model.json", model)
     doc = json.loads(path.read_text())
     for change, message in (({"schema_version": 99}, "version 99"), ({"schema": "x"}, "not a flight-sysid model"),
-                            ({"cost": {}}, "incomplete or damaged")):
+                            ({"cost": {}}, "cost has no average")):
         (tmp_path / "bad.json").write_text(json.dumps(doc | change))
         with pytest.raises(ModelError, match=message):
             read_model(tmp_path / "bad.json")

@@ -1,0 +1,101 @@
+"""Conditioned flights from what a command was given: HDF5 datasets (``sysid ingest -o``) or logs."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ._common import progress_bar
+
+__all__ = ["is_dataset", "check_sources", "conditioned_flights"]
+
+
+def is_dataset(path: Path) -> bool:
+    """Whether `path` names an HDF5 dataset (by its suffix) rather than a flight log.
+
+    Parameters
+    ----------
+    path : Path
+        A file given on the command line.
+    """
+    return Path(path).suffix.lower() in (".h5", ".hdf5")
+
+
+def check_sources(sources: Sequence[Path], log_only: Mapping[str, Any]) -> bool:
+    """True when `sources` are datasets, False when they are logs; a usage error when they are mixed.
+
+    Parameters
+    ----------
+    sources : sequence of Path
+        The files given.
+    log_only : Mapping[str, Any]
+        Options that only make sense with logs (``{"--wind": paths}``), by
+        option name; any that is set (not None, False or empty; 0.0 is set)
+        with datasets is a usage error.
+
+    Raises
+    ------
+    click.UsageError
+        If datasets and logs are mixed, or a log-only option is given with datasets.
+    """
+    datasets = [p for p in sources if is_dataset(p)]
+    if datasets and len(datasets) != len(sources):
+        raise click.UsageError("give either datasets (.h5 from `sysid ingest -o`) or logs, not both")
+    if not datasets:
+        return False
+    given = [name for name, value in log_only.items() if _is_set(value)]
+    if given:
+        raise click.UsageError(f"{', '.join(given)} go{'es' if len(given) == 1 else ''} with logs: a dataset already "
+                               "holds its aligned wind and its maneuvers (give them to `sysid ingest`)")
+    return True
+
+
+def _is_set(value: Any) -> bool:
+    return not (value is None or value is False or (isinstance(value, (tuple, list)) and not value))
+
+
+def conditioned_flights(sources: Sequence[Path], wind_paths: Sequence[Path], conditioning: Any, *,
+                        log_only: Mapping[str, Any], quiet: bool) -> list[Any]:
+    """The conditioned flights of `sources`: read from datasets, or logs ingested here with a progress bar.
+
+    Parameters
+    ----------
+    sources : sequence of Path
+        Datasets or logs (not both).
+    wind_paths : sequence of Path
+        Anemometer files or folders (logs only).
+    conditioning : flightlogs.condition.ConditioningOptions
+        How to condition logs.
+    log_only : Mapping[str, Any]
+        Options the command was given that only go with logs (see :func:`check_sources`).
+    quiet : bool
+        No progress bar.
+
+    Returns
+    -------
+    list of flightlogs.condition.ConditionedFlight
+
+    Raises
+    ------
+    click.UsageError
+        See :func:`check_sources`.
+    flightlogs.errors.DataError
+        If no flight could be conditioned (or a dataset holds none).
+    """
+    if check_sources(sources, log_only):
+        from flightlogs.errors import DataError
+        from flightlogs.store import read_dataset
+
+        flights = [flight for path in sources for flight in read_dataset(path).conditioned if flight is not None]
+        if not flights:
+            raise DataError(f"{', '.join(p.name for p in sources)}: no conditioned flight in the dataset")
+        return flights
+    from flightlogs.campaign import ingest_campaign
+
+    with progress_bar("reading", quiet=quiet) as bar:
+        campaign = ingest_campaign(list(sources), list(wind_paths), options=conditioning,
+                                   progress=lambda _name, done, total: bar(done, total))
+    return list(campaign.require_flights())
