@@ -101,8 +101,8 @@ def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[s
     with progress_bar("reading", quiet=quiet) as bar:
         campaign = ingest_campaign(list(logs), list(wind_paths), columns=columns, options=options,
                                    progress=lambda _name, done, total: bar(done, total))
-    campaign.require_flights()  # nothing written when no log could be conditioned; some: warned below
     if out is not None:
+        campaign.require_flights()  # no dataset without a flight in it; some not conditioned: warned below
         write_dataset(out, campaign.logs, campaign.winds, list(campaign.flights))
     summary = _summary(campaign, out)
     if not quiet:

@@ -124,6 +124,10 @@ def test_ingest_writes_nothing_when_no_log_can_be_conditioned(demo: dict[str, Pa
     entries = json.loads(result.stdout)["logs"]
     assert any("not conditioned: " in w and "trunc100.bin" in w for w in entries[1]["warnings"])
     assert out.exists()
+    # without -o the log is only looked at: its signals are listed, with the reason it cannot be conditioned
+    result = CliRunner().invoke(cli, ["ingest", str(broken), "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    assert any("not conditioned: " in w for w in json.loads(result.stdout)["logs"][0]["warnings"])
 
 
 @pytest.mark.parametrize(("args", "named"), [
