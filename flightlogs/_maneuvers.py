@@ -278,9 +278,9 @@ def _lobes(x: np.ndarray, t: np.ndarray, h: float) -> list[tuple[int, float, flo
 def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float) -> tuple | None:
     """(kind, f_min_hz, f_max_hz[, (first, last)]) of the maneuver on samples [lo, hi], or None.
 
-    Doublets come with refined bounds: the first and last sample of their two
-    lobes that stand out of the noise (and above 3 % of their peak), since
-    their edges are steps.
+    Doublets and 3211s come with refined bounds: the first and last sample
+    of their two (four) lobes that stand out of the noise (and above 3 % of
+    their peak), since their edges are steps.
     """
     x, h = act.detrended[lo : hi + 1], threshold * act.sigma
     lobes = _lobes(x, t[lo : hi + 1], h)
@@ -302,9 +302,14 @@ def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float)
         if signs[0] == signs[2] == -signs[1] and areas[big[1]] == areas[big].max():
             return "doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h)
     if big.size == 4 and np.all(np.diff(big) == 1):
-        unit = durations[big].sum() / 7.0
-        if np.all(np.abs(durations[big] / unit - [3, 2, 1, 1]) <= [1.0, 0.7, 0.4, 0.4]):
-            return "3211", None, None
+        # the outer pulses run from the first loud sample and to the last: their steps, not the
+        # zero crossings the noise or the loop's settling move away from them
+        first, last = _loud_span(x, t, lo, lobes[big[0]], lobes[big[3]], h)
+        steps = durations[big].copy()
+        steps[0], steps[3] = lobes[big[0]][2] - t[first], t[last] + (t[1] - t[0]) - lobes[big[3]][1]
+        unit = steps.sum() / 7.0
+        if unit > 0 and np.all(np.abs(steps / unit - [3, 2, 1, 1]) <= [1.0, 0.7, 0.4, 0.4]):
+            return "3211", None, None, (first, last)
     pair = _dominant_pair(lobes, areas)
     if pair is not None:
         return "doublet", None, None, _loud_span(x, t, lo, lobes[pair], lobes[pair + 1], h)

@@ -10,8 +10,8 @@ whose doublets, 3211s and sweeps have their true shape again.
 
 A short record (a doublet with a few seconds of hover either side) has too
 little quiet data for that fit. Around each burst of activity the feedback
-is therefore also fitted jointly with a doublet (see
-:mod:`flightlogs._doublet_fit`): where a doublet explains the burst, the
+is therefore also fitted jointly with a doublet, and with a 3-2-1-1 (see
+:mod:`flightlogs._doublet_fit`): where one explains the burst, the
 excitation there is the input minus that joint fit of the feedback.
 """
 
@@ -65,18 +65,18 @@ def estimate_excitation(
         Samples with no excitation, where the feedback law is fitted.
     time_s : ndarray, shape (n_samples,), optional
         Uniform sample times, s. When given, every burst of activity (up to
-        15 s) is also searched for a doublet fitted jointly with the
-        feedback; without it only the quiet-sample fit is made.
+        15 s) is also searched for a doublet or a 3-2-1-1 fitted jointly
+        with the feedback; without it only the quiet-sample fit is made.
 
     Returns
     -------
     dict of ndarray
         For each axis, the input minus its fitted feedback (``K x + c0`` on
         the quiet samples; with fewer than 200 of them, only the median).
-        Where a doublet explains a burst, the input minus the feedback
-        fitted jointly with it, blended into the rest over 1 s, unless the
-        quiet fit is trusted (10 s of quiet samples or more) and already
-        shows the doublet. Without the axis's states, the input itself;
+        Where a doublet or a 3-2-1-1 explains a burst, the input minus the
+        feedback fitted jointly with it, blended into the rest over 1 s,
+        unless the quiet fit is trusted (10 s of quiet samples or more) and
+        already shows it. Without the axis's states, the input itself;
         NaN as 0.
 
     Raises
@@ -94,8 +94,12 @@ def estimate_excitation(
     opposite signs and agree in size within 3:1, each stands out of the
     residual by 10 standard errors, together they leave at most 5 % of the
     burst's energy unexplained, and 1 s of the window lies either side.
-    Bursts less than 3 s apart are fitted as one, so the steps of a 3-2-1-1
-    are never taken for a doublet. States named as angles are unwrapped.
+    A 3-2-1-1 (pulses of 3, 2, 1 and 1 units, the unit scanned from 0.1 to
+    5/3 s) is fitted the same way; it replaces the doublet when its four
+    pulses pass the same rules and it leaves at most half the energy the
+    best doublet leaves. Bursts less than 3 s apart are fitted as one, so
+    the steps of a 3-2-1-1 are not fitted as separate doublets. States
+    named as angles are unwrapped.
 
     Examples
     --------
@@ -151,11 +155,12 @@ def _quiet_fit(u: np.ndarray, x: np.ndarray, usable: np.ndarray) -> np.ndarray:
 
 def _with_doublets(u: np.ndarray, x: np.ndarray, base: np.ndarray, trusted: bool, finite: np.ndarray, dt: float,
                    angles: list[bool]) -> np.ndarray:
-    """`base` with the joint doublet-and-feedback fit put in around the bursts a doublet explains.
+    """`base` with the joint fit of feedback and doublet (or 3-2-1-1) put in around the bursts one explains.
 
     Where `base` is `trusted` (its feedback fitted on enough hover) and a
-    doublet already explains the burst in it, `base` is kept: a long quiet
-    fit averages the feedback better than a few seconds around one burst.
+    doublet or 3-2-1-1 already explains the burst in it, `base` is kept: a
+    long quiet fit averages the feedback better than a few seconds around
+    one burst.
     """
     bursts = _candidates(base, u, finite, dt)
     pad = int(round((_PAD_S if trusted else _WIDE_PAD_S) / dt))

@@ -177,8 +177,14 @@ def detect_segments(
     the excitation (a fade-in is found once it rises out of the noise). The
     trace is cut into half-waves at zero crossings (hysteresis `threshold`
     σ): two large ones of similar area make a doublet, four of durations
-    3:2:1:1 a 3211, eight or more with a frequency trend (Spearman |ρ| > 0.6,
-    range over 2:1) or at one frequency a sweep, otherwise a multisine.
+    3:2:1:1 (the outer two timed from the first and to the last loud
+    sample) a 3211, both bounded by those samples since their edges are
+    steps; eight or more with a frequency trend (Spearman |ρ| > 0.6, range
+    over 2:1) or at one frequency a sweep, otherwise a multisine. In closed
+    loop, pass the excitation of :func:`flightlogs.excitation.estimate_excitation`,
+    which fits doublets and 3-2-1-1s jointly with the feedback (a 3-2-1-1 bent
+    by a poorly fitted feedback can show an adjacent pair of pulses that
+    passes for a doublet).
     """
     t, dt = _uniform(time_s)
     traces = _check_inputs(inputs, t.size)

@@ -45,6 +45,12 @@ def report_browser() -> ModuleType:
 
 
 @pytest.fixture(scope="session")
+def excitation_tests() -> ModuleType:
+    """``tests/flightlogs/test_excitation.py``'s closed-loop roll hold: ``_closed_loop``, ``_3211``, ``DT``."""
+    return _test_helper("_excitation_tests", "flightlogs/test_excitation.py")
+
+
+@pytest.fixture(scope="session")
 def report_models() -> ModuleType:
     """``tests/reports/test_model_report.py``'s builders: ``small_model()``, ``STAMP``, ``PAIRS``."""
     return _test_helper("_model_report_tests", "reports/test_model_report.py")
