@@ -152,11 +152,10 @@ def _candidate(u: np.ndarray, resid: np.ndarray, basis: np.ndarray, dt: float, b
 
 
 def _accepted(fit: DoubletFit, n: int, dt: float) -> bool:
-    """Signs alternate, sizes agree within `_PULSE_RATIO_MAX`, each pulse has z >= `_Z_MIN`, the fit explains, 1 s either side."""
+    """Signs alternate, sizes within `_PULSE_RATIO_MAX`, each z >= `_Z_MIN`, the fit explains, 1 s either side."""
     a = np.abs(fit.amplitudes)
-    shaped = all(x * y < 0 for x, y in zip(fit.amplitudes, fit.amplitudes[1:])) and (
-        1 / _PULSE_RATIO_MAX <= a[1:] / a[:-1]).all() and (a[1:] / a[:-1] <= _PULSE_RATIO_MAX).all() and (
-        a.max() <= _PULSE_RATIO_MAX * a.min())
+    alternating = all(x * y < 0 for x, y in zip(fit.amplitudes, fit.amplitudes[1:]))
+    shaped = alternating and a.max() <= _PULSE_RATIO_MAX * a.min()
     lead = int(round(_LEAD_S / dt))
     framed = fit.first >= lead and n - fit.first - sum(_UNITS[fit.kind]) * fit.width >= lead
     return bool(shaped and framed and min(fit.z) >= _Z_MIN and fit.unexplained <= _UNEXPLAINED_MAX)
@@ -209,8 +208,7 @@ def _scan(resid: np.ndarray, basis: np.ndarray, dt: float, burst: tuple[int, int
         return None
     first, width = best[1], best[2]
     widths = range(max(w_min, width - step), min(w_max, width + step) + 1)
-    slack = (span + 1) * step if units != _DOUBLET else 3 * step
-    fine = grid(sums, run, widths, max(earliest, first - step), min(latest, first + span * width + slack), 1)
+    fine = grid(sums, run, widths, max(earliest, first - step), min(latest, first + span * (width + step) + step), 1)
     return (fine[1], fine[2]) if fine is not None else (first, width)
 
 

@@ -12,7 +12,8 @@ import numpy as np
 from flightlogs.atomic import atomic_output
 from flightlogs.errors import SysidError
 
-__all__ = ["finite_or_none", "float_or_nan", "json_floats", "float_array", "write_json", "read_json_object"]
+__all__ = ["finite_or_none", "float_or_nan", "json_floats", "float_array", "value_text", "write_json",
+           "read_json_object"]
 
 
 def finite_or_none(value: float | None) -> float | None:
@@ -96,6 +97,27 @@ def float_array(values: Any) -> np.ndarray:
     [1.0, nan]
     """
     return np.array([float_or_nan(v) for v in values], dtype=float)
+
+
+def value_text(value: Any) -> str:
+    """A JSON value as an error message shows it: ``null`` for None, else its repr cut to 40 characters.
+
+    Parameters
+    ----------
+    value : object
+        As read from JSON.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> value_text(None), value_text("abc"), value_text(list(range(30)))
+    ('null', "'abc'", '[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11...')
+    """
+    text = "null" if value is None else repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def write_json(path: str | Path, doc: Any) -> Path:

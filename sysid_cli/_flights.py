@@ -89,7 +89,7 @@ def conditioned_flights(sources: Sequence[Path], wind_paths: Sequence[Path], con
         from flightlogs.errors import DataError
         from flightlogs.store import read_dataset
 
-        flights = [flight for path in sources for flight in read_dataset(path).conditioned if flight is not None]
+        flights = [flight for path in sources for flight in read_dataset(path).conditioned]
         if not flights:
             raise DataError(f"{', '.join(p.name for p in sources)}: no conditioned flight in the dataset")
         return flights

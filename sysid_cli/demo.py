@@ -32,7 +32,7 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
 
     identified = read_model(model_path)
     model, with_wind = identified.linear_model(include_wind=False), identified.linear_model(include_wind=True)
-    flights = [f for f in read_dataset(dataset).conditioned if f is not None]
+    flights = list(read_dataset(dataset).conditioned)
     cut = doublet_records(flights, before_s=_BEFORE_S, after_s=_AFTER_S)
     verification = verify(model, cut.records, excited=cut.excited, axes=axis_outputs(identified),
                           wind_model=with_wind if with_wind.inputs != model.inputs else None,

@@ -149,7 +149,8 @@ def _summary(verification: Any, model_path: Path, logs: tuple[Path, ...], report
         "logs": [str(p) for p in logs],
         "records": [{"label": r.label, "source": str(r.source), "start_s": float(r.time_s[0]),
                      "end_s": float(r.time_s[-1]), "rmse": r.rmse, "tic": r.tic, "unstable": r.unstable,
-                     "growth": r.growth, "unstable_modes": list(r.unstable_modes), "notice": r.notice, "reference_shifts": dict(r.reference_shifts),
+                     "growth": r.growth, "unstable_modes": list(r.unstable_modes), "notice": r.notice,
+                     "reference_shifts": dict(r.reference_shifts),
                      "bias": {o.name: o.bias for o in r.outputs}, "excited": r.excited,
                      "on_axis": [o.name for o in r.judged], "off_axis": list(r.off_axis)}
                     for r in verification.records],

@@ -22,6 +22,7 @@ from .._json import finite_or_none as _num
 from .._json import float_array as _vector
 from .._json import json_floats as _array
 from .._json import read_json_object, write_json
+from .._json import value_text as _show
 from ..freqresp import FrequencyResponse
 from ._json import parameter_entry
 from .cost import CostSummary
@@ -141,11 +142,6 @@ class _Fields:
         table = self.get(parent, key, where, dict, {})
         label = key if where == "the file" else f"{where} {key}"
         return {k: self.number(table, k, label, finite=finite) for k in table}
-
-
-def _show(value: Any) -> str:
-    text = "null" if value is None else repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def _response_from_dict(d: Mapping[str, Any], f: _Fields, where: str) -> FrequencyResponse:

@@ -16,6 +16,7 @@ import numpy as np
 from flightlogs.errors import ModelError
 
 from .._json import read_json_object, write_json
+from .._json import value_text as _show
 from .models import PARAMETER_NAMES, GroundEffectFit, evaluate_model
 
 __all__ = ["FittedGroundEffect", "fit_summary", "write_ground_effect_model", "read_ground_effect_model",
@@ -237,11 +238,6 @@ def _number(path: Path, table: dict[str, Any], key: str, missing: str, *, defaul
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ModelError(f"{path}: {label or key} is {_show(value)}, not a finite number")
     return float(value)
-
-
-def _show(value: Any) -> str:
-    text = "null" if value is None else repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def _finite(value: Any) -> Any:

@@ -68,7 +68,7 @@ duration_s = 20.0
 """
 
 
-@pytest.mark.parametrize("unit_s", [0.25, 1.0])
+@pytest.mark.parametrize("unit_s", [0.25, 0.5, 1.0])
 @pytest.mark.parametrize(("gust", "seed"), [(0.1, 0), (0.3, 1)])
 @pytest.mark.parametrize("pass_", ["first", "second"])
 def test_a_closed_loop_3211_is_recovered_and_found_to_the_sample(unit_s: float, gust: float, seed: int, pass_: str,

@@ -9,6 +9,7 @@ import pytest
 from flightlogs.campaign import Campaign, ingest_campaign
 from flightlogs.errors import DataError
 
+
 def test_no_conditioned_flight_names_each_logs_reason() -> None:
     campaign = Campaign((), (), (None, None), (("not conditioned: a.ulg has no attitude",),
                                                 ("not conditioned: b.bin is 2 s long",)))
