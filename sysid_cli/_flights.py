@@ -10,7 +10,7 @@ import click
 
 from ._common import progress_bar
 
-__all__ = ["is_dataset", "check_sources", "conditioned_flights"]
+__all__ = ["is_dataset", "check_sources", "dataset_flights", "conditioned_flights"]
 
 
 def is_dataset(path: Path) -> bool:
@@ -57,6 +57,28 @@ def _is_set(value: Any) -> bool:
     return not (value is None or value is False or (isinstance(value, (tuple, list)) and not value))
 
 
+def dataset_flights(datasets: Sequence[Path]) -> list[Any]:
+    """The conditioned flights held in HDF5 datasets (``sysid ingest -o``), in order.
+
+    Parameters
+    ----------
+    datasets : sequence of Path
+        Dataset files.
+
+    Raises
+    ------
+    flightlogs.errors.DataError
+        If the datasets hold no conditioned flight.
+    """
+    from flightlogs.errors import DataError
+    from flightlogs.store import read_dataset
+
+    flights = [flight for path in datasets for flight in read_dataset(path).conditioned]
+    if not flights:
+        raise DataError(f"{', '.join(p.name for p in datasets)}: no conditioned flight in the dataset")
+    return flights
+
+
 def conditioned_flights(sources: Sequence[Path], wind_paths: Sequence[Path], conditioning: Any, *,
                         log_only: Mapping[str, Any], quiet: bool) -> list[Any]:
     """The conditioned flights of `sources`: read from datasets, or logs ingested here with a progress bar.
@@ -86,13 +108,7 @@ def conditioned_flights(sources: Sequence[Path], wind_paths: Sequence[Path], con
         If no flight could be conditioned (or a dataset holds none).
     """
     if check_sources(sources, log_only):
-        from flightlogs.errors import DataError
-        from flightlogs.store import read_dataset
-
-        flights = [flight for path in sources for flight in read_dataset(path).conditioned]
-        if not flights:
-            raise DataError(f"{', '.join(p.name for p in sources)}: no conditioned flight in the dataset")
-        return flights
+        return dataset_flights(sources)
     from flightlogs.campaign import ingest_campaign
 
     with progress_bar("reading", quiet=quiet) as bar:

@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, emit_json, json_option, progress_bar
-from ._flights import check_sources, conditioned_flights
+from ._flights import check_sources, dataset_flights
 from ._wind_options import (anemometer_at_option, transport_delay_option, wind_distance_option, wind_offset_option,
                             wind_option)
 
@@ -100,7 +100,7 @@ def fit(logs: tuple[Path, ...], model_name: str, wind_paths: tuple[Path, ...], w
             bar(done, total)
 
         if dataset:
-            flights = conditioned_flights(logs, (), None, log_only={}, quiet=True)
+            flights = dataset_flights(logs)
             model = identify_flights(flights, structure, options=options, files=list(logs), progress=progress)
         else:
             conditioning = ConditioningOptions(

@@ -211,8 +211,7 @@ def _reduction(doc: Mapping[str, Any], f: _Fields) -> tuple[ReductionStep, ...]:
 
 
 def _wind(doc: Mapping[str, Any], f: _Fields) -> WindFit | None:
-    wind = f.get(doc, "wind", "the file", object, None)
-    if wind is None:
+    if doc.get("wind") is None:
         return None
     wind = f.get(doc, "wind", "the file", dict)
     outputs = tuple(f.get(wind, "outputs", "wind", list))
