@@ -18,9 +18,9 @@ import argparse
 import os
 import subprocess
 import sys
-from dataclasses import replace
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 SPEEDS = {"calm": 0.9, "light": 2.7, "strong": 5.4}
@@ -44,11 +44,11 @@ def main() -> None:
     for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[name] = str(args.threads)
 
-    from flightlogs.campaign import ingest_campaign
-    from flightlogs.condition import ConditioningOptions
+    from flightlogs.conditioning.condition import ConditioningOptions
+    from flightlogs.store.campaign import ingest_campaign
+    from simulator.campaign.fly import run_scenario
+    from simulator.campaign.scenario import WindCondition, load_builtin
     from sysid.fit import FitOptions, IdentifyOptions, fit_frequency_responses, identify_flights
-    from sysid.sim.campaign import run_scenario
-    from sysid.sim.scenario import WindCondition, load_builtin
 
     folder = args.folder or Path(tempfile.mkdtemp(prefix="bench-fit-"))
     folder.mkdir(parents=True, exist_ok=True)
@@ -58,31 +58,60 @@ def main() -> None:
         scenario = replace(load_builtin("linear-sweeps"), trials=args.trials, conditions=(wind,))
         start = time.perf_counter()
         run_scenario(scenario, logs_dir)
-        print(f"simulated {args.trials} sweeps per axis in {args.condition} wind: {time.perf_counter() - start:.1f} s "
-              f"(not part of the timing)")
+        print(
+            f"simulated {args.trials} sweeps per axis in {args.condition} wind: {time.perf_counter() - start:.1f} s "
+            f"(not part of the timing)"
+        )
     logs = sorted(str(p) for p in logs_dir.glob("*.bin"))
-    command = ["sysid", "fit", *logs, "--wind", str(logs_dir), "--wind-distance", "4.6", "--model", "hover-wind",
-               "-o", str(folder / "model.json"), "-q"]
+    command = [
+        "sysid",
+        "fit",
+        *logs,
+        "--wind",
+        str(logs_dir),
+        "--wind-distance",
+        "4.6",
+        "--model",
+        "hover-wind",
+        "-o",
+        str(folder / "model.json"),
+        "-q",
+    ]
     start = time.perf_counter()
     subprocess.run(command, check=True)
     total = time.perf_counter() - start
-    print(f"sysid fit, {len(logs)} logs, {args.condition} wind, hover-wind: {total:.2f} s wall "
-          f"(target < 20 s on 2 cores) {'OK' if total < 20 else 'SLOW'}")
+    print(
+        f"sysid fit, {len(logs)} logs, {args.condition} wind, hover-wind: {total:.2f} s wall "
+        f"(target < 20 s on 2 cores) {'OK' if total < 20 else 'SLOW'}"
+    )
 
     print("stages, in-process:")
-    campaign, _ = _timed("read + condition (ingest_campaign)", ingest_campaign, [Path(p) for p in logs], [logs_dir],
-                         options=ConditioningOptions(wind_distance_m=4.6))
+    campaign, _ = _timed(
+        "read + condition (ingest_campaign)",
+        ingest_campaign,
+        [Path(p) for p in logs],
+        [logs_dir],
+        options=ConditioningOptions(wind_distance_m=4.6),
+    )
     flights = [c for c in campaign.conditioned if c is not None]
     model, _ = _timed("responses + fit + reduction + wind step", identify_flights, flights, "hover-wind")
     responses = model.responses
     print("F/G_u fit on the same gated responses (with reduction):")
     _, analytic = _timed("analytic Jacobian, 1 start", fit_frequency_responses, model.structure, responses)
-    _, numeric = _timed("forward-difference Jacobian, 1 start", fit_frequency_responses, model.structure, responses,
-                        options=FitOptions(jacobian="numeric"))
-    _, several = _timed("analytic Jacobian, 5 starts", fit_frequency_responses, model.structure, responses,
-                        options=FitOptions(starts=5))
-    print(f"ratios: numeric / analytic = {numeric / analytic:.1f}x, 5 starts / 1 start = {several / analytic:.1f}x; "
-          f"J_ave = {model.cost.average:.1f}")
+    _, numeric = _timed(
+        "forward-difference Jacobian, 1 start",
+        fit_frequency_responses,
+        model.structure,
+        responses,
+        options=FitOptions(jacobian="numeric"),
+    )
+    _, several = _timed(
+        "analytic Jacobian, 5 starts", fit_frequency_responses, model.structure, responses, options=FitOptions(starts=5)
+    )
+    print(
+        f"ratios: numeric / analytic = {numeric / analytic:.1f}x, 5 starts / 1 start = {several / analytic:.1f}x; "
+        f"J_ave = {model.cost.average:.1f}"
+    )
     if IdentifyOptions().fit.starts != 1:  # pragma: no cover - a reminder if the default changes
         print("note: the default number of starts is not 1", file=sys.stderr)
 

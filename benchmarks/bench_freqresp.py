@@ -5,7 +5,7 @@ Usage::
     python benchmarks/bench_freqresp.py [--repeat 10] [--n-freq 150]
 
 Five pitch sweeps of 34 s at 100 Hz (the chapter 3 calm model of Table 3.3,
-flown closed loop by :func:`sysid.sim.linear_flight.simulate_hover`), one
+flown closed loop by :func:`simulator.flights.linear.simulate_hover`), one
 input (``delta_lon``) and four outputs (``q ax theta u``), five window lengths
 at 80 % overlap. It reports, best of ``--repeat`` runs:
 
@@ -45,10 +45,11 @@ import pandas as pd
 from scipy import signal as sps
 
 from flightlogs.record import Record
+from simulator.autopilot.excitation import Maneuver, excitation_signal
+from simulator.flights.linear import simulate_hover
+from simulator.vehicle.identified import CALM_HOVER
 from sysid.freqresp import ResponseOptions, automatic_window_lengths, frequency_responses
 from sysid.freqresp._spectra import window_spectra
-from sysid.sim.excitation import Maneuver, excitation_signal
-from sysid.sim.linear_flight import CALM_HOVER, simulate_hover
 
 OUTPUTS = ("q", "ax", "theta", "u")
 SWEEP_S, RATE_HZ, N_SWEEPS = 34.0, 100.0, 5
@@ -57,17 +58,30 @@ SWEEP_S, RATE_HZ, N_SWEEPS = 34.0, 100.0, 5
 def campaign_axis(seed: int = 0) -> list[Record]:
     """Five 34 s pitch sweeps (0.1-10 Hz, 8 %) of the calm model, each exactly 3400 samples."""
     starts = tuple(4.0 + 40.0 * k for k in range(N_SWEEPS))
-    flight = simulate_hover(starts[-1] + SWEEP_S + 4.0, tuple(Maneuver("lon", "sweep", s, 8.0, SWEEP_S) for s in starts),
-                            parameters=CALM_HOVER, seed=seed)
+    flight = simulate_hover(
+        starts[-1] + SWEEP_S + 4.0,
+        tuple(Maneuver("lon", "sweep", s, 8.0, SWEEP_S) for s in starts),
+        parameters=CALM_HOVER,
+        seed=seed,
+    )
     table = pd.DataFrame({n: flight.signals[n] for n in ("delta_lon", *OUTPUTS)}, index=flight.time_s)
-    table["excitation"] = excitation_signal(flight.time_s, tuple(Maneuver("lon", "sweep", s, 8.0, SWEEP_S)
-                                                                 for s in starts), "lon") / 100.0
+    table["excitation"] = (
+        excitation_signal(flight.time_s, tuple(Maneuver("lon", "sweep", s, 8.0, SWEEP_S) for s in starts), "lon")
+        / 100.0
+    )
     whole = Record(table, {c: "-" for c in table.columns}, {}, Path("simulated-campaign"), "campaign")
     pieces = []
     for start in starts:
         first = int(round(start * RATE_HZ))
-        pieces.append(Record(table.iloc[first : first + int(SWEEP_S * RATE_HZ)], whole.units, {}, whole.source,
-                             f"sweep at {start:.0f} s"))
+        pieces.append(
+            Record(
+                table.iloc[first : first + int(SWEEP_S * RATE_HZ)],
+                whole.units,
+                {},
+                whole.source,
+                f"sweep at {start:.0f} s",
+            )
+        )
     return pieces
 
 
@@ -107,8 +121,9 @@ def dense_transforms(records: list[Record], n_freq: int = 2000) -> tuple[Callabl
     omega = np.linspace(1.0, 70.0, n_freq)
 
     def run(spacing: str) -> Callable[[], object]:
-        return lambda: window_spectra(data, 1 / RATE_HZ, 1700, omega, overlap=0.8, taper="hann", min_cycles=3,
-                                      spacing=spacing)
+        return lambda: window_spectra(
+            data, 1 / RATE_HZ, 1700, omega, overlap=0.8, taper="hann", min_cycles=3, spacing=spacing
+        )
 
     return run("log"), run("linear")
 
@@ -148,11 +163,14 @@ def main(argv: list[str] | None = None) -> int:
     windows_only = ResponseOptions(n_freq=args.n_freq, whole_record=False)
     referenced = ResponseOptions(n_freq=args.n_freq, reference="excitation")
     (first, *_) = frequency_responses(records, ["delta_lon"], list(OUTPUTS), options)
-    print(f"{N_SWEEPS} sweeps x {SWEEP_S:g} s x {RATE_HZ:g} Hz, 1 input, {len(OUTPUTS)} outputs, windows "
-          f"{', '.join(f'{t:.2f}' for t in first.windows_s)} s, overlap {options.overlap:g}, {first.omega.size} "
-          f"frequencies; {os.cpu_count()} CPUs")
-    ours, ours_cpu = best_with_cpu(lambda: frequency_responses(records, ["delta_lon"], list(OUTPUTS), options),
-                                   args.repeat)
+    print(
+        f"{N_SWEEPS} sweeps x {SWEEP_S:g} s x {RATE_HZ:g} Hz, 1 input, {len(OUTPUTS)} outputs, windows "
+        f"{', '.join(f'{t:.2f}' for t in first.windows_s)} s, overlap {options.overlap:g}, {first.omega.size} "
+        f"frequencies; {os.cpu_count()} CPUs"
+    )
+    ours, ours_cpu = best_with_cpu(
+        lambda: frequency_responses(records, ["delta_lon"], list(OUTPUTS), options), args.repeat
+    )
     czt = best(lambda: frequency_responses(records, ["delta_lon"], list(OUTPUTS), linear), args.repeat)
     windows = best(lambda: frequency_responses(records, ["delta_lon"], list(OUTPUTS), windows_only), args.repeat)
     with_reference = best(lambda: frequency_responses(records, ["delta_lon"], list(OUTPUTS), referenced), args.repeat)

@@ -25,10 +25,10 @@ def main() -> None:
     for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[name] = str(args.threads)
 
-    from sysid.sim.campaign import scenario_trials
-    from sysid.sim.nonlinear import simulate_flights, truth_parameters
-    from sysid.sim.presets import OCTO_S1000
-    from sysid.sim.scenario import load_builtin
+    from simulator.campaign.fly import scenario_trials
+    from simulator.campaign.scenario import load_builtin
+    from simulator.flights.nonlinear import simulate_flights, truth_parameters
+    from simulator.vehicle.presets import OCTO_S1000
 
     truth_parameters(OCTO_S1000)  # linearise once, outside the timing
     campaign = scenario_trials(load_builtin("chapter3-campaign"))
@@ -38,8 +38,10 @@ def main() -> None:
     batch_s = time.perf_counter() - start
     flown = sum(f.time_s.size for f in flights) / 100.0
     print(f"campaign: {len(flights)} trials, {flown:.0f} s of flight, {steps} trial-steps at 400 Hz ({args.method})")
-    print(f"batched:  {batch_s:6.1f} s wall  ({batch_s / len(flights) * 1e3:6.1f} ms per trial,"
-          f" {flown / batch_s:5.0f}x real time)")
+    print(
+        f"batched:  {batch_s:6.1f} s wall  ({batch_s / len(flights) * 1e3:6.1f} ms per trial,"
+        f" {flown / batch_s:5.0f}x real time)"
+    )
 
     sample = campaign[:: max(1, len(campaign) // args.one_by_one)][: args.one_by_one]
     start = time.perf_counter()
@@ -48,8 +50,10 @@ def main() -> None:
     alone_s = time.perf_counter() - start
     share = sum(t.duration_s for t in sample) / sum(t.duration_s for t in campaign)
     alone_total = alone_s / share
-    print(f"alone:    {alone_s:6.1f} s for {len(sample)} trials -> {alone_total:6.1f} s for the campaign (extrapolated"
-          f" by flight time)")
+    print(
+        f"alone:    {alone_s:6.1f} s for {len(sample)} trials -> {alone_total:6.1f} s for the campaign (extrapolated"
+        f" by flight time)"
+    )
     print(f"ratio:    one by one / batched = {alone_total / batch_s:5.1f}x per trial")
 
 

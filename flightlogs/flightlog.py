@@ -4,14 +4,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from types import MappingProxyType
 from typing import Literal
 
 import numpy as np
 
-from .signals import LOGGED_SIGNALS, is_canonical
+from flightlogs.signals import LOGGED_SIGNALS, is_canonical
 
 __all__ = ["Signal", "SystemIdRun", "FlightLog", "Autopilot", "LogFormat"]
 
@@ -50,8 +50,7 @@ class Signal:
         values = np.ascontiguousarray(self.values, dtype=np.float64)
         if time_s.ndim != 1 or values.shape != time_s.shape:
             raise ValueError(
-                f"signal {self.name!r}: time_s {time_s.shape} and values {values.shape} "
-                "must be 1-D of equal length"
+                f"signal {self.name!r}: time_s {time_s.shape} and values {values.shape} must be 1-D of equal length"
             )
         if not is_canonical(self.name):
             raise ValueError(f"{self.name!r} is not a canonical signal name")
@@ -169,7 +168,7 @@ class FlightLog:
         object.__setattr__(self, "system_id_runs", tuple(self.system_id_runs))
 
     def __getitem__(self, name: str) -> Signal:
-        from .errors import MissingSignalError
+        from flightlogs.errors import MissingSignalError
 
         try:
             return self.signals[name]
@@ -204,4 +203,4 @@ class FlightLog:
         """UTC of the first sample, or None without GPS time."""
         if self.utc_offset_s is None or not self.signals:
             return None
-        return datetime.fromtimestamp(self.time_range_s[0] + self.utc_offset_s, tz=timezone.utc)
+        return datetime.fromtimestamp(self.time_range_s[0] + self.utc_offset_s, tz=UTC)

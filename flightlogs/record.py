@@ -10,7 +10,7 @@ from types import MappingProxyType
 import numpy as np
 import pandas as pd
 
-from .errors import MissingSignalError
+from flightlogs.errors import MissingSignalError
 
 __all__ = ["Record"]
 
@@ -54,7 +54,9 @@ class Record:
         if missing_units:
             raise ValueError(f"record {self.label!r}: no unit for {missing_units}")
         object.__setattr__(self, "units", MappingProxyType({c: self.units[c] for c in self.table.columns}))
-        object.__setattr__(self, "trim", MappingProxyType({c: float(self.trim.get(c, 0.0)) for c in self.table.columns}))
+        object.__setattr__(
+            self, "trim", MappingProxyType({c: float(self.trim.get(c, 0.0)) for c in self.table.columns})
+        )
         self.table.index.name = "time_s"
         self.table.attrs["units"] = dict(self.units)
 
@@ -111,5 +113,10 @@ class Record:
             Label of the piece; default the record's own with the bounds.
         """
         piece = self.table.loc[start_s:end_s].copy()
-        return Record(piece, self.units, self.trim, self.source,
-                      label if label is not None else f"{self.label} [{start_s:.2f}, {end_s:.2f}] s")
+        return Record(
+            piece,
+            self.units,
+            self.trim,
+            self.source,
+            label if label is not None else f"{self.label} [{start_s:.2f}, {end_s:.2f}] s",
+        )

@@ -79,8 +79,24 @@ CANONICAL_SIGNALS: dict[str, SignalSpec] = {spec.name: spec for spec in _SPECS}
 #: Signals a reader is expected to find in a flight log (``motor_1..n`` aside).
 #: The ones it cannot find are reported as missing, by name.
 LOGGED_SIGNALS: tuple[str, ...] = (
-    "p", "q", "r", "phi", "theta", "psi", "vn", "ve", "vd", "ax", "ay", "az",
-    "delta_lat", "delta_lon", "delta_yaw", "delta_thr", "height_agl", "battery_v",
+    "p",
+    "q",
+    "r",
+    "phi",
+    "theta",
+    "psi",
+    "vn",
+    "ve",
+    "vd",
+    "ax",
+    "ay",
+    "az",
+    "delta_lat",
+    "delta_lon",
+    "delta_yaw",
+    "delta_thr",
+    "height_agl",
+    "battery_v",
 )
 
 #: Optional signals a reader adds when the autopilot logs them. ``latitude``

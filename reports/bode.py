@@ -12,7 +12,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter, NullLocator
 
-from flightlogs.atomic import atomic_output
+from flightlogs.writers.atomic import atomic_output
 from sysid.freqresp import FrequencyResponse
 
 from .svg import figure_svg, new_figure
@@ -150,8 +150,9 @@ def _layout(grid: np.ndarray, width_in: float, height_in: float) -> None:
             elif panel:
                 top -= _GAP_IN
             bottom = top - _PANEL_IN[panel]
-            grid[row, col].set_position([left / width_in, bottom / height_in, column_width / width_in,
-                                         _PANEL_IN[panel] / height_in])
+            grid[row, col].set_position(
+                [left / width_in, bottom / height_in, column_width / width_in, _PANEL_IN[panel] / height_in]
+            )
             top = bottom
 
 
@@ -189,18 +190,21 @@ def _model_values(models: Mapping[str, ModelResponse] | None, response: Frequenc
     return values
 
 
-def _draw(panels: np.ndarray, response: FrequencyResponse, model: np.ndarray | None,
-          min_coherence: float | None) -> None:
+def _draw(
+    panels: np.ndarray, response: FrequencyResponse, model: np.ndarray | None, min_coherence: float | None
+) -> None:
     magnitude, phase, coherence = panels
     omega = response.omega
     magnitude.semilogx(omega, response.magnitude_db, color=_DATA, lw=1.2, label="flight data")
     phase.semilogx(omega, response.phase_deg, color=_DATA, lw=1.2)
     coherence.semilogx(omega, response.coherence, color=_DATA, lw=1.2)
     if model is not None:
-        model_phase = _nearest_branch(np.asarray(response.phase_deg, dtype=float),
-                                      np.degrees(np.unwrap(np.angle(model))))
-        magnitude.semilogx(omega, 20 * np.log10(np.maximum(np.abs(model), 1e-300)), color=_MODEL, lw=1.2,
-                           ls="--", label="model")
+        model_phase = _nearest_branch(
+            np.asarray(response.phase_deg, dtype=float), np.degrees(np.unwrap(np.angle(model)))
+        )
+        magnitude.semilogx(
+            omega, 20 * np.log10(np.maximum(np.abs(model), 1e-300)), color=_MODEL, lw=1.2, ls="--", label="model"
+        )
         phase.semilogx(omega, model_phase, color=_MODEL, lw=1.2, ls="--")
     if response.fit_range is not None:
         for ax in panels:

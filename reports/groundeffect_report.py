@@ -25,10 +25,18 @@ __all__ = [
     "write_spacing_report",
 ]
 
-_COLOURS = {"cheeseman_bennett": "#7f7f7f", "corrected": "#c0392b", "exponential": "#2e8b57",
-            "piecewise_linear": "#1f4e79"}
-_LABELS = {"cheeseman_bennett": "Cheeseman–Bennett (2.1)", "corrected": "corrected ρ (2.2)",
-           "exponential": "exponential (2.3)", "piecewise_linear": "piecewise linear (2.5)"}
+_COLOURS = {
+    "cheeseman_bennett": "#7f7f7f",
+    "corrected": "#c0392b",
+    "exponential": "#2e8b57",
+    "piecewise_linear": "#1f4e79",
+}
+_LABELS = {
+    "cheeseman_bennett": "Cheeseman–Bennett (2.1)",
+    "corrected": "corrected ρ (2.2)",
+    "exponential": "exponential (2.3)",
+    "piecewise_linear": "piecewise linear (2.5)",
+}
 _DATA = "#222222"
 _CRITERIA = {"aicc": "AICc", "bic": "BIC"}
 
@@ -65,8 +73,14 @@ def fit_figure(fit: GroundEffectFit, *, ax: Any = None, legend: bool = True) -> 
     x = _curve_x(fit)
     for model in fit.models:
         chosen = model.name == fit.best
-        axes.plot(x, model.ratio(x), color=_COLOURS[model.name], lw=2.2 if chosen else 1.1,
-                  ls="-" if chosen else "--", label=_LABELS[model.name] + (" — chosen" if chosen else ""))
+        axes.plot(
+            x,
+            model.ratio(x),
+            color=_COLOURS[model.name],
+            lw=2.2 if chosen else 1.1,
+            ls="-" if chosen else "--",
+            label=_LABELS[model.name] + (" — chosen" if chosen else ""),
+        )
     axes.plot(fit.data.height_ratio, fit.data.thrust_ratio, "o", ms=3.2, color=_DATA, alpha=0.7, label="data")
     axes.set_xlabel("Z/R")
     axes.set_ylabel("F/F0")
@@ -116,10 +130,21 @@ def steps_figure(steps: HoverSteps, rotor_radius_m: float) -> Figure:
     figure, ax = _figure(width_in=7.0, height_in=2.8)
     ax.plot(steps.time_s, steps.height_m, color=_DATA, lw=0.9, label="height (0.5 s means)")
     for i, step in enumerate(steps.steps):
-        ax.axvspan(step.steady_start_s, step.end_s, color="#2e8b57", alpha=0.18, lw=0,
-                   label="steady half used" if i == 0 else None)
-        ax.plot([step.steady_start_s, step.end_s], [step.height_m] * 2, color="#c0392b", lw=1.6,
-                label="step mean" if i == 0 else None)
+        ax.axvspan(
+            step.steady_start_s,
+            step.end_s,
+            color="#2e8b57",
+            alpha=0.18,
+            lw=0,
+            label="steady half used" if i == 0 else None,
+        )
+        ax.plot(
+            [step.steady_start_s, step.end_s],
+            [step.height_m] * 2,
+            color="#c0392b",
+            lw=1.6,
+            label="step mean" if i == 0 else None,
+        )
     ax.set_xlabel("time (s)")
     ax.set_ylabel("height (m)")
     right = ax.secondary_yaxis("right", functions=(lambda h: h / rotor_radius_m, lambda r: r * rotor_radius_m))
@@ -155,8 +180,16 @@ def spacing_figure(study: SpacingStudy) -> Figure:
             ax.axvline(study.transition_m * 1e3, color="#9a6700", lw=1.0, ls="--")
     if show_rho:
         rho, low, high = study.parameter("corrected", "rho")
-        axes[2].errorbar(spacing_mm, rho, yerr=[rho - low, high - rho], fmt="o-", color=_COLOURS["corrected"],
-                         capsize=3, ms=4, lw=1.2)
+        axes[2].errorbar(
+            spacing_mm,
+            rho,
+            yerr=[rho - low, high - rho],
+            fmt="o-",
+            color=_COLOURS["corrected"],
+            capsize=3,
+            ms=4,
+            lw=1.2,
+        )
         axes[2].set_ylabel("ρ (eq. 2.2)")
     for ax in axes:
         ax.set_xlabel("rotor spacing increment (mm)")
@@ -176,8 +209,13 @@ def _spacing_curves(study: SpacingStudy) -> Figure:
         x = _curve_x(fit)
         ax.plot(fit.data.height_ratio, fit.data.thrust_ratio, "o", ms=2.2, color=_DATA, alpha=0.5)
         for name in study.families:
-            ax.plot(x, fit.model(name).ratio(x), color=_COLOURS[name], lw=2.0 if name == chosen else 1.0,
-                    ls="-" if name == chosen else "--")
+            ax.plot(
+                x,
+                fit.model(name).ratio(x),
+                color=_COLOURS[name],
+                lw=2.0 if name == chosen else 1.0,
+                ls="-" if name == chosen else "--",
+            )
         ax.set_title(f"{spacing * 1e3:g} mm: {_LABELS[chosen]}", fontsize=8, loc="left")
         ax.set_xlabel("Z/R", fontsize=8)
         ax.set_ylabel("F/F0", fontsize=8)
@@ -190,16 +228,29 @@ def _spacing_curves(study: SpacingStudy) -> Figure:
 def _model_rows(fit: GroundEffectFit) -> list[dict[str, Any]]:
     rows = []
     for model in fit.models:
-        rows.append({"name": model.name, "label": _LABELS[model.name], "params": _param_rows(model),
-                     "rmse": model.rmse, "r2": model.r2, "aicc": model.aicc, "bic": model.bic,
-                     "delta": fit.delta(model.name), "chosen": model.name == fit.best, "notes": list(model.notes),
-                     "n_free": model.n_free})
+        rows.append(
+            {
+                "name": model.name,
+                "label": _LABELS[model.name],
+                "params": _param_rows(model),
+                "rmse": model.rmse,
+                "r2": model.r2,
+                "aicc": model.aicc,
+                "bic": model.bic,
+                "delta": fit.delta(model.name),
+                "chosen": model.name == fit.best,
+                "notes": list(model.notes),
+                "n_free": model.n_free,
+            }
+        )
     return rows
 
 
 def _param_rows(model: ModelFit) -> list[dict[str, Any]]:
-    return [{"name": n, "value": v, "low": lo, "high": hi}
-            for n, v, lo, hi in zip(model.param_names, model.values, model.ci_low, model.ci_high)]
+    return [
+        {"name": n, "value": v, "low": lo, "high": hi}
+        for n, v, lo, hi in zip(model.param_names, model.values, model.ci_low, model.ci_high)
+    ]
 
 
 def render_groundeffect_report(fit: GroundEffectFit, *, title: str | None = None) -> str:
@@ -220,13 +271,23 @@ def render_groundeffect_report(fit: GroundEffectFit, *, title: str | None = None
     data = fit.data
     steps = data.steps
     return render_html(
-        "groundeffect.html", kind="fit", title=title or f"Ground effect: {data.source or 'data'}",
-        fit_svg=figure_svg(fit_figure(fit)), residual_svg=figure_svg(residual_figure(fit)),
+        "groundeffect.html",
+        kind="fit",
+        title=title or f"Ground effect: {data.source or 'data'}",
+        fit_svg=figure_svg(fit_figure(fit)),
+        residual_svg=figure_svg(residual_figure(fit)),
         steps_svg=figure_svg(steps_figure(steps, data.rotor_radius_m)) if steps is not None else None,
-        steps=list(steps.steps) if steps is not None else [], dropped=list(steps.dropped) if steps else [],
-        rows=_model_rows(fit), best=_LABELS[fit.best], criterion=_CRITERIA[fit.criterion],
-        confidence=fit.confidence, source=data.source, f0_source=data.f0_source, n_points=data.n_points,
-        rotor_radius_m=data.rotor_radius_m, x_range=(float(data.height_ratio.min()), float(data.height_ratio.max())),
+        steps=list(steps.steps) if steps is not None else [],
+        dropped=list(steps.dropped) if steps else [],
+        rows=_model_rows(fit),
+        best=_LABELS[fit.best],
+        criterion=_CRITERIA[fit.criterion],
+        confidence=fit.confidence,
+        source=data.source,
+        f0_source=data.f0_source,
+        n_points=data.n_points,
+        rotor_radius_m=data.rotor_radius_m,
+        x_range=(float(data.height_ratio.min()), float(data.height_ratio.max())),
     )
 
 
@@ -268,16 +329,32 @@ def render_spacing_report(study: SpacingStudy, *, title: str | None = None) -> s
     names = [m.name for m in study.fits[0].models]
     rows = []
     for spacing, fit, chosen in zip(study.spacings_m, study.fits, study.chosen):
-        rows.append({"spacing_mm": spacing * 1e3, "source": fit.data.source, "n_points": fit.data.n_points,
-                     "models": [{"name": n, "r2": fit.model(n).r2, "rmse": fit.model(n).rmse,
-                                 "params": _param_rows(fit.model(n))} for n in names],
-                     "chosen": _LABELS[chosen], "best_overall": _LABELS[fit.best]})
+        rows.append(
+            {
+                "spacing_mm": spacing * 1e3,
+                "source": fit.data.source,
+                "n_points": fit.data.n_points,
+                "models": [
+                    {"name": n, "r2": fit.model(n).r2, "rmse": fit.model(n).rmse, "params": _param_rows(fit.model(n))}
+                    for n in names
+                ],
+                "chosen": _LABELS[chosen],
+                "best_overall": _LABELS[fit.best],
+            }
+        )
     return render_html(
-        "groundeffect.html", kind="spacing", title=title or f"Rotor-spacing study, {study.rotors} rotors",
-        spacing_svg=figure_svg(spacing_figure(study)), curves_svg=figure_svg(_spacing_curves(study)),
-        rows=rows, names=[_LABELS[n] for n in names], families=[_LABELS[f] for f in study.families],
+        "groundeffect.html",
+        kind="spacing",
+        title=title or f"Rotor-spacing study, {study.rotors} rotors",
+        spacing_svg=figure_svg(spacing_figure(study)),
+        curves_svg=figure_svg(_spacing_curves(study)),
+        rows=rows,
+        names=[_LABELS[n] for n in names],
+        families=[_LABELS[f] for f in study.families],
         transition_mm=None if study.transition_m is None else study.transition_m * 1e3,
-        criterion=_CRITERIA[study.fits[0].criterion], confidence=study.fits[0].confidence, rotors=study.rotors,
+        criterion=_CRITERIA[study.fits[0].criterion],
+        confidence=study.fits[0].confidence,
+        rotors=study.rotors,
     )
 
 

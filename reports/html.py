@@ -12,7 +12,7 @@ from typing import Any
 import jinja2
 from markupsafe import Markup
 
-from flightlogs.atomic import atomic_output
+from flightlogs.writers.atomic import atomic_output
 
 __all__ = ["render_html", "write_html", "software_versions"]
 
@@ -57,7 +57,7 @@ def render_html(template: str, **context: Any) -> str:
     str
         One HTML document with inline CSS and SVG: no network fetches.
     """
-    context.setdefault("generated_utc", _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"))
+    context.setdefault("generated_utc", _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"))
     context.setdefault("versions", software_versions())
     return _ENVIRONMENT.get_template(template).render(**context)
 

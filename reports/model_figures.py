@@ -12,8 +12,8 @@ from matplotlib.figure import Figure
 
 from sysid.fit import IdentifiedModel
 from sysid.freqresp import FrequencyResponse
-from sysid.modes import Mode
-from sysid.statespace import DelayedStateSpace
+from sysid.model.modes import Mode
+from sysid.model.statespace import DelayedStateSpace
 
 from .bode import bode_figure
 from .svg import new_figure
@@ -21,11 +21,20 @@ from .svg import new_figure
 __all__ = ["pair_response", "response_figures", "correlation_figure", "pole_map_figure", "plain_text"]
 
 #: What each mixer input commands, for captions.
-INPUT_AXES = {"delta_lat": "roll (lateral)", "delta_lon": "pitch (longitudinal)", "delta_yaw": "yaw",
-              "delta_thr": "thrust (heave)"}
+INPUT_AXES = {
+    "delta_lat": "roll (lateral)",
+    "delta_lon": "pitch (longitudinal)",
+    "delta_yaw": "yaw",
+    "delta_thr": "thrust (heave)",
+}
 #: Colour and marker of each mode: markers differ too, so coinciding poles stay apart in grey print.
-_MODE_STYLES = {"roll": ("#0969da", "x"), "pitch": ("#c0392b", "+"), "yaw": ("#2e8b57", "o"),
-                "heave": ("#8250df", "s"), "actuator": ("#6e7781", "D")}
+_MODE_STYLES = {
+    "roll": ("#0969da", "x"),
+    "pitch": ("#c0392b", "+"),
+    "yaw": ("#2e8b57", "o"),
+    "heave": ("#8250df", "s"),
+    "actuator": ("#6e7781", "D"),
+}
 _OTHER_STYLES = (("#b35900", "^"), ("#1b7c83", "v"), ("#953800", "<"), ("#5a32a3", ">"))
 
 
@@ -119,8 +128,10 @@ def response_figures(model: IdentifiedModel, *, min_coherence: float | None = No
         figure = bode_figure(responses, models=overlays, min_coherence=min_coherence)
         axis = INPUT_AXES.get(signal, signal)
         conditioned = sorted({name for r in responses for name in r.conditioned_on})
-        caption = (f"Responses to {signal} ({axis} mixer input): flight data (solid) and identified model "
-                   f"(dashed); the fit range is shaded")
+        caption = (
+            f"Responses to {signal} ({axis} mixer input): flight data (solid) and identified model "
+            f"(dashed); the fit range is shaded"
+        )
         if min_coherence is not None:
             caption += f", dotted line γ² = {min_coherence:g}"
         if conditioned:
@@ -173,8 +184,15 @@ def correlation_figure(names: Sequence[str], correlation: np.ndarray, *, thresho
         for j in range(n):
             value = matrix[i, j]
             if i != j and np.isfinite(value) and abs(value) > threshold:
-                ax.text(j, i, f"{value:.2f}".replace("0.", "."), ha="center", va="center", fontsize=6.5,
-                        color="white" if abs(value) > 0.6 else "black")
+                ax.text(
+                    j,
+                    i,
+                    f"{value:.2f}".replace("0.", "."),
+                    ha="center",
+                    va="center",
+                    fontsize=6.5,
+                    color="white" if abs(value) > 0.6 else "black",
+                )
     bar = figure.colorbar(image, ax=ax, fraction=0.046, pad=0.03)
     bar.set_label("correlation coefficient r")
     return figure
@@ -191,8 +209,17 @@ def _draw_poles(ax: Axes, found: Sequence[Mode], others: dict[str, tuple[str, st
     for mode in found:
         colour, marker = _style(mode.mode, others)
         imag = [mode.imag, -mode.imag] if mode.imag > 0 else [0.0]
-        ax.plot([mode.real] * len(imag), imag, ls="none", marker=marker, ms=8 if marker in "x+" else 7,
-                mew=1.6, color=colour, mfc="none", label=plain_text(mode.mode) if mode.mode not in seen else None)
+        ax.plot(
+            [mode.real] * len(imag),
+            imag,
+            ls="none",
+            marker=marker,
+            ms=8 if marker in "x+" else 7,
+            mew=1.6,
+            color=colour,
+            mfc="none",
+            label=plain_text(mode.mode) if mode.mode not in seen else None,
+        )
         seen.add(mode.mode)
     ax.axvline(0.0, color="0.25", lw=0.8)
     ax.axhline(0.0, color="0.6", lw=0.6)
@@ -223,7 +250,7 @@ def pole_map_figure(found: Sequence[Mode]) -> Figure:
     Parameters
     ----------
     found : sequence of Mode
-        Modes from :func:`sysid.modes.modes` (a complex pair is drawn with its conjugate).
+        Modes from :func:`sysid.model.modes.modes` (a complex pair is drawn with its conjugate).
 
     Returns
     -------
@@ -236,7 +263,7 @@ def pole_map_figure(found: Sequence[Mode]) -> Figure:
 
     Examples
     --------
-    >>> from sysid.modes import Mode
+    >>> from sysid.model.modes import Mode
     >>> fig = pole_map_figure([Mode(-1.0, 2.0, 0.45, 2.24, float("inf"), 0.69, "pitch", "stable")])
     >>> len(fig.axes)
     1
@@ -257,7 +284,6 @@ def pole_map_figure(found: Sequence[Mode]) -> Figure:
         _shade_unstable(ax, x_high, y_limit)
         ax.set_xlim(x_low, x_high)
         ax.set_ylim(-y_limit, y_limit)
-        ax.set_title("all poles" if zoom and k == 0 else "near the origin" if zoom else "poles", fontsize=9,
-                     loc="left")
+        ax.set_title("all poles" if zoom and k == 0 else "near the origin" if zoom else "poles", fontsize=9, loc="left")
     figure.tight_layout(w_pad=1.5)
     return figure

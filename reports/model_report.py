@@ -22,7 +22,7 @@ import numpy as np
 
 from sysid.fit import IdentifiedModel
 from sysid.freqresp import FrequencyResponse
-from sysid.modes import Mode, modes
+from sysid.model.modes import Mode, modes
 from sysid.verify import Verification
 
 from .html import render_html, write_html
@@ -30,9 +30,21 @@ from .model_figures import correlation_figure, pole_map_figure, response_figures
 from .svg import figure_svg
 from .verify_section import TIC_ACCEPTABLE, TIC_GOOD, sized_svg, verification_context
 
-__all__ = ["J_AVE_GOOD", "J_AVE_ACCEPTABLE", "J_RESPONSE_MAX", "CR_MAX_PERCENT", "INSENSITIVITY_MAX_PERCENT",
-           "CORRELATION_FLAG", "TIC_GOOD", "TIC_ACCEPTABLE", "Check", "Verdict", "model_verdict",
-           "model_report_html", "write_model_report"]
+__all__ = [
+    "J_AVE_GOOD",
+    "J_AVE_ACCEPTABLE",
+    "J_RESPONSE_MAX",
+    "CR_MAX_PERCENT",
+    "INSENSITIVITY_MAX_PERCENT",
+    "CORRELATION_FLAG",
+    "TIC_GOOD",
+    "TIC_ACCEPTABLE",
+    "Check",
+    "Verdict",
+    "model_verdict",
+    "model_report_html",
+    "write_model_report",
+]
 
 #: J_ave of a good fit (eq. 3.9; Tischler & Remple).
 J_AVE_GOOD = 100.0
@@ -101,36 +113,72 @@ def _worst(grades: Sequence[Grade]) -> Grade:
 
 def _misses(p: Any) -> bool:
     cr, ins = p.cr_percent, p.insensitivity_percent
-    return p.status == "estimated" and ((math.isfinite(cr) and cr > CR_MAX_PERCENT)
-                                        or (math.isfinite(ins) and ins > INSENSITIVITY_MAX_PERCENT))
+    return p.status == "estimated" and (
+        (math.isfinite(cr) and cr > CR_MAX_PERCENT) or (math.isfinite(ins) and ins > INSENSITIVITY_MAX_PERCENT)
+    )
 
 
 def _cost_checks(model: IdentifiedModel) -> list[Check]:
     j = model.cost.average
     grade: Grade = "good" if j <= J_AVE_GOOD else "acceptable" if j <= J_AVE_ACCEPTABLE else "poor"
-    problem = "" if grade == "good" else (f"J_ave = {j:.1f} is above {J_AVE_GOOD:g}"
-                                          + (f" (acceptable up to {J_AVE_ACCEPTABLE:g})" if grade == "acceptable"
-                                             else f" and {J_AVE_ACCEPTABLE:g}"))
-    checks = [Check("average cost J_ave", f"{j:.1f}", f"≤ {J_AVE_GOOD:g} good, ≤ {J_AVE_ACCEPTABLE:g} acceptable",
-                    grade, problem)]
+    problem = (
+        ""
+        if grade == "good"
+        else (
+            f"J_ave = {j:.1f} is above {J_AVE_GOOD:g}"
+            + (f" (acceptable up to {J_AVE_ACCEPTABLE:g})" if grade == "acceptable" else f" and {J_AVE_ACCEPTABLE:g}")
+        )
+    )
+    checks = [
+        Check(
+            "average cost J_ave",
+            f"{j:.1f}",
+            f"≤ {J_AVE_GOOD:g} good, ≤ {J_AVE_ACCEPTABLE:g} acceptable",
+            grade,
+            problem,
+        )
+    ]
     over = {k: v for k, v in model.cost.responses.items() if not v <= J_RESPONSE_MAX}
     worst = max(model.cost.responses.values(), default=math.nan)
-    problem = "" if not over else (f"{len(over)} response cost{'s' if len(over) > 1 else ''} exceed "
-                                   f"{J_RESPONSE_MAX:g} ({', '.join(f'{k} {v:.0f}' for k, v in over.items())})")
-    checks.append(Check("cost of each response J", f"worst {worst:.1f}", f"≤ {J_RESPONSE_MAX:g}",
-                        "acceptable" if over else "good", problem))
+    problem = (
+        ""
+        if not over
+        else (
+            f"{len(over)} response cost{'s' if len(over) > 1 else ''} exceed "
+            f"{J_RESPONSE_MAX:g} ({', '.join(f'{k} {v:.0f}' for k, v in over.items())})"
+        )
+    )
+    checks.append(
+        Check(
+            "cost of each response J",
+            f"worst {worst:.1f}",
+            f"≤ {J_RESPONSE_MAX:g}",
+            "acceptable" if over else "good",
+            problem,
+        )
+    )
     return checks
 
 
 def _parameter_check(model: IdentifiedModel) -> Check:
     estimated = [p for p in model.parameters if p.status == "estimated"]
     failing = [p.name for p in estimated if _misses(p)]
-    problem = "" if not failing else (f"{len(failing)} of {len(estimated)} estimated parameters miss CR ≤ "
-                                      f"{CR_MAX_PERCENT:g} % or I ≤ {INSENSITIVITY_MAX_PERCENT:g} % "
-                                      f"({', '.join(failing)})")
-    return Check("parameter accuracy", f"{len(estimated) - len(failing)} of {len(estimated)} within",
-                 f"CR ≤ {CR_MAX_PERCENT:g} %, I ≤ {INSENSITIVITY_MAX_PERCENT:g} %",
-                 "acceptable" if failing else "good", problem)
+    problem = (
+        ""
+        if not failing
+        else (
+            f"{len(failing)} of {len(estimated)} estimated parameters miss CR ≤ "
+            f"{CR_MAX_PERCENT:g} % or I ≤ {INSENSITIVITY_MAX_PERCENT:g} % "
+            f"({', '.join(failing)})"
+        )
+    )
+    return Check(
+        "parameter accuracy",
+        f"{len(estimated) - len(failing)} of {len(estimated)} within",
+        f"CR ≤ {CR_MAX_PERCENT:g} %, I ≤ {INSENSITIVITY_MAX_PERCENT:g} %",
+        "acceptable" if failing else "good",
+        problem,
+    )
 
 
 def _verification_check(verification: Verification) -> Check | None:
@@ -140,10 +188,21 @@ def _verification_check(verification: Verification) -> Check | None:
     tic = worst.tic
     grade: Grade = "good" if tic <= TIC_GOOD else "acceptable" if tic <= TIC_ACCEPTABLE else "poor"
     shown = f"{tic:.2f}" if round(tic, 2) not in (TIC_GOOD, TIC_ACCEPTABLE) else f"{tic:.3f}"
-    problem = "" if grade == "good" else (f"the worst doublet prediction has TIC {shown} ({worst.name}), above "
-                                          f"{TIC_GOOD:g}" + ("" if grade == "acceptable" else f"-{TIC_ACCEPTABLE:g}"))
-    return Check("prediction of doublets, worst on-axis output TIC", f"{shown} ({worst.name})",
-                 f"≤ {TIC_GOOD:g}-{TIC_ACCEPTABLE:g}", grade, problem)
+    problem = (
+        ""
+        if grade == "good"
+        else (
+            f"the worst doublet prediction has TIC {shown} ({worst.name}), above "
+            f"{TIC_GOOD:g}" + ("" if grade == "acceptable" else f"-{TIC_ACCEPTABLE:g}")
+        )
+    )
+    return Check(
+        "prediction of doublets, worst on-axis output TIC",
+        f"{shown} ({worst.name})",
+        f"≤ {TIC_GOOD:g}-{TIC_ACCEPTABLE:g}",
+        grade,
+        problem,
+    )
 
 
 def model_verdict(model: IdentifiedModel, verification: Verification | None = None) -> Verdict:
@@ -174,13 +233,17 @@ def model_verdict(model: IdentifiedModel, verification: Verification | None = No
     grade = _worst([c.grade for c in checks])
     n = sum(p.status == "estimated" for p in model.parameters)
     fit_ok = all(c.grade == "good" for c in checks if c is not verified)
-    fit_text = (f"J_ave = {model.cost.average:.1f} ≤ {J_AVE_GOOD:g}, every response cost ≤ {J_RESPONSE_MAX:g}, "
-                f"all {n} estimated parameters within CR ≤ {CR_MAX_PERCENT:g} % and I ≤ "
-                f"{INSENSITIVITY_MAX_PERCENT:g} %")
+    fit_text = (
+        f"J_ave = {model.cost.average:.1f} ≤ {J_AVE_GOOD:g}, every response cost ≤ {J_RESPONSE_MAX:g}, "
+        f"all {n} estimated parameters within CR ≤ {CR_MAX_PERCENT:g} % and I ≤ "
+        f"{INSENSITIVITY_MAX_PERCENT:g} %"
+    )
     if grade == "good":
         sentence = f"Good model by Tischler's guidelines: {fit_text}" + (
             f", and doublets predicted with TIC ≤ {TIC_GOOD:g} (worst {verified.value})."
-            if verified is not None else "; not yet verified on doublets.")
+            if verified is not None
+            else "; not yet verified on doublets."
+        )
     else:
         sentence = f"{grade.capitalize()} model: " + "; ".join(c.problem for c in checks if c.problem)
         if fit_ok:
@@ -198,38 +261,52 @@ def _wind_text(model: IdentifiedModel) -> str:
         text = f"mean {math.hypot(north, east):.1f} m/s from {origin:03.0f}° (anemometer, at the vehicle)"
     if model.wind is not None:
         units = {r.output: r.output_unit for r in model.responses}
-        change = ", ".join(f"{o} {b:.3g} → {a:.3g} {units.get(o, '')}".rstrip()
-                           for o, b, a in zip(model.wind.outputs, model.wind.rms_before, model.wind.rms_after))
+        change = ", ".join(
+            f"{o} {b:.3g} → {a:.3g} {units.get(o, '')}".rstrip()
+            for o, b, a in zip(model.wind.outputs, model.wind.rms_before, model.wind.rms_after)
+        )
         text += f"; wind terms G_w fitted on the residual of eq. 3.14 (RMS {change})"
     elif any(p.stage == "wind" for p in model.parameters):
         text += "; the structure's wind terms were not fitted"
     return text
 
 
-def _card(model: IdentifiedModel, verification: Verification | None,
-          logs_summary: Mapping[str, str] | None) -> list[tuple[str, str]]:
+def _card(
+    model: IdentifiedModel, verification: Verification | None, logs_summary: Mapping[str, str] | None
+) -> list[tuple[str, str]]:
     structure = model.structure
     counts = {s: sum(p.status == s for p in model.parameters) for s in ("estimated", "fixed", "dropped")}
     facts: dict[str, str] = {
-        "structure": (f"{model.structure_name}: {structure.description} ({len(structure.states)} states, "
-                      f"{len(structure.outputs)} outputs)"),
+        "structure": (
+            f"{model.structure_name}: {structure.description} ({len(structure.states)} states, "
+            f"{len(structure.outputs)} outputs)"
+        ),
         "data": ", ".join(Path(f).name for f in model.provenance.files) or "not recorded",
     }
     facts.update({str(k): str(v) for k, v in (logs_summary or {}).items()})
     facts.setdefault("wind", _wind_text(model))
     if model.responses:
-        low = min(r.fit_range[0] for r in model.responses if r.fit_range) if any(
-            r.fit_range for r in model.responses) else math.nan
+        low = (
+            min(r.fit_range[0] for r in model.responses if r.fit_range)
+            if any(r.fit_range for r in model.responses)
+            else math.nan
+        )
         high = max((r.fit_range[1] for r in model.responses if r.fit_range), default=math.nan)
-        facts.setdefault("fit", f"{len(model.responses)} responses over {low:.2g}-{high:.3g} rad/s, "
-                                f"J_ave = {model.cost.average:.1f}")
-    facts.setdefault("parameters", f"{counts['estimated']} estimated, {counts['fixed']} fixed, "
-                                   f"{counts['dropped']} dropped by structure reduction")
+        facts.setdefault(
+            "fit", f"{len(model.responses)} responses over {low:.2g}-{high:.3g} rad/s, J_ave = {model.cost.average:.1f}"
+        )
+    facts.setdefault(
+        "parameters",
+        f"{counts['estimated']} estimated, {counts['fixed']} fixed, {counts['dropped']} dropped by structure reduction",
+    )
     if verification is not None:
         sources = ", ".join(dict.fromkeys(r.source.name for r in verification.records))
-        facts.setdefault("verification", f"{len(verification.records)} doublet records from {sources}, each judged "
-                                         f"on the outputs of its axis: overall TIC {verification.tic:.2f}, "
-                                         f"J_rms {verification.rmse:.3g}")
+        facts.setdefault(
+            "verification",
+            f"{len(verification.records)} doublet records from {sources}, each judged "
+            f"on the outputs of its axis: overall TIC {verification.tic:.2f}, "
+            f"J_rms {verification.rmse:.3g}",
+        )
     facts.setdefault("identified", model.provenance.created_utc or "unknown")
     return list(facts.items())
 
@@ -268,9 +345,19 @@ def _parameter_rows(model: IdentifiedModel) -> list[_ParameterRow]:
     rows = []
     for p in model.parameters:
         estimated = p.status == "estimated"
-        rows.append(_ParameterRow(p.name, p.value, p.unit, p.cr_percent, p.insensitivity_percent, p.status, p.stage,
-                                  estimated and p.cr_percent > CR_MAX_PERCENT,
-                                  estimated and p.insensitivity_percent > INSENSITIVITY_MAX_PERCENT))
+        rows.append(
+            _ParameterRow(
+                p.name,
+                p.value,
+                p.unit,
+                p.cr_percent,
+                p.insensitivity_percent,
+                p.status,
+                p.stage,
+                estimated and p.cr_percent > CR_MAX_PERCENT,
+                estimated and p.insensitivity_percent > INSENSITIVITY_MAX_PERCENT,
+            )
+        )
     return rows
 
 
@@ -294,11 +381,19 @@ def _cost_rows(model: IdentifiedModel) -> list[_CostRow]:
 
 
 def _mode_rows(found: Sequence[Mode]) -> list[dict[str, Any]]:
-    return [{"mode": m.mode, "real": m.real, "imag": m.imag, "damping": m.damping,
-             "omega_n": m.natural_frequency_rad_s, "stability": m.stability,
-             "time": m.time_to_double_s if m.stability == "unstable" else m.time_to_half_s,
-             "time_kind": "to double" if m.stability == "unstable" else "to half" if m.stability == "stable" else ""}
-            for m in found]
+    return [
+        {
+            "mode": m.mode,
+            "real": m.real,
+            "imag": m.imag,
+            "damping": m.damping,
+            "omega_n": m.natural_frequency_rad_s,
+            "stability": m.stability,
+            "time": m.time_to_double_s if m.stability == "unstable" else m.time_to_half_s,
+            "time_kind": "to double" if m.stability == "unstable" else "to half" if m.stability == "stable" else "",
+        }
+        for m in found
+    ]
 
 
 def _correlated(names: Sequence[str], matrix: Any) -> list[tuple[str, str, float]]:
@@ -322,10 +417,15 @@ def _flatten(options: Mapping[str, Any], prefix: str = "") -> list[tuple[str, st
     return rows
 
 
-def model_report_html(model: IdentifiedModel, *, verification: Verification | None = None, title: str | None = None,
-                      logs_summary: Mapping[str, str] | None = None,
-                      verification_options: Mapping[str, Any] | None = None,
-                      generated_utc: str | None = None) -> str:
+def model_report_html(
+    model: IdentifiedModel,
+    *,
+    verification: Verification | None = None,
+    title: str | None = None,
+    logs_summary: Mapping[str, str] | None = None,
+    verification_options: Mapping[str, Any] | None = None,
+    generated_utc: str | None = None,
+) -> str:
     """The model report as HTML text.
 
     Parameters
@@ -360,17 +460,33 @@ def model_report_html(model: IdentifiedModel, *, verification: Verification | No
     stages = np.array([model.parameter(name).stage for name in names])
     matrix = np.where(stages[:, None] == stages[None, :], matrix, np.nan)  # the two steps are fitted apart
     context: dict[str, Any] = {
-        "title": title or f"Identified model: {model.structure_name}", "model": model,
-        "verdict": model_verdict(model, verification), "card": _card(model, verification, logs_summary),
-        "bode": [_shown(f, caption) for f, caption in response_figures(
-            model, min_coherence=float(min_coherence) if isinstance(min_coherence, (int, float)) else None)],
-        "parameters": _parameter_rows(model), "costs": _cost_rows(model),
+        "title": title or f"Identified model: {model.structure_name}",
+        "model": model,
+        "verdict": model_verdict(model, verification),
+        "card": _card(model, verification, logs_summary),
+        "bode": [
+            _shown(f, caption)
+            for f, caption in response_figures(
+                model, min_coherence=float(min_coherence) if isinstance(min_coherence, (int, float)) else None
+            )
+        ],
+        "parameters": _parameter_rows(model),
+        "costs": _cost_rows(model),
         "correlation": _shown(correlation_figure(names, matrix), "") if len(names) >= 2 else None,
-        "correlated": _correlated(names, matrix), "n_correlated": len(names),
-        "modes": _mode_rows(found), "poles": _shown(pole_map_figure(found), "") if found else None,
-        "limits": {"cr": CR_MAX_PERCENT, "ins": INSENSITIVITY_MAX_PERCENT, "j_good": J_AVE_GOOD,
-                   "j_ok": J_AVE_ACCEPTABLE, "j_one": J_RESPONSE_MAX, "r": CORRELATION_FLAG, "tic_good": TIC_GOOD,
-                   "tic_ok": TIC_ACCEPTABLE},
+        "correlated": _correlated(names, matrix),
+        "n_correlated": len(names),
+        "modes": _mode_rows(found),
+        "poles": _shown(pole_map_figure(found), "") if found else None,
+        "limits": {
+            "cr": CR_MAX_PERCENT,
+            "ins": INSENSITIVITY_MAX_PERCENT,
+            "j_good": J_AVE_GOOD,
+            "j_ok": J_AVE_ACCEPTABLE,
+            "j_one": J_RESPONSE_MAX,
+            "r": CORRELATION_FLAG,
+            "tic_good": TIC_GOOD,
+            "tic_ok": TIC_ACCEPTABLE,
+        },
         "options": _flatten(model.provenance.options),
         "verification_options": _flatten(verification_options or {}),
         "files": [(f, model.provenance.sha256.get(f, "")) for f in model.provenance.files],
@@ -384,10 +500,16 @@ def model_report_html(model: IdentifiedModel, *, verification: Verification | No
     return render_html("model.html", **context)
 
 
-def write_model_report(path: str | Path, model: IdentifiedModel, *, verification: Verification | None = None,
-                       title: str | None = None, logs_summary: Mapping[str, str] | None = None,
-                       verification_options: Mapping[str, Any] | None = None,
-                       generated_utc: str | None = None) -> Path:
+def write_model_report(
+    path: str | Path,
+    model: IdentifiedModel,
+    *,
+    verification: Verification | None = None,
+    title: str | None = None,
+    logs_summary: Mapping[str, str] | None = None,
+    verification_options: Mapping[str, Any] | None = None,
+    generated_utc: str | None = None,
+) -> Path:
     """Render the model report and write it atomically.
 
     Parameters
@@ -412,6 +534,14 @@ def write_model_report(path: str | Path, model: IdentifiedModel, *, verification
     Path
         The file written.
     """
-    return write_html(path, model_report_html(model, verification=verification, title=title,
-                                              logs_summary=logs_summary, verification_options=verification_options,
-                                              generated_utc=generated_utc))
+    return write_html(
+        path,
+        model_report_html(
+            model,
+            verification=verification,
+            title=title,
+            logs_summary=logs_summary,
+            verification_options=verification_options,
+            generated_utc=generated_utc,
+        ),
+    )

@@ -8,7 +8,7 @@ from typing import Any, Literal
 import numpy as np
 from matplotlib.figure import Figure
 
-from sysid.mrac import CONTROLLERS, ControllerResult, MracComparison, MetricStatistics, Statistic, StepCase
+from simulator.mrac import CONTROLLERS, ControllerResult, MetricStatistics, MracComparison, Statistic, StepCase
 
 from .html import render_html, write_html
 from .svg import figure_svg, new_figure
@@ -20,9 +20,13 @@ _LABELS = {"pid": "PID", "mrac_linear": "MRAC, linear", "mrac_rbf": "MRAC, RBF"}
 _REFERENCE = "#2e8b57"
 _PHASES: tuple[Literal["takeoff", "landing"], ...] = ("takeoff", "landing")
 _PHASE_LABELS = {"takeoff": "take-off", "landing": "landing"}
-_INDICES = (("rise_time_s", "rise time (s)", 1.0), ("steady_state_error_m", "SSE (mm)", 1e3),
-            ("mse_m2", "MSE to reference (mm²)", 1e6), ("overshoot_percent", "overshoot (%)", 1.0),
-            ("settling_time_s", "settling time (s)", 1.0))
+_INDICES = (
+    ("rise_time_s", "rise time (s)", 1.0),
+    ("steady_state_error_m", "SSE (mm)", 1e3),
+    ("mse_m2", "MSE to reference (mm²)", 1e6),
+    ("overshoot_percent", "overshoot (%)", 1.0),
+    ("settling_time_s", "settling time (s)", 1.0),
+)
 
 
 def _every(n_samples: int, most: int = 600) -> slice:
@@ -40,8 +44,7 @@ def _phase_axis(result: ControllerResult, phase: str) -> tuple[np.ndarray, slice
 def _title(case: StepCase) -> str:
     if case.in_ground_effect:
         return f"Z/R ≈ {case.height_ratio:g}: ground ↔ {100 * case.high_m:.2f} cm"
-    return (f"Z/R ≈ {case.height_ratio:g}: {100 * case.low_m:.1f} ↔ {100 * case.high_m:.1f} cm "
-            "(out of ground effect)")
+    return f"Z/R ≈ {case.height_ratio:g}: {100 * case.low_m:.1f} ↔ {100 * case.high_m:.1f} cm (out of ground effect)"
 
 
 def height_figure(comparison: MracComparison, height_ratio: float) -> Figure:
@@ -72,10 +75,22 @@ def height_figure(comparison: MracComparison, height_ratio: float) -> Figure:
             ax.fill_between(t, mean - std, mean + std, color=colour, alpha=0.2, linewidth=0)
             ax.plot(t, mean, color=colour, linewidth=1.3, label=_LABELS[result.controller])
         t, rows, every = _phase_axis(longest, phase)
-        ax.plot(t, 100 * longest.reference_m[rows][every], color=_REFERENCE, linestyle="--",
-                linewidth=1.1, label="reference (2.20)")
-        ax.plot(t, 100 * longest.run.command_m[rows, 0][every], color="#222222", linestyle=":",
-                linewidth=1.0, label="command")
+        ax.plot(
+            t,
+            100 * longest.reference_m[rows][every],
+            color=_REFERENCE,
+            linestyle="--",
+            linewidth=1.1,
+            label="reference (2.20)",
+        )
+        ax.plot(
+            t,
+            100 * longest.run.command_m[rows, 0][every],
+            color="#222222",
+            linestyle=":",
+            linewidth=1.0,
+            label="command",
+        )
         ax.set_title(_PHASE_LABELS[phase])
         ax.set_xlabel("time from the step (s)")
         ax.set_ylabel("height above ground (cm)")
@@ -138,8 +153,15 @@ def rise_time_figure(comparison: MracComparison) -> Figure:
     for k, name in enumerate(names):
         stats = [comparison.statistics(name, height_ratio=c.height_ratio, phase=p).rise_time_s for c, p in groups]
         x = np.arange(len(groups)) + (k - (len(names) - 1) / 2) * width
-        ax.bar(x, [s.mean for s in stats], width, yerr=[s.std for s in stats], color=_COLOURS[name],
-               label=_LABELS[name], capsize=2)
+        ax.bar(
+            x,
+            [s.mean for s in stats],
+            width,
+            yerr=[s.std for s in stats],
+            color=_COLOURS[name],
+            label=_LABELS[name],
+            capsize=2,
+        )
     ax.set_xticks(np.arange(len(groups)))
     ax.set_xticklabels([f"{c.height_ratio:g} {'up' if p == 'takeoff' else 'down'}" for c, p in groups], fontsize=8)
     ax.set_xlabel("Z/R and phase")
@@ -153,8 +175,10 @@ def _cell(statistic: Statistic, scale: float) -> dict[str, Any]:
 
 
 def _table(stats: dict[str, MetricStatistics]) -> list[dict[str, Any]]:
-    return [{"label": _LABELS[name], "cells": [_cell(getattr(s, field), scale) for field, _, scale in _INDICES]}
-            for name, s in stats.items()]
+    return [
+        {"label": _LABELS[name], "cells": [_cell(getattr(s, field), scale) for field, _, scale in _INDICES]}
+        for name, s in stats.items()
+    ]
 
 
 def _checks(comparison: MracComparison) -> list[dict[str, Any]]:
@@ -163,8 +187,11 @@ def _checks(comparison: MracComparison) -> list[dict[str, Any]]:
     for case in comparison.cases:
         for phase in _PHASES:
             stats = {n: comparison.statistics(n, height_ratio=case.height_ratio, phase=phase) for n in names}
-            row: dict[str, Any] = {"case": f"{case.height_ratio:g}", "in_ground_effect": case.in_ground_effect,
-                                   "phase": _PHASE_LABELS[phase]}
+            row: dict[str, Any] = {
+                "case": f"{case.height_ratio:g}",
+                "in_ground_effect": case.in_ground_effect,
+                "phase": _PHASE_LABELS[phase],
+            }
             pid = stats["pid"].rise_time_s.mean if "pid" in stats else float("nan")
             for n in ("mrac_linear", "mrac_rbf"):
                 row[n] = stats[n].rise_time_s.mean / pid if n in stats else float("nan")
@@ -174,14 +201,15 @@ def _checks(comparison: MracComparison) -> list[dict[str, Any]]:
     return rows
 
 
-def render_mrac_report(comparison: MracComparison, *,
-                       title: str = "Altitude loop near the ground: PID and MRAC") -> str:
+def render_mrac_report(
+    comparison: MracComparison, *, title: str = "Altitude loop near the ground: PID and MRAC"
+) -> str:
     """The comparison as one self-contained HTML page.
 
     Parameters
     ----------
     comparison : MracComparison
-        The result of :func:`sysid.mrac.compare_controllers`.
+        The result of :func:`simulator.mrac.compare_controllers`.
     title : str, optional
         Page title.
 
@@ -194,20 +222,39 @@ def render_mrac_report(comparison: MracComparison, *,
     cases = []
     for case, analysis in zip(comparison.cases, comparison.analyses):
         theta = theta_figure(comparison, case.height_ratio)
-        cases.append({
-            "title": _title(case), "case": case, "analysis": analysis,
-            "height_svg": figure_svg(height_figure(comparison, case.height_ratio)),
-            "theta_svg": figure_svg(theta) if theta is not None else None,
-            "phases": [{"name": _PHASE_LABELS[p],
-                        "rows": _table({n: comparison.statistics(n, height_ratio=case.height_ratio, phase=p)
-                                        for n in names})} for p in _PHASES],
-        })
+        cases.append(
+            {
+                "title": _title(case),
+                "case": case,
+                "analysis": analysis,
+                "height_svg": figure_svg(height_figure(comparison, case.height_ratio)),
+                "theta_svg": figure_svg(theta) if theta is not None else None,
+                "phases": [
+                    {
+                        "name": _PHASE_LABELS[p],
+                        "rows": _table(
+                            {n: comparison.statistics(n, height_ratio=case.height_ratio, phase=p) for n in names}
+                        ),
+                    }
+                    for p in _PHASES
+                ],
+            }
+        )
     vehicle = comparison.vehicle
     return render_html(
-        "mrac.html", title=title, comparison=comparison, config=comparison.config, vehicle=vehicle,
-        indices=[label for _, label, _ in _INDICES], overall=_table({n: comparison.statistics(n) for n in names}),
-        cases=cases, checks=_checks(comparison), rise_svg=figure_svg(rise_time_figure(comparison)),
-        has_mrac=any(n != "pid" for n in names), labels=_LABELS, all_controllers=CONTROLLERS,
+        "mrac.html",
+        title=title,
+        comparison=comparison,
+        config=comparison.config,
+        vehicle=vehicle,
+        indices=[label for _, label, _ in _INDICES],
+        overall=_table({n: comparison.statistics(n) for n in names}),
+        cases=cases,
+        checks=_checks(comparison),
+        rise_svg=figure_svg(rise_time_figure(comparison)),
+        has_mrac=any(n != "pid" for n in names),
+        labels=_LABELS,
+        all_controllers=CONTROLLERS,
     )
 
 

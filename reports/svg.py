@@ -23,8 +23,9 @@ _STYLE: dict[str, Any] = {
 }
 
 
-def new_figure(n_rows: int = 1, n_cols: int = 1, *, width_in: float = 7.5, height_in: float = 3.2,
-               sharex: bool = False) -> tuple[Figure, object]:
+def new_figure(
+    n_rows: int = 1, n_cols: int = 1, *, width_in: float = 7.5, height_in: float = 3.2, sharex: bool = False
+) -> tuple[Figure, object]:
     """A figure in the house style and its axes (an array when more than one).
 
     Parameters

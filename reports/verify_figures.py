@@ -55,16 +55,27 @@ def _score(output: OutputVerification, other: OutputVerification | None) -> str:
     return f"TIC {output.tic:.2f} with $G_w$, {other.tic:.2f} without"
 
 
-def _draw_output(ax: Axes, time_s: np.ndarray, output: OutputVerification, other: OutputVerification | None,
-                 *, wind: bool, small: bool = False) -> None:
+def _draw_output(
+    ax: Axes,
+    time_s: np.ndarray,
+    output: OutputVerification,
+    other: OutputVerification | None,
+    *,
+    wind: bool,
+    small: bool = False,
+) -> None:
     """Measured, model (and model without G_w) of one output, with its TIC (small panels: in the title)."""
     scale, unit = display_scale(output.unit)
     thin = 0.75 if small else 1.0
     ax.plot(time_s, output.measured * scale, label="measured", **(_MEASURED | {"linewidth": 2.2 * thin}))
     if other is not None:
         ax.plot(time_s, other.simulated * scale, label="model without $G_w$", **(_WITHOUT | {"linewidth": 1.1 * thin}))
-    ax.plot(time_s, output.simulated * scale, label="model with $G_w$" if wind else "model",
-            **(_MODEL | {"linewidth": 1.1 * thin}))
+    ax.plot(
+        time_s,
+        output.simulated * scale,
+        label="model with $G_w$" if wind else "model",
+        **(_MODEL | {"linewidth": 1.1 * thin}),
+    )
     label = f"{plain_text(output.name)} [{plain_text(unit)}]"
     ax.margins(x=0)
     if small:
@@ -72,8 +83,17 @@ def _draw_output(ax: Axes, time_s: np.ndarray, output: OutputVerification, other
         ax.set_title(f"TIC {output.tic:.2f}", fontsize=7.5, loc="right", pad=3, color="#5b6575")
         return
     ax.set_ylabel(label)
-    ax.text(0.005, 0.97, _score(output, other), transform=ax.transAxes, ha="left", va="top", fontsize=8,
-            color="#5b6575", bbox={"facecolor": "white", "alpha": 0.75, "edgecolor": "none", "pad": 1.0})
+    ax.text(
+        0.005,
+        0.97,
+        _score(output, other),
+        transform=ax.transAxes,
+        ha="left",
+        va="top",
+        fontsize=8,
+        color="#5b6575",
+        bbox={"facecolor": "white", "alpha": 0.75, "edgecolor": "none", "pad": 1.0},
+    )
     low, high = ax.get_ylim()
     ax.set_ylim(low, high + 0.3 * (high - low))  # room for the score above the traces
 
@@ -103,8 +123,9 @@ def record_figure(result: RecordVerification, *, without_wind: RecordVerificatio
     bottom_in = _OFF_HEAD_IN + _SMALL_IN * off_rows if informative else 0.0
     figure, _ = new_figure(width_in=7.5, height_in=top_in + bottom_in)
     figure.clear()  # laid out in two parts below, in the house style new_figure set
-    parts: list[Any] = (list(cast(np.ndarray, figure.subfigures(2, 1, height_ratios=[top_in, bottom_in])))
-                        if informative else [figure])
+    parts: list[Any] = (
+        list(cast(np.ndarray, figure.subfigures(2, 1, height_ratios=[top_in, bottom_in]))) if informative else [figure]
+    )
     axes = np.atleast_1d(cast(np.ndarray, parts[0].subplots(len(judged), 1, sharex=True)))
     parts[0].subplots_adjust(top=1.0 - _TITLE_IN / top_in, bottom=_FOOT_IN / top_in, hspace=0.25)
 
@@ -118,25 +139,35 @@ def record_figure(result: RecordVerification, *, without_wind: RecordVerificatio
     axes[-1].set_xlabel("time [s]")
     axes[0].set_title(plain_text(result.label), fontsize=9, loc="left")
     if result.unstable:
-        axes[0].set_title(f"{mode_names(result.unstable_modes)} unstable: grows {result.growth:.0f}-fold", fontsize=8,
-                          loc="right",
-                          color="#9a6700")
+        axes[0].set_title(
+            f"{mode_names(result.unstable_modes)} unstable: grows {result.growth:.0f}-fold",
+            fontsize=8,
+            loc="right",
+            color="#9a6700",
+        )
     axes[-1].legend(loc="upper center", bbox_to_anchor=(0.5, -0.45), ncol=3, frameon=False, fontsize=8)
     parts[0].align_ylabels(axes)
     if informative:
         grid = cast(np.ndarray, parts[1].subplots(off_rows, _OFF_COLUMNS, sharex=True, squeeze=False))
-        parts[1].subplots_adjust(top=1.0 - _OFF_HEAD_IN / bottom_in, bottom=0.25 / bottom_in, hspace=0.65,
-                                 wspace=0.4)
+        parts[1].subplots_adjust(top=1.0 - _OFF_HEAD_IN / bottom_in, bottom=0.25 / bottom_in, hspace=0.65, wspace=0.4)
         for k, ax in enumerate(grid.ravel()):
             if k >= len(informative):
                 ax.set_visible(False)
                 continue
-            _draw_output(ax, result.time_s, informative[k], other(informative[k].name),
-                         wind=without_wind is not None, small=True)
+            _draw_output(
+                ax, result.time_s, informative[k], other(informative[k].name), wind=without_wind is not None, small=True
+            )
             ax.tick_params(labelsize=7)
         axis = f"the doublet excites {plain_text(result.excited)}" if result.excited else "another axis is excited"
-        parts[1].suptitle(f"off-axis outputs, for information only (not judged: {axis})", x=0.02, y=0.995,
-                          ha="left", va="top", fontsize=8.5, color="#5b6575")
+        parts[1].suptitle(
+            f"off-axis outputs, for information only (not judged: {axis})",
+            x=0.02,
+            y=0.995,
+            ha="left",
+            va="top",
+            fontsize=8.5,
+            color="#5b6575",
+        )
     return figure_svg(figure)
 
 
@@ -169,8 +200,9 @@ def _wind_figure(corrections: Sequence[WindCorrection]) -> Figure:
     for x, c, ratio in zip(positions, shown, with_wind):
         change = -c.reduction_percent
         text = "0 %" if round(change) == 0 else f"{change:+.0f} %".replace("-", "\N{MINUS SIGN}")
-        ax.annotate(text, (x + 0.2, ratio), ha="center", va="bottom", fontsize=8, xytext=(0, 2),
-                    textcoords="offset points")
+        ax.annotate(
+            text, (x + 0.2, ratio), ha="center", va="bottom", fontsize=8, xytext=(0, 2), textcoords="offset points"
+        )
     ax.set_xticks(positions, [plain_text(c.name) for c in shown])
     ax.set_ylabel("RMS error / without $G_w$")
     ax.set_ylim(0, max(1.2, 1.18 * max(with_wind, default=1.0)))  # room for the labels above the tallest bar
@@ -194,16 +226,22 @@ def verification_figures(verification: Verification) -> list[tuple[str, str]]:
     """
     figures = []
     if verification.wind_correction:
-        figures.append((wind_correction_figure(verification.wind_correction),
-                        "RMS error of each output with the wind term, relative to the model without it, over the "
-                        "doublets where the output is on-axis; outputs it changes by less than 0.5 % are left out."))
+        figures.append(
+            (
+                wind_correction_figure(verification.wind_correction),
+                "RMS error of each output with the wind term, relative to the model without it, over the "
+                "doublets where the output is on-axis; outputs it changes by less than 0.5 % are left out.",
+            )
+        )
     without = {id(r): w for r, w in zip(verification.records, verification.without_wind)}
     for record in verification.records:
         caption = f"{record.label}: measured (grey) and simulated from all the measured inputs"
         if record.off_axis:
             caption += f"; judged on {', '.join(o.name for o in record.judged)}, the others shown small below"
         if record.unstable:
-            caption += (f"; the model's {mode_names(record.unstable_modes)} (unstable open loop) reach the judged "
-                        "outputs over this record, see the one-step-ahead errors")
+            caption += (
+                f"; the model's {mode_names(record.unstable_modes)} (unstable open loop) reach the judged "
+                "outputs over this record, see the one-step-ahead errors"
+            )
         figures.append((record_figure(record, without_wind=without.get(id(record))), caption + "."))
     return figures

@@ -57,17 +57,31 @@ class _OutputRow:
     doublets: str
 
 
-def _output_rows(summaries: Sequence[OutputSummary], records: Sequence[RecordVerification], *,
-                 judged: bool = True) -> list[_OutputRow]:
+def _output_rows(
+    summaries: Sequence[OutputSummary], records: Sequence[RecordVerification], *, judged: bool = True
+) -> list[_OutputRow]:
     rows = []
     for s in summaries:
         scale, unit = display_scale(s.unit)
         grade = "good" if s.tic <= TIC_GOOD else "warn" if s.tic <= TIC_ACCEPTABLE else "bad"
-        excited = dict.fromkeys(r.excited or "all inputs" for r in records
-                                if any(o.name == s.name for o in (r.judged if judged else r.informative)))
-        rows.append(_OutputRow(s.name, unit, s.rmse * scale, s.tic, grade,
-                               None if s.prediction_rmse is None else s.prediction_rmse * scale, s.prediction_tic,
-                               s.n_records, ", ".join(excited)))
+        excited = dict.fromkeys(
+            r.excited or "all inputs"
+            for r in records
+            if any(o.name == s.name for o in (r.judged if judged else r.informative))
+        )
+        rows.append(
+            _OutputRow(
+                s.name,
+                unit,
+                s.rmse * scale,
+                s.tic,
+                grade,
+                None if s.prediction_rmse is None else s.prediction_rmse * scale,
+                s.prediction_tic,
+                s.n_records,
+                ", ".join(excited),
+            )
+        )
     return rows
 
 
@@ -79,13 +93,16 @@ def _notices(records: Sequence[RecordVerification]) -> list[str]:
         growth = sorted({f"{r.growth:.0f}" for r in unstable}, key=float)
         spans = sorted({f"{r.time_s[-1] - r.time_s[0]:.1f}" for r in unstable}, key=float)
         names = mode_names([m for r in unstable for m in r.unstable_modes])
-        notices.insert(0, f"The model is unstable open loop in its {names}, which the judged outputs depend on, "
-                          f"and grows "
-                          f"{'-'.join(dict.fromkeys([growth[0], growth[-1]]))}-fold over the "
-                          f"{'-'.join(dict.fromkeys([spans[0], spans[-1]]))} s of {len(unstable)} of the "
-                          f"{len(records)} records ({'; '.join(r.label for r in unstable)}): small input or "
-                          "initial-state errors diverge there, so judge them also by the one-step-ahead "
-                          "prediction error.")
+        notices.insert(
+            0,
+            f"The model is unstable open loop in its {names}, which the judged outputs depend on, "
+            f"and grows "
+            f"{'-'.join(dict.fromkeys([growth[0], growth[-1]]))}-fold over the "
+            f"{'-'.join(dict.fromkeys([spans[0], spans[-1]]))} s of {len(unstable)} of the "
+            f"{len(records)} records ({'; '.join(r.label for r in unstable)}): small input or "
+            "initial-state errors diverge there, so judge them also by the one-step-ahead "
+            "prediction error.",
+        )
     return notices
 
 
@@ -105,13 +122,23 @@ def verification_context(verification: Verification | None) -> dict[str, Any]:
     if verification is None:
         return {"verification": None}
     return {
-        "verification": verification, "output_rows": _output_rows(verification.summary, verification.records),
+        "verification": verification,
+        "output_rows": _output_rows(verification.summary, verification.records),
         "off_axis_rows": _output_rows(verification.off_axis, verification.records, judged=False),
-        "wind_rows": [(c.name, display_scale(c.unit)[1], c.rmse_without * display_scale(c.unit)[0],
-                       c.rmse_with * display_scale(c.unit)[0], c.reduction_percent)
-                      for c in verification.wind_correction],
+        "wind_rows": [
+            (
+                c.name,
+                display_scale(c.unit)[1],
+                c.rmse_without * display_scale(c.unit)[0],
+                c.rmse_with * display_scale(c.unit)[0],
+                c.reduction_percent,
+            )
+            for c in verification.wind_correction
+        ],
         "verification_figures": [sized_svg(svg, caption) for svg, caption in verification_figures(verification)],
         "notices": _notices(verification.records),
-        "offsets": [(r.label, dict(r.reference_shifts), {o.name: o.bias * display_scale(o.unit)[0] for o in r.outputs})
-                    for r in verification.records],
+        "offsets": [
+            (r.label, dict(r.reference_shifts), {o.name: o.bias * display_scale(o.unit)[0] for o in r.outputs})
+            for r in verification.records
+        ],
     }

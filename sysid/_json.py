@@ -9,11 +9,18 @@ from typing import Any
 
 import numpy as np
 
-from flightlogs.atomic import atomic_output
 from flightlogs.errors import SysidError
+from flightlogs.writers.atomic import atomic_output
 
-__all__ = ["finite_or_none", "float_or_nan", "json_floats", "float_array", "value_text", "write_json",
-           "read_json_object"]
+__all__ = [
+    "finite_or_none",
+    "float_or_nan",
+    "json_floats",
+    "float_array",
+    "value_text",
+    "write_json",
+    "read_json_object",
+]
 
 
 def finite_or_none(value: float | None) -> float | None:

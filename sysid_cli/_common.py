@@ -13,7 +13,7 @@ from typing import Any
 
 import click
 
-from flightlogs.atomic import atomic_output
+from flightlogs.writers.atomic import atomic_output
 
 __all__ = ["OutputPath", "json_option", "emit_json", "progress_bar"]
 
@@ -107,8 +107,14 @@ def progress_bar(label: str, *, quiet: bool = False) -> Iterator[Callable[[int, 
     from tqdm import tqdm
 
     bar = tqdm(
-        desc=label, total=0, unit="B", unit_scale=True, delay=1.0, leave=False,
-        disable=True if quiet else None, file=sys.stderr,
+        desc=label,
+        total=0,
+        unit="B",
+        unit_scale=True,
+        delay=1.0,
+        leave=False,
+        disable=True if quiet else None,
+        file=sys.stderr,
     )
 
     def update(done: int, total: int) -> None:

@@ -48,8 +48,10 @@ def check_sources(sources: Sequence[Path], log_only: Mapping[str, Any]) -> bool:
         return False
     given = [name for name, value in log_only.items() if _is_set(value)]
     if given:
-        raise click.UsageError(f"{', '.join(given)} go{'es' if len(given) == 1 else ''} with logs: a dataset already "
-                               "holds its aligned wind and its maneuvers (give them to `sysid ingest`)")
+        raise click.UsageError(
+            f"{', '.join(given)} go{'es' if len(given) == 1 else ''} with logs: a dataset already "
+            "holds its aligned wind and its maneuvers (give them to `sysid ingest`)"
+        )
     return True
 
 
@@ -71,7 +73,7 @@ def dataset_flights(datasets: Sequence[Path]) -> list[Any]:
         If the datasets hold no conditioned flight.
     """
     from flightlogs.errors import DataError
-    from flightlogs.store import read_dataset
+    from flightlogs.store.dataset import read_dataset
 
     flights = [flight for path in datasets for flight in read_dataset(path).conditioned]
     if not flights:
@@ -79,8 +81,9 @@ def dataset_flights(datasets: Sequence[Path]) -> list[Any]:
     return flights
 
 
-def conditioned_flights(sources: Sequence[Path], wind_paths: Sequence[Path], conditioning: Any, *,
-                        log_only: Mapping[str, Any], quiet: bool) -> list[Any]:
+def conditioned_flights(
+    sources: Sequence[Path], wind_paths: Sequence[Path], conditioning: Any, *, log_only: Mapping[str, Any], quiet: bool
+) -> list[Any]:
     """The conditioned flights of `sources`: read from datasets, or logs ingested here with a progress bar.
 
     Parameters
@@ -89,7 +92,7 @@ def conditioned_flights(sources: Sequence[Path], wind_paths: Sequence[Path], con
         Datasets or logs (not both).
     wind_paths : sequence of Path
         Anemometer files or folders (logs only).
-    conditioning : flightlogs.condition.ConditioningOptions
+    conditioning : flightlogs.conditioning.condition.ConditioningOptions
         How to condition logs.
     log_only : Mapping[str, Any]
         Options the command was given that only go with logs (see :func:`check_sources`).
@@ -98,7 +101,7 @@ def conditioned_flights(sources: Sequence[Path], wind_paths: Sequence[Path], con
 
     Returns
     -------
-    list of flightlogs.condition.ConditionedFlight
+    list of flightlogs.conditioning.condition.ConditionedFlight
 
     Raises
     ------
@@ -109,9 +112,10 @@ def conditioned_flights(sources: Sequence[Path], wind_paths: Sequence[Path], con
     """
     if check_sources(sources, log_only):
         return dataset_flights(sources)
-    from flightlogs.campaign import ingest_campaign
+    from flightlogs.store.campaign import ingest_campaign
 
     with progress_bar("reading", quiet=quiet) as bar:
-        campaign = ingest_campaign(list(sources), list(wind_paths), options=conditioning,
-                                   progress=lambda _name, done, total: bar(done, total))
+        campaign = ingest_campaign(
+            list(sources), list(wind_paths), options=conditioning, progress=lambda _name, done, total: bar(done, total)
+        )
     return list(campaign.require_flights())

@@ -25,25 +25,38 @@ _BEFORE_S, _AFTER_S = 0.5, 1.0
 
 def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
     """Verify the model (with and without G_w) on the dataset's doublets, save it, and say how it went."""
-    from flightlogs.store import read_dataset
+    from flightlogs.store.dataset import read_dataset
     from sysid.fit import read_model
     from sysid.verify import VerificationOptions, axis_outputs, doublet_records, verify
-    from sysid.verify_io import write_verification
+    from sysid.verify.io import write_verification
 
     identified = read_model(model_path)
     model, with_wind = identified.linear_model(include_wind=False), identified.linear_model(include_wind=True)
     flights = list(read_dataset(dataset).conditioned)
     cut = doublet_records(flights, before_s=_BEFORE_S, after_s=_AFTER_S)
-    verification = verify(model, cut.records, excited=cut.excited, axes=axis_outputs(identified),
-                          wind_model=with_wind if with_wind.inputs != model.inputs else None,
-                          options=VerificationOptions(initial_state="estimated"))
-    created = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-    options = {"initial_state": "estimated", "before_s": _BEFORE_S, "after_s": _AFTER_S, "inputs": "all measured",
-               "judged": "on-axis outputs of each doublet's axis", "dataset": dataset.name}
+    verification = verify(
+        model,
+        cut.records,
+        excited=cut.excited,
+        axes=axis_outputs(identified),
+        wind_model=with_wind if with_wind.inputs != model.inputs else None,
+        options=VerificationOptions(initial_state="estimated"),
+    )
+    created = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+    options = {
+        "initial_state": "estimated",
+        "before_s": _BEFORE_S,
+        "after_s": _AFTER_S,
+        "inputs": "all measured",
+        "judged": "on-axis outputs of each doublet's axis",
+        "dataset": dataset.name,
+    }
     write_verification(out, verification, model=model_path.name, options=options, created_utc=created)
     worst = max(verification.summary, key=lambda s: s.tic)
-    text = (f"  {len(verification.records)} doublets, each judged on its axis' outputs: overall TIC "
-            f"{verification.tic:.2f} (worst output {worst.name} {worst.tic:.3f}; ≤ 0.25-0.3 is good)")
+    text = (
+        f"  {len(verification.records)} doublets, each judged on its axis' outputs: overall TIC "
+        f"{verification.tic:.2f} (worst output {worst.name} {worst.tic:.3f}; ≤ 0.25-0.3 is good)"
+    )
     table = {"ax": "−13 to −16 %", "az": "−7 to −15 %"}  # dissertation Table 3.6
     for c in verification.wind_correction:
         if c.name in table or abs(c.reduction_percent) >= 5:
@@ -53,15 +66,22 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
 
 
 @click.command(epilog=_EPILOG)
-@click.option("-o", "--out", "out_dir", type=OutputPath(folder=True),
-              default=Path("sysid-demo"), show_default=True, help="Folder for the demo's files.")
+@click.option(
+    "-o",
+    "--out",
+    "out_dir",
+    type=OutputPath(folder=True),
+    default=Path("sysid-demo"),
+    show_default=True,
+    help="Folder for the demo's files.",
+)
 @click.pass_context
 def demo(ctx: click.Context, out_dir: Path) -> None:
     """Simulate a sweep + doublet flight of the chapter 3 octocopter in light wind (with a ground
     anemometer 4.6 m upstream whose clock is 1.5 s fast), ingest it (align the wind, find the
     maneuvers), fit the hover-wind model to the sweeps, verify it on the doublets with and without
     its wind term, and write the HTML report. Prints where each file is; the report's path last."""
-    from sysid.sim.scenarios import write_demo_flight
+    from simulator.campaign.demo_flight import write_demo_flight
 
     from .fit import fit
     from .ingest import ingest
@@ -72,17 +92,46 @@ def demo(ctx: click.Context, out_dir: Path) -> None:
     click.echo(f"  log        {files.log}\n  anemometer {files.wind_csv}\n  truth      {files.truth}")
     dataset, ingest_json = out_dir / "dataset.h5", out_dir / "ingest.json"
     click.echo("ingesting (align wind, resample, segment) ...")
-    ctx.invoke(ingest, logs=(files.log,), wind_paths=(files.wind_csv,), wind_distance=4.6, wind_offset=None,
-               estimate_wind_offset=True, out=dataset, json_path=str(ingest_json), quiet=False,
-               columns=None, wind_bearing=None, transport_delay=None, rate_hz=None, segments_file=None)
+    ctx.invoke(
+        ingest,
+        logs=(files.log,),
+        wind_paths=(files.wind_csv,),
+        wind_distance=4.6,
+        wind_offset=None,
+        estimate_wind_offset=True,
+        out=dataset,
+        json_path=str(ingest_json),
+        quiet=False,
+        columns=None,
+        wind_bearing=None,
+        transport_delay=None,
+        rate_hz=None,
+        segments_file=None,
+    )
     click.echo(f"dataset: {dataset}\nsummary: {ingest_json}")
     model_path, validation_path, page = out_dir / "model.json", out_dir / "validation.json", out_dir / "report.html"
     click.echo("identifying the hover-wind model from the sweeps (eq. 3.9, then the wind step of eq. 3.14) ...")
-    ctx.invoke(fit, logs=(dataset,), model_name="hover-wind", initial={}, constants={}, out=model_path,
-               json_path=str(out_dir / "fit.json"), quiet=False)
+    ctx.invoke(
+        fit,
+        logs=(dataset,),
+        model_name="hover-wind",
+        initial={},
+        constants={},
+        out=model_path,
+        json_path=str(out_dir / "fit.json"),
+        quiet=False,
+    )
     click.echo("verifying on the doublets, with and without the wind term ...")
     click.echo(_verify_doublets(model_path, dataset, validation_path))
     click.echo(f"verification: {validation_path}")
-    ctx.invoke(report, model_path=model_path, validation_path=validation_path, out=page, ingest_path=ingest_json,
-               title=None, json_path=None, quiet=False)
+    ctx.invoke(
+        report,
+        model_path=model_path,
+        validation_path=validation_path,
+        out=page,
+        ingest_path=ingest_json,
+        title=None,
+        json_path=None,
+        quiet=False,
+    )
     click.echo(f"report: {page.resolve()}")

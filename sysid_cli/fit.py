@@ -10,8 +10,13 @@ import click
 
 from ._common import OutputPath, emit_json, json_option, progress_bar
 from ._flights import check_sources, dataset_flights
-from ._wind_options import (anemometer_at_option, transport_delay_option, wind_distance_option, wind_offset_option,
-                            wind_option)
+from ._wind_options import (
+    anemometer_at_option,
+    transport_delay_option,
+    wind_distance_option,
+    wind_offset_option,
+    wind_option,
+)
 
 __all__ = ["fit", "parse_assignments", "print_modes"]
 
@@ -40,62 +45,151 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
 
 @click.command(epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--model", "model_name", default="hover", show_default=True, metavar="NAME|FILE",
-              help="Built-in structure (hover, hover-wind) or a structure TOML file.")
+@click.option(
+    "--model",
+    "model_name",
+    default="hover",
+    show_default=True,
+    metavar="NAME|FILE",
+    help="Built-in structure (hover, hover-wind) or a structure TOML file.",
+)
 @wind_option("Anemometer CSV or folder (repeatable): air-relative u v w and the wind input.")
 @wind_distance_option()
 @anemometer_at_option("Anemometer position, deg, for the distance to the vehicle's GPS position.")
 @transport_delay_option("Transport delay of the wind, s.")
 @wind_offset_option("Anemometer clock minus UTC, s.")
 @click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset by cross-correlation.")
-@click.option("--kind", default="sweep", show_default=True,
-              type=click.Choice(["sweep", "multisine", "3211", "doublet"]), help="Maneuvers to fit.")
-@click.option("--set", "initial", multiple=True, callback=parse_assignments, metavar="NAME=VALUE",
-              help="Starting value of a parameter (repeatable).")
-@click.option("--trim", "constants", multiple=True, callback=parse_assignments, metavar="NAME=VALUE",
-              help="Trim constant instead of the flights' trim, e.g. U0=0 (repeatable).")
-@click.option("--starts", type=click.IntRange(min=1), default=1, show_default=True,
-              help="Starting points of the search (more guard against local minima).")
+@click.option(
+    "--kind",
+    default="sweep",
+    show_default=True,
+    type=click.Choice(["sweep", "multisine", "3211", "doublet"]),
+    help="Maneuvers to fit.",
+)
+@click.option(
+    "--set",
+    "initial",
+    multiple=True,
+    callback=parse_assignments,
+    metavar="NAME=VALUE",
+    help="Starting value of a parameter (repeatable).",
+)
+@click.option(
+    "--trim",
+    "constants",
+    multiple=True,
+    callback=parse_assignments,
+    metavar="NAME=VALUE",
+    help="Trim constant instead of the flights' trim, e.g. U0=0 (repeatable).",
+)
+@click.option(
+    "--starts",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="Starting points of the search (more guard against local minima).",
+)
 @click.option("--no-reduce", is_flag=True, help="Keep every parameter (no structure reduction).")
-@click.option("--max-cr", type=click.FloatRange(min=0, min_open=True), default=20.0, show_default=True,
-              help="Cramér–Rao bound guideline, % of the value.")
-@click.option("--max-insensitivity", type=click.FloatRange(min=0, min_open=True), default=10.0, show_default=True,
-              help="Insensitivity guideline, % of the value.")
-@click.option("--max-correlation", type=click.FloatRange(0, 1, min_open=True), default=None, metavar="R",
-              help="Also remove one of two parameters correlated beyond |R| (default: correlation not used).")
-@click.option("--min-coherence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.5,
-              show_default=True, help="Gating threshold on the coherence (eq. 3.8).")
-@click.option("-o", "--out", type=OutputPath(),
-              help="Write the identified model (versioned JSON).")
-@click.option("--mat", type=OutputPath(),
-              help="Also write the model for MATLAB (.mat).")
-@click.option("--report", type=OutputPath(),
-              help="Write the HTML fit report.")
+@click.option(
+    "--max-cr",
+    type=click.FloatRange(min=0, min_open=True),
+    default=20.0,
+    show_default=True,
+    help="Cramér–Rao bound guideline, % of the value.",
+)
+@click.option(
+    "--max-insensitivity",
+    type=click.FloatRange(min=0, min_open=True),
+    default=10.0,
+    show_default=True,
+    help="Insensitivity guideline, % of the value.",
+)
+@click.option(
+    "--max-correlation",
+    type=click.FloatRange(0, 1, min_open=True),
+    default=None,
+    metavar="R",
+    help="Also remove one of two parameters correlated beyond |R| (default: correlation not used).",
+)
+@click.option(
+    "--min-coherence",
+    type=click.FloatRange(0, 1, min_open=True, max_open=True),
+    default=0.5,
+    show_default=True,
+    help="Gating threshold on the coherence (eq. 3.8).",
+)
+@click.option("-o", "--out", type=OutputPath(), help="Write the identified model (versioned JSON).")
+@click.option("--mat", type=OutputPath(), help="Also write the model for MATLAB (.mat).")
+@click.option("--report", type=OutputPath(), help="Write the HTML fit report.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no tables.")
-def fit(logs: tuple[Path, ...], model_name: str, wind_paths: tuple[Path, ...], wind_distance: float | None,
-        anemometer_at: tuple[float, float] | None, transport_delay: float | None, wind_offset: float | None,
-        estimate_wind_offset: bool, kind: str, initial: dict[str, float], constants: dict[str, float], starts: int,
-        no_reduce: bool, max_cr: float, max_insensitivity: float, max_correlation: float | None,
-        min_coherence: float, out: Path | None,
-        mat: Path | None, report: Path | None, json_path: str | None, quiet: bool) -> None:
+def fit(
+    logs: tuple[Path, ...],
+    model_name: str,
+    wind_paths: tuple[Path, ...],
+    wind_distance: float | None,
+    anemometer_at: tuple[float, float] | None,
+    transport_delay: float | None,
+    wind_offset: float | None,
+    estimate_wind_offset: bool,
+    kind: str,
+    initial: dict[str, float],
+    constants: dict[str, float],
+    starts: int,
+    no_reduce: bool,
+    max_cr: float,
+    max_insensitivity: float,
+    max_correlation: float | None,
+    min_coherence: float,
+    out: Path | None,
+    mat: Path | None,
+    report: Path | None,
+    json_path: str | None,
+    quiet: bool,
+) -> None:
     """Identify a state-space model from the sweeps in LOGS (flight logs, or HDF5 datasets written by
     ``sysid ingest -o``): frequency responses, gating, the cost of eq. 3.9 with Cramér–Rao and
     insensitivity accuracy, structure reduction, then the wind terms on the residual of eq. 3.14.
     Control derivatives are per unit of the logged mixer input (the unit is printed)."""
-    from flightlogs.condition import ConditioningOptions
-    from sysid.fit import FitOptions, IdentifyOptions, fit_summary, identify_flights, identify_logs, write_mat, write_model
+    from flightlogs.conditioning.condition import ConditioningOptions
+    from sysid.fit import (
+        FitOptions,
+        IdentifyOptions,
+        fit_summary,
+        identify_flights,
+        identify_logs,
+        write_mat,
+        write_model,
+    )
     from sysid.model import load_structure
 
     structure = load_structure(model_name)
     options = IdentifyOptions(
-        fit=FitOptions(starts=starts, reduce=not no_reduce, max_cr_percent=max_cr,
-                       max_insensitivity_percent=max_insensitivity, max_correlation=max_correlation),
-        kind=kind, min_coherence=min_coherence, constants=constants or None, initial=initial or None)
-    dataset = check_sources(logs, {"--wind": wind_paths, "--wind-distance": wind_distance,
-                                   "--anemometer-at": anemometer_at, "--transport-delay": transport_delay,
-                                   "--wind-offset": wind_offset, "--estimate-wind-offset": estimate_wind_offset})
+        fit=FitOptions(
+            starts=starts,
+            reduce=not no_reduce,
+            max_cr_percent=max_cr,
+            max_insensitivity_percent=max_insensitivity,
+            max_correlation=max_correlation,
+        ),
+        kind=kind,
+        min_coherence=min_coherence,
+        constants=constants or None,
+        initial=initial or None,
+    )
+    dataset = check_sources(
+        logs,
+        {
+            "--wind": wind_paths,
+            "--wind-distance": wind_distance,
+            "--anemometer-at": anemometer_at,
+            "--transport-delay": transport_delay,
+            "--wind-offset": wind_offset,
+            "--estimate-wind-offset": estimate_wind_offset,
+        },
+    )
     with progress_bar("identifying", quiet=quiet) as bar:
+
         def progress(_stage: str, done: int, total: int) -> None:
             bar(done, total)
 
@@ -104,11 +198,20 @@ def fit(logs: tuple[Path, ...], model_name: str, wind_paths: tuple[Path, ...], w
             model = identify_flights(flights, structure, options=options, files=list(logs), progress=progress)
         else:
             conditioning = ConditioningOptions(
-                wind_distance_m=wind_distance, anemometer_position_rad=anemometer_at,
-                transport_delay_s=transport_delay, wind_offset_s=wind_offset,
-                estimate_wind_offset=estimate_wind_offset)
-            model = identify_logs(list(logs), structure, wind_paths=list(wind_paths), conditioning=conditioning,
-                                  options=options, progress=progress)
+                wind_distance_m=wind_distance,
+                anemometer_position_rad=anemometer_at,
+                transport_delay_s=transport_delay,
+                wind_offset_s=wind_offset,
+                estimate_wind_offset=estimate_wind_offset,
+            )
+            model = identify_logs(
+                list(logs),
+                structure,
+                wind_paths=list(wind_paths),
+                conditioning=conditioning,
+                options=options,
+                progress=progress,
+            )
     if out is not None:
         write_model(out, model)
     if mat is not None:
@@ -117,8 +220,11 @@ def fit(logs: tuple[Path, ...], model_name: str, wind_paths: tuple[Path, ...], w
         from reports.model_report import write_model_report
 
         write_model_report(report, model)
-    summary = fit_summary(model) | {"output": str(out) if out else None, "mat": str(mat) if mat else None,
-                                    "report": str(report) if report else None}
+    summary = fit_summary(model) | {
+        "output": str(out) if out else None,
+        "mat": str(mat) if mat else None,
+        "report": str(report) if report else None,
+    }
     if not quiet:
         _print_fit(summary, (max_cr, max_insensitivity), to_stderr=json_path == "-")
     emit_json(summary, json_path)
@@ -134,8 +240,10 @@ def print_modes(rows: list[dict[str, Any]], say: Any) -> None:
     for m in rows:
         pair = f"{m['real']:.4g} ± {m['imag']:.4g}i" if m["imag"] > 0 else f"{m['real']:.4g}"
         time = m["time_to_double_s"] if m["time_to_double_s"] is not None else m["time_to_half_s"]
-        say(f"  {m['mode']:<9} {pair:>22} {_fmt(m['damping']):>8} {m['natural_frequency_rad_s']:>13.4g} "
-            f"{_fmt(time):>11}  {m['stability']}")
+        say(
+            f"  {m['mode']:<9} {pair:>22} {_fmt(m['damping']):>8} {m['natural_frequency_rad_s']:>13.4g} "
+            f"{_fmt(time):>11}  {m['stability']}"
+        )
 
 
 def _print_fit(summary: dict[str, Any], guidelines: tuple[float, float], *, to_stderr: bool) -> None:
@@ -145,16 +253,22 @@ def _print_fit(summary: dict[str, Any], guidelines: tuple[float, float], *, to_s
     say(f"model {summary['model']}: J_ave = {summary['cost']['average']:.2f} (guideline <= 100)")
     say(f"  {'parameter':<11} {'value':>11} {'CR%':>7} {'I%':>7}  {'status':<10} unit")
     for name, p in summary["parameters"].items():
-        flag = " !" if (p["cr_percent"] or 0) > guidelines[0] or (p["insensitivity_percent"] or 0) > guidelines[1] else ""
-        say(f"  {name:<11} {p['value']:>11.5g} {_fmt(p['cr_percent'], '.2f'):>7} "
-            f"{_fmt(p['insensitivity_percent'], '.2f'):>7}  {p['status'] + flag:<10} {p['unit']}")
+        flag = (
+            " !" if (p["cr_percent"] or 0) > guidelines[0] or (p["insensitivity_percent"] or 0) > guidelines[1] else ""
+        )
+        say(
+            f"  {name:<11} {p['value']:>11.5g} {_fmt(p['cr_percent'], '.2f'):>7} "
+            f"{_fmt(p['insensitivity_percent'], '.2f'):>7}  {p['status'] + flag:<10} {p['unit']}"
+        )
     say("  response costs: " + ", ".join(f"{k} {v:.1f}" for k, v in summary["cost"]["responses"].items()))
     for step in summary["reduction"]:
         say(f"  reduction {step['step']}: {step['parameter']} {step['action']} ({step['reason']})")
     if summary["wind"]:
         w = summary["wind"]
-        say("  wind step residual RMS: " + ", ".join(
-            f"{o} {b:.3g} -> {a:.3g}" for o, b, a in zip(w["outputs"], w["rms_before"], w["rms_after"])))
+        say(
+            "  wind step residual RMS: "
+            + ", ".join(f"{o} {b:.3g} -> {a:.3g}" for o, b, a in zip(w["outputs"], w["rms_before"], w["rms_after"]))
+        )
     print_modes(summary["eigenvalues"], say)
     for note in summary["notes"]:
         say(f"  note: {note}")

@@ -31,8 +31,9 @@ def _floats(_ctx: click.Context, _param: click.Parameter, value: str | None) -> 
         lengths = tuple(float(part) for part in value.split(","))
     except ValueError:
         raise click.BadParameter(f"{value!r} is not a comma-separated list of seconds (e.g. 2,4,8,12,17)") from None
-    bad = [part.strip() for part, length in zip(value.split(","), lengths)
-           if not (math.isfinite(length) and length > 0)]
+    bad = [
+        part.strip() for part, length in zip(value.split(","), lengths) if not (math.isfinite(length) and length > 0)
+    ]
     if bad:
         raise click.BadParameter(f"{', '.join(bad)}: window lengths must be positive seconds (e.g. 2,4,8,12,17)")
     return lengths
@@ -52,73 +53,158 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
 
 
 @click.command(epilog=_EPILOG)
-@click.argument("sources", metavar="DATASET|LOG...", nargs=-1, required=True,
-                type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument(
+    "sources",
+    metavar="DATASET|LOG...",
+    nargs=-1,
+    required=True,
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+)
 @wind_option("Anemometer CSV or folder (with logs; aligned by UTC as in `sysid ingest`).")
 @wind_distance_option("Anemometer-to-vehicle distance, m (with --wind; see `sysid ingest` for the other choices).")
 @wind_offset_option("Anemometer clock minus UTC, s (with --wind).")
-@click.option("--pairs", callback=_pairs, metavar="OUT/IN,...",
-              help="Responses to compute, e.g. q/delta_lon,ax/delta_lon (default: the chapter 3 outputs of "
-                   "every axis with a sweep).")
-@click.option("--axis", type=click.Choice(["lat", "lon", "yaw", "thr"]),
-              help="Use this axis's maneuvers for every pair (needed for inputs such as wind_lon alone).")
-@click.option("--kind", default="sweep", show_default=True,
-              type=click.Choice(["sweep", "multisine", "3211", "doublet"]), help="Maneuvers to use.")
-@click.option("--omega-min", type=click.FloatRange(min=0, min_open=True), default=0.5, show_default=True,
-              help="Lowest frequency, rad/s.")
-@click.option("--omega-max", type=click.FloatRange(min=0, min_open=True), default=70.0, show_default=True,
-              help="Highest frequency, rad/s.")
-@click.option("--n-freq", type=click.IntRange(min=2), default=150, show_default=True,
-              help="Points of the log-spaced grid.")
-@click.option("--windows", callback=_floats, metavar="S,S,...",
-              help="Window lengths, s (default: five from 2π/(5·omega-min) to half the longest record).")
-@click.option("--overlap", type=click.FloatRange(0.0, 0.95, max_open=True), default=0.8, show_default=True,
-              help="Window overlap, fraction.")
-@click.option("--min-coherence", type=click.FloatRange(0.0, 1.0, min_open=True, max_open=True), default=0.5,
-              show_default=True, help="Coherence γ² a fit range must keep (0.6 for noisy data).")
-@click.option("--min-decades", type=click.FloatRange(min=0, min_open=True), default=0.3, show_default=True,
-              help="Shortest fit range, decades.")
-@click.option("--reference", default="auto", show_default=True, metavar="auto|none|SIGNAL",
-              help="Injected excitation used as the mixer input's instrument, H = G_ry/G_rx: 'auto' uses the "
-                   "logged `excitation` (ArduPilot SIDD) where every piece of an axis carries it, else the mixer "
-                   "input (PX4); 'none' never; or a signal name on every axis.")
-@click.option("--whole-record/--no-whole-record", default=True, show_default=True,
-              help="Add the records' whole-length transforms to the composite (free of the windows' resolution "
-                   "bias; needs more maneuver pieces than inputs).")
-@click.option("-o", "--out", type=OutputPath(),
-              help="Write the responses (fit range set on those kept) to this HDF5 file.")
-@click.option("--plot", type=OutputPath(),
-              help="Write Bode and coherence plots to this SVG file.")
+@click.option(
+    "--pairs",
+    callback=_pairs,
+    metavar="OUT/IN,...",
+    help="Responses to compute, e.g. q/delta_lon,ax/delta_lon (default: the chapter 3 outputs of "
+    "every axis with a sweep).",
+)
+@click.option(
+    "--axis",
+    type=click.Choice(["lat", "lon", "yaw", "thr"]),
+    help="Use this axis's maneuvers for every pair (needed for inputs such as wind_lon alone).",
+)
+@click.option(
+    "--kind",
+    default="sweep",
+    show_default=True,
+    type=click.Choice(["sweep", "multisine", "3211", "doublet"]),
+    help="Maneuvers to use.",
+)
+@click.option(
+    "--omega-min",
+    type=click.FloatRange(min=0, min_open=True),
+    default=0.5,
+    show_default=True,
+    help="Lowest frequency, rad/s.",
+)
+@click.option(
+    "--omega-max",
+    type=click.FloatRange(min=0, min_open=True),
+    default=70.0,
+    show_default=True,
+    help="Highest frequency, rad/s.",
+)
+@click.option(
+    "--n-freq", type=click.IntRange(min=2), default=150, show_default=True, help="Points of the log-spaced grid."
+)
+@click.option(
+    "--windows",
+    callback=_floats,
+    metavar="S,S,...",
+    help="Window lengths, s (default: five from 2π/(5·omega-min) to half the longest record).",
+)
+@click.option(
+    "--overlap",
+    type=click.FloatRange(0.0, 0.95, max_open=True),
+    default=0.8,
+    show_default=True,
+    help="Window overlap, fraction.",
+)
+@click.option(
+    "--min-coherence",
+    type=click.FloatRange(0.0, 1.0, min_open=True, max_open=True),
+    default=0.5,
+    show_default=True,
+    help="Coherence γ² a fit range must keep (0.6 for noisy data).",
+)
+@click.option(
+    "--min-decades",
+    type=click.FloatRange(min=0, min_open=True),
+    default=0.3,
+    show_default=True,
+    help="Shortest fit range, decades.",
+)
+@click.option(
+    "--reference",
+    default="auto",
+    show_default=True,
+    metavar="auto|none|SIGNAL",
+    help="Injected excitation used as the mixer input's instrument, H = G_ry/G_rx: 'auto' uses the "
+    "logged `excitation` (ArduPilot SIDD) where every piece of an axis carries it, else the mixer "
+    "input (PX4); 'none' never; or a signal name on every axis.",
+)
+@click.option(
+    "--whole-record/--no-whole-record",
+    default=True,
+    show_default=True,
+    help="Add the records' whole-length transforms to the composite (free of the windows' resolution "
+    "bias; needs more maneuver pieces than inputs).",
+)
+@click.option(
+    "-o", "--out", type=OutputPath(), help="Write the responses (fit range set on those kept) to this HDF5 file."
+)
+@click.option("--plot", type=OutputPath(), help="Write Bode and coherence plots to this SVG file.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
-def freqresp(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_distance: float | None,
-             wind_offset: float | None, pairs: tuple[tuple[str, str], ...] | None,
-             axis: str | None, kind: str, omega_min: float, omega_max: float, n_freq: int,
-             windows: tuple[float, ...] | None, overlap: float, min_coherence: float, min_decades: float,
-             reference: str, whole_record: bool, out: Path | None, plot: Path | None, json_path: str | None,
-             quiet: bool) -> None:
+def freqresp(
+    sources: tuple[Path, ...],
+    wind_paths: tuple[Path, ...],
+    wind_distance: float | None,
+    wind_offset: float | None,
+    pairs: tuple[tuple[str, str], ...] | None,
+    axis: str | None,
+    kind: str,
+    omega_min: float,
+    omega_max: float,
+    n_freq: int,
+    windows: tuple[float, ...] | None,
+    overlap: float,
+    min_coherence: float,
+    min_decades: float,
+    reference: str,
+    whole_record: bool,
+    out: Path | None,
+    plot: Path | None,
+    json_path: str | None,
+    quiet: bool,
+) -> None:
     """Compute composite (multi-window, chirp-z) frequency responses from the maneuvers of a DATASET
     (`sysid ingest -o`) or of LOGs ingested on the fly, gate them by coherence, and write them."""
     from sysid.freqresp import ResponseOptions, flight_responses, gate_responses, write_responses
 
     forced = None if reference in ("auto", "none") else reference
     if omega_min >= omega_max:
-        raise click.BadParameter(f"{omega_min:g} rad/s must be below --omega-max ({omega_max:g} rad/s)",
-                                 param_hint="'--omega-min'")
+        raise click.BadParameter(
+            f"{omega_min:g} rad/s must be below --omega-max ({omega_max:g} rad/s)", param_hint="'--omega-min'"
+        )
     try:
-        options = ResponseOptions(omega_min=omega_min, omega_max=omega_max, n_freq=n_freq, window_lengths_s=windows,
-                                  overlap=overlap, min_coherence=min_coherence, min_decades=min_decades,
-                                  reference=forced, whole_record=whole_record)
+        options = ResponseOptions(
+            omega_min=omega_min,
+            omega_max=omega_max,
+            n_freq=n_freq,
+            window_lengths_s=windows,
+            overlap=overlap,
+            min_coherence=min_coherence,
+            min_decades=min_decades,
+            reference=forced,
+            whole_record=whole_record,
+        )
     except ValueError as err:
         raise click.UsageError(str(err)) from None
-    from flightlogs.condition import ConditioningOptions
+    from flightlogs.conditioning.condition import ConditioningOptions
 
-    flights = conditioned_flights(sources, wind_paths,
-                                  ConditioningOptions(wind_distance_m=wind_distance, wind_offset_s=wind_offset),
-                                  log_only={"--wind": wind_paths, "--wind-distance": wind_distance,
-                                            "--wind-offset": wind_offset}, quiet=quiet)
-    computed = flight_responses(flights, pairs, axis=axis, kind=kind, options=options,
-                                use_excitation=reference != "none")
+    flights = conditioned_flights(
+        sources,
+        wind_paths,
+        ConditioningOptions(wind_distance_m=wind_distance, wind_offset_s=wind_offset),
+        log_only={"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset},
+        quiet=quiet,
+    )
+    computed = flight_responses(
+        flights, pairs, axis=axis, kind=kind, options=options, use_excitation=reference != "none"
+    )
     gated = gate_responses(computed.responses, min_coherence=min_coherence, min_decades=min_decades)
     kept = {response.pair: response for response in gated.kept}
     ordered = [kept.get(response.pair, response) for response in computed.responses]
@@ -129,24 +215,37 @@ def freqresp(sources: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_dista
     if out is not None:
         write_responses(out, ordered)
     summary = _summary(ordered, gated.dropped, dict(computed.pieces), options, out, plot) | {
-        "notes": list(computed.notes)}
+        "notes": list(computed.notes)
+    }
     if not quiet:
         _print_summary(summary, to_stderr=json_path == "-")
     emit_json(summary, json_path)
 
 
-def _summary(responses: list[Any], dropped: tuple[Any, ...], pieces: dict[str, int], options: Any,
-             out: Path | None, plot: Path | None) -> dict[str, Any]:
+def _summary(
+    responses: list[Any],
+    dropped: tuple[Any, ...],
+    pieces: dict[str, int],
+    options: Any,
+    out: Path | None,
+    plot: Path | None,
+) -> dict[str, Any]:
     import numpy as np
 
     reasons = {d.pair: d.reason for d in dropped}
     entries = []
     for response in responses:
         entry: dict[str, Any] = {
-            "pair": response.pair, "input": response.input, "output": response.output,
-            "kept": response.fit_range is not None, "fit_range_rad_s": None, "mean_coherence": None,
-            "reason": reasons.get(response.pair), "windows_s": [round(t, 4) for t in response.windows_s],
-            "conditioned_on": list(response.conditioned_on), "reference": response.reference,
+            "pair": response.pair,
+            "input": response.input,
+            "output": response.output,
+            "kept": response.fit_range is not None,
+            "fit_range_rad_s": None,
+            "mean_coherence": None,
+            "reason": reasons.get(response.pair),
+            "windows_s": [round(t, 4) for t in response.windows_s],
+            "conditioned_on": list(response.conditioned_on),
+            "reference": response.reference,
             "whole_record": response.whole_record,
         }
         if response.fit_range is not None:
@@ -156,12 +255,20 @@ def _summary(responses: list[Any], dropped: tuple[Any, ...], pieces: dict[str, i
             entry["mean_coherence"] = float(np.mean(response.coherence[inside]))
         entries.append(entry)
     return {
-        "responses": entries, "pieces": pieces,
-        "options": {"omega_min": options.omega_min, "omega_max": options.omega_max, "n_freq": options.n_freq,
-                    "overlap": options.overlap, "min_coherence": options.min_coherence,
-                    "min_decades": options.min_decades, "reference": options.reference,
-                    "whole_record": options.whole_record},
-        "output": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
+        "responses": entries,
+        "pieces": pieces,
+        "options": {
+            "omega_min": options.omega_min,
+            "omega_max": options.omega_max,
+            "n_freq": options.n_freq,
+            "overlap": options.overlap,
+            "min_coherence": options.min_coherence,
+            "min_decades": options.min_decades,
+            "reference": options.reference,
+            "whole_record": options.whole_record,
+        },
+        "output": str(out) if out is not None else None,
+        "plot": str(plot) if plot is not None else None,
     }
 
 

@@ -63,30 +63,89 @@ def _models(_ctx: click.Context, _param: click.Parameter, value: str | None) -> 
 def _data_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Options turning a rig CSV or a flight log into F/F0 against Z/R (shared by fit and spacing)."""
     options = [
-        click.option("--rotor-radius", "rotor_radius", type=click.FloatRange(min=0, min_open=True), required=True,
-                     metavar="M", help="Propeller radius R, m (Crazyflie: 0.0225)."),
-        click.option("--f0", type=click.FloatRange(min=0, min_open=True), metavar="N",
-                     help="Rig: thrust out of ground effect, N (default: mean of the rows with Z/R > 8)."),
-        click.option("--columns", callback=parse_columns, metavar="height=COL,thrust=COL",
-                     help="Rig CSV column names (default height_m, thrust_n)."),
-        click.option("--units", callback=parse_columns, metavar="height=U,thrust=U",
-                     help="Rig CSV units (m, cm, mm, in; N, mN, g, kg) when the column names do not say."),
-        click.option("--kf", type=click.FloatRange(min=0, min_open=True), default=2.083e-6, show_default=True,
-                     metavar="N", help="Flight: k_f of eq. 2.6, N per PWM count (Table 2.1)."),
-        click.option("--mass", type=click.FloatRange(min=0, min_open=True), metavar="KG",
-                     help="Flight: vehicle mass, kg (default: the weight is the eq. 2.6 thrust of steps above Z/R 8)."),
-        click.option("--pwm-full-scale", type=click.FloatRange(min=0, min_open=True), default=65535.0,
-                     show_default=True, help="Flight: PWM counts of a full command, for motors logged as 0..1."),
-        click.option("--rotor-offset", type=float, default=0.0, show_default=True, metavar="M",
-                     help="Flight: rotor plane above the height sensor's reference, m."),
-        click.option("--min-hold", type=click.FloatRange(min=0, min_open=True), default=6.0, show_default=True,
-                     metavar="S", help="Flight: shortest hover step, s (its second half is used)."),
-        click.option("--models", callback=_models, metavar="NAME,...",
-                     help="Families to fit (default all: cheeseman_bennett,corrected,exponential,piecewise_linear)."),
-        click.option("--criterion", type=click.Choice(["aicc", "bic"]), default="aicc", show_default=True,
-                     help="Model selection: corrected Akaike or Bayesian information criterion."),
-        click.option("--confidence", type=click.FloatRange(0, 1, min_open=True, max_open=True), default=0.95,
-                     show_default=True, help="Level of the parameter confidence intervals."),
+        click.option(
+            "--rotor-radius",
+            "rotor_radius",
+            type=click.FloatRange(min=0, min_open=True),
+            required=True,
+            metavar="M",
+            help="Propeller radius R, m (Crazyflie: 0.0225).",
+        ),
+        click.option(
+            "--f0",
+            type=click.FloatRange(min=0, min_open=True),
+            metavar="N",
+            help="Rig: thrust out of ground effect, N (default: mean of the rows with Z/R > 8).",
+        ),
+        click.option(
+            "--columns",
+            callback=parse_columns,
+            metavar="height=COL,thrust=COL",
+            help="Rig CSV column names (default height_m, thrust_n).",
+        ),
+        click.option(
+            "--units",
+            callback=parse_columns,
+            metavar="height=U,thrust=U",
+            help="Rig CSV units (m, cm, mm, in; N, mN, g, kg) when the column names do not say.",
+        ),
+        click.option(
+            "--kf",
+            type=click.FloatRange(min=0, min_open=True),
+            default=2.083e-6,
+            show_default=True,
+            metavar="N",
+            help="Flight: k_f of eq. 2.6, N per PWM count (Table 2.1).",
+        ),
+        click.option(
+            "--mass",
+            type=click.FloatRange(min=0, min_open=True),
+            metavar="KG",
+            help="Flight: vehicle mass, kg (default: the weight is the eq. 2.6 thrust of steps above Z/R 8).",
+        ),
+        click.option(
+            "--pwm-full-scale",
+            type=click.FloatRange(min=0, min_open=True),
+            default=65535.0,
+            show_default=True,
+            help="Flight: PWM counts of a full command, for motors logged as 0..1.",
+        ),
+        click.option(
+            "--rotor-offset",
+            type=float,
+            default=0.0,
+            show_default=True,
+            metavar="M",
+            help="Flight: rotor plane above the height sensor's reference, m.",
+        ),
+        click.option(
+            "--min-hold",
+            type=click.FloatRange(min=0, min_open=True),
+            default=6.0,
+            show_default=True,
+            metavar="S",
+            help="Flight: shortest hover step, s (its second half is used).",
+        ),
+        click.option(
+            "--models",
+            callback=_models,
+            metavar="NAME,...",
+            help="Families to fit (default all: cheeseman_bennett,corrected,exponential,piecewise_linear).",
+        ),
+        click.option(
+            "--criterion",
+            type=click.Choice(["aicc", "bic"]),
+            default="aicc",
+            show_default=True,
+            help="Model selection: corrected Akaike or Bayesian information criterion.",
+        ),
+        click.option(
+            "--confidence",
+            type=click.FloatRange(0, 1, min_open=True, max_open=True),
+            default=0.95,
+            show_default=True,
+            help="Level of the parameter confidence intervals.",
+        ),
     ]
     for option in reversed(options):
         command = option(command)
@@ -102,10 +161,17 @@ def _configs(kw: dict[str, Any]) -> tuple[Any, Any]:
         if extra:
             raise click.BadParameter(f"{', '.join(sorted(extra))}: only height= and thrust= are known", param_hint=what)
     data = GroundEffectDataConfig(
-        rotor_radius_m=kw["rotor_radius"], f0_n=kw["f0"], height_column=columns.get("height", "height_m"),
-        thrust_column=columns.get("thrust", "thrust_n"), height_unit=units.get("height"),
-        thrust_unit=units.get("thrust"), kf_n_per_count=kw["kf"], mass_kg=kw["mass"],
-        pwm_full_scale=kw["pwm_full_scale"], rotor_offset_m=kw["rotor_offset"], min_hold_s=kw["min_hold"],
+        rotor_radius_m=kw["rotor_radius"],
+        f0_n=kw["f0"],
+        height_column=columns.get("height", "height_m"),
+        thrust_column=columns.get("thrust", "thrust_n"),
+        height_unit=units.get("height"),
+        thrust_unit=units.get("thrust"),
+        kf_n_per_count=kw["kf"],
+        mass_kg=kw["mass"],
+        pwm_full_scale=kw["pwm_full_scale"],
+        rotor_offset_m=kw["rotor_offset"],
+        min_hold_s=kw["min_hold"],
     )
     return data, FitConfig(kw["models"] or MODEL_NAMES, kw["criterion"], kw["confidence"])
 
@@ -118,8 +184,12 @@ def ground_effect() -> None:
 @ground_effect.command("fit", epilog=_FIT_EPILOG)
 @click.argument("data", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @_data_options
-@click.option("-o", "--out", type=OutputPath(),
-              help="Write the chosen model (and the fit summary) as JSON, for `sysid mrac compare --ground-effect`.")
+@click.option(
+    "-o",
+    "--out",
+    type=OutputPath(),
+    help="Write the chosen model (and the fit summary) as JSON, for `sysid mrac compare --ground-effect`.",
+)
 @click.option("--report", type=OutputPath(), help="Write an HTML report.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
@@ -150,16 +220,34 @@ def fit(data: Path, out: Path | None, report: Path | None, json_path: str | None
 
 @ground_effect.command("spacing", epilog=_SPACING_EPILOG)
 @click.argument("data", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--spacing", "spacing_mm", callback=_float_list, required=True, metavar="MM,...",
-              help="Rotor-spacing increment of each DATA file, mm, in the same order.")
-@click.option("--rotors", type=click.IntRange(min=2), default=4, show_default=True,
-              help="Rotors running: 2 reports rho of eq. 2.2; more compares piecewise linear with eq. 2.2.")
+@click.option(
+    "--spacing",
+    "spacing_mm",
+    callback=_float_list,
+    required=True,
+    metavar="MM,...",
+    help="Rotor-spacing increment of each DATA file, mm, in the same order.",
+)
+@click.option(
+    "--rotors",
+    type=click.IntRange(min=2),
+    default=4,
+    show_default=True,
+    help="Rotors running: 2 reports rho of eq. 2.2; more compares piecewise linear with eq. 2.2.",
+)
 @_data_options
 @click.option("--report", type=OutputPath(), help="Write an HTML report.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
-def spacing(data: tuple[Path, ...], spacing_mm: list[float], rotors: int, report: Path | None,
-            json_path: str | None, quiet: bool, **kw: Any) -> None:
+def spacing(
+    data: tuple[Path, ...],
+    spacing_mm: list[float],
+    rotors: int,
+    report: Path | None,
+    json_path: str | None,
+    quiet: bool,
+    **kw: Any,
+) -> None:
     """Compare rotor spacings: fit each DATA file and find where piecewise linear gives way to eq. 2.2.
 
     One DATA file per spacing (--spacing, mm, same order); with 2 rotors rho of eq. 2.2 is reported
@@ -170,8 +258,7 @@ def spacing(data: tuple[Path, ...], spacing_mm: list[float], rotors: int, report
     data_config, fit_config = _configs(kw)
     with progress_bar("fitting", quiet=quiet) as bar:
         datasets = [load_thrust_ratio(path, data_config) for path in data]
-        study = spacing_study(datasets, [s * 1e-3 for s in spacing_mm], rotors=rotors, config=fit_config,
-                              progress=bar)
+        study = spacing_study(datasets, [s * 1e-3 for s in spacing_mm], rotors=rotors, config=fit_config, progress=bar)
     if report is not None:
         from reports.groundeffect_report import write_spacing_report
 
@@ -194,8 +281,10 @@ def _check_spacings(spacing_mm: list[float], data: tuple[Path, ...]) -> None:
         raise click.BadParameter(f"{bad[0]:g} mm: spacings must be finite and not negative", param_hint="'--spacing'")
     repeated = sorted({s for s in spacing_mm if spacing_mm.count(s) > 1})
     if repeated:
-        raise click.BadParameter(f"{', '.join(f'{s:g}' for s in repeated)} mm given twice: each DATA file needs its "
-                                 "own spacing", param_hint="'--spacing'")
+        raise click.BadParameter(
+            f"{', '.join(f'{s:g}' for s in repeated)} mm given twice: each DATA file needs its own spacing",
+            param_hint="'--spacing'",
+        )
 
 
 def _print_fit(summary: dict[str, Any], *, to_stderr: bool) -> None:
@@ -206,8 +295,10 @@ def _print_fit(summary: dict[str, Any], *, to_stderr: bool) -> None:
     criterion = {"aicc": "AICc", "bic": "BIC"}[summary["criterion"]]
     say(f"  {'model':<18} {'RMSE':>8} {'R2':>8} {'d' + criterion:>8}  parameters")
     for name, model in summary["models"].items():
-        params = ", ".join(f"{n} {v:.5g} [{lo:.4g}, {hi:.4g}]" for (n, v), (lo, hi)
-                           in zip(model["params"].items(), model["ci"].values()))
+        params = ", ".join(
+            f"{n} {v:.5g} [{lo:.4g}, {hi:.4g}]"
+            for (n, v), (lo, hi) in zip(model["params"].items(), model["ci"].values())
+        )
         mark = "*" if name == summary["best"] else " "
         say(f"{mark} {name:<18} {model['rmse']:>8.4f} {model['r2']:>8.4f} {model['delta']:>8.2f}  {params or '-'}")
     say(f"chosen: {summary['best']} (lowest {criterion})")
@@ -227,7 +318,9 @@ def _print_spacing(summary: dict[str, Any], *, to_stderr: bool) -> None:
         say(f"{entry['spacing_mm']:>10g}  {r2}  {entry['chosen']}")
     if len(families) > 1:
         transition = summary["transition_mm"]
-        say(f"transition {families[0]} -> {families[-1]}: "
-            + (f"at {transition:g} mm" if transition is not None else "none found"))
+        say(
+            f"transition {families[0]} -> {families[-1]}: "
+            + (f"at {transition:g} mm" if transition is not None else "none found")
+        )
     if summary["outputs"]["report"]:
         say(f"wrote report {summary['outputs']['report']}")

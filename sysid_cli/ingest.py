@@ -9,8 +9,16 @@ from typing import Any
 import click
 
 from ._common import OutputPath, emit_json, json_option, progress_bar
-from ._wind_options import (anemometer_at_option, parse_position, segments_from, segments_option,
-                            transport_delay_option, wind_distance_option, wind_offset_option, wind_option)
+from ._wind_options import (
+    anemometer_at_option,
+    parse_position,
+    segments_from,
+    segments_option,
+    transport_delay_option,
+    wind_distance_option,
+    wind_offset_option,
+    wind_option,
+)
 
 __all__ = ["ingest", "parse_columns", "parse_position"]
 
@@ -39,14 +47,15 @@ def parse_columns(_ctx: click.Context, _param: click.Parameter, value: str | Non
 
 def _wind_columns(ctx: click.Context, param: click.Parameter, value: str | None) -> dict[str, str] | None:
     """:func:`parse_columns`, keeping to the anemometer's keys (time, date, speed, direction, u, v, w)."""
-    from flightlogs.anemometer import COLUMN_SYNONYMS
+    from flightlogs.readers.anemometer import COLUMN_SYNONYMS
 
     mapping = parse_columns(ctx, param, value)
     unknown = sorted(set(mapping or {}) - set(COLUMN_SYNONYMS))
     if unknown:
         raise click.BadParameter(
             f"{', '.join(unknown)}: not a column key; use --columns "
-            + ",".join(f"{key}=COL" for key in COLUMN_SYNONYMS))
+            + ",".join(f"{key}=COL" for key in COLUMN_SYNONYMS)
+        )
     return mapping
 
 
@@ -57,50 +66,89 @@ _MAX_RATE_HZ = 10_000.0
 @click.command(epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @wind_option("Anemometer CSV, or a folder of them (repeatable); each log takes the file overlapping it in UTC.")
-@click.option("--columns", callback=_wind_columns,
-              help="Override anemometer column detection: time=,speed=,direction= or time=,u=,v=.")
+@click.option(
+    "--columns",
+    callback=_wind_columns,
+    help="Override anemometer column detection: time=,speed=,direction= or time=,u=,v=.",
+)
 @wind_distance_option()
-@click.option("--wind-bearing", type=float, metavar="DEG",
-              help="Direction from the anemometer to the vehicle, deg from north (default: straight upstream).")
-@anemometer_at_option("Anemometer position, deg (WGS-84); without --wind-distance, the distance and bearing "
-                      "to the vehicle come from its mean GPS position in the log.")
+@click.option(
+    "--wind-bearing",
+    type=float,
+    metavar="DEG",
+    help="Direction from the anemometer to the vehicle, deg from north (default: straight upstream).",
+)
+@anemometer_at_option(
+    "Anemometer position, deg (WGS-84); without --wind-distance, the distance and bearing "
+    "to the vehicle come from its mean GPS position in the log."
+)
 @transport_delay_option()
 @wind_offset_option()
-@click.option("--estimate-wind-offset", is_flag=True,
-              help="Correct the clock offset by cross-correlating the wind with the vehicle's response.")
-@click.option("--estimate-transport-delay", is_flag=True,
-              help="Find the transport delay by that cross-correlation instead (trusting the clock offset).")
-@click.option("--rate", "rate_hz", type=click.FloatRange(min=0, min_open=True, max=_MAX_RATE_HZ), metavar="HZ",
-              help="Rate of the common time base, up to 10 kHz (default: the fastest core signal's).")
+@click.option(
+    "--estimate-wind-offset",
+    is_flag=True,
+    help="Correct the clock offset by cross-correlating the wind with the vehicle's response.",
+)
+@click.option(
+    "--estimate-transport-delay",
+    is_flag=True,
+    help="Find the transport delay by that cross-correlation instead (trusting the clock offset).",
+)
+@click.option(
+    "--rate",
+    "rate_hz",
+    type=click.FloatRange(min=0, min_open=True, max=_MAX_RATE_HZ),
+    metavar="HZ",
+    help="Rate of the common time base, up to 10 kHz (default: the fastest core signal's).",
+)
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
-@click.option("-o", "--out", type=OutputPath(),
-              help="Write signals, records and segments to this HDF5 dataset.")
+@click.option("-o", "--out", type=OutputPath(), help="Write signals, records and segments to this HDF5 dataset.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
-def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[str, str] | None,
-           wind_distance: float | None, wind_bearing: float | None, anemometer_at: tuple[float, float] | None,
-           transport_delay: float | None,
-           wind_offset: float | None, estimate_wind_offset: bool, estimate_transport_delay: bool,
-           rate_hz: float | None,
-           segments_file: Path | None, out: Path | None, json_path: str | None, quiet: bool) -> None:
+def ingest(
+    logs: tuple[Path, ...],
+    wind_paths: tuple[Path, ...],
+    columns: dict[str, str] | None,
+    wind_distance: float | None,
+    wind_bearing: float | None,
+    anemometer_at: tuple[float, float] | None,
+    transport_delay: float | None,
+    wind_offset: float | None,
+    estimate_wind_offset: bool,
+    estimate_transport_delay: bool,
+    rate_hz: float | None,
+    segments_file: Path | None,
+    out: Path | None,
+    json_path: str | None,
+    quiet: bool,
+) -> None:
     """Read LOGS (PX4 .ulg, ArduPilot .bin or MAVLink .tlog, detected from content), report every
     canonical signal with its rate, unit and source, align the anemometer wind, and find the maneuvers."""
-    from flightlogs.campaign import ingest_campaign
-    from flightlogs.condition import ConditioningOptions
-    from flightlogs.store import write_dataset
+    from flightlogs.conditioning.condition import ConditioningOptions
+    from flightlogs.store.campaign import ingest_campaign
+    from flightlogs.store.dataset import write_dataset
 
     if estimate_wind_offset and estimate_transport_delay:
         raise click.UsageError("--estimate-wind-offset and --estimate-transport-delay shift the wind alike; pick one")
     options = ConditioningOptions(
-        rate_hz=rate_hz, wind_offset_s=wind_offset, estimate_wind_offset=estimate_wind_offset,
+        rate_hz=rate_hz,
+        wind_offset_s=wind_offset,
+        estimate_wind_offset=estimate_wind_offset,
         estimate_transport_delay=estimate_transport_delay,
-        wind_distance_m=wind_distance, wind_bearing_rad=None if wind_bearing is None else math.radians(wind_bearing),
-        anemometer_position_rad=anemometer_at, transport_delay_s=transport_delay,
+        wind_distance_m=wind_distance,
+        wind_bearing_rad=None if wind_bearing is None else math.radians(wind_bearing),
+        anemometer_position_rad=anemometer_at,
+        transport_delay_s=transport_delay,
         segments=segments_from(segments_file),
     )
     with progress_bar("reading", quiet=quiet) as bar:
-        campaign = ingest_campaign(list(logs), list(wind_paths), columns=columns, options=options,
-                                   progress=lambda _name, done, total: bar(done, total))
+        campaign = ingest_campaign(
+            list(logs),
+            list(wind_paths),
+            columns=columns,
+            options=options,
+            progress=lambda _name, done, total: bar(done, total),
+        )
     if out is not None:
         campaign.require_flights()  # no dataset without a flight in it; some not conditioned: warned below
         write_dataset(out, campaign.logs, campaign.winds, list(campaign.flights))
@@ -111,7 +159,7 @@ def ingest(logs: tuple[Path, ...], wind_paths: tuple[Path, ...], columns: dict[s
 
 
 def _summary(campaign: Any, out: Path | None) -> dict[str, Any]:
-    from flightlogs.summary import conditioned_summary, log_summary, wind_summary
+    from flightlogs.store.summary import conditioned_summary, log_summary, wind_summary
 
     entries = []
     for log, flight, notes in zip(campaign.logs, campaign.conditioned, campaign.notes):
@@ -133,9 +181,11 @@ def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
         click.echo(text, err=to_stderr)
 
     for entry in summary["logs"]:
-        say(f"{entry['path']}: {entry['autopilot']} {entry['log_format']}, "
+        say(
+            f"{entry['path']}: {entry['autopilot']} {entry['log_format']}, "
             f"{entry['vehicle'] or 'vehicle unknown'}, {entry['duration_s']:.1f} s"
-            + (f", starts {entry['utc_start']}" if entry["utc_start"] else ", no GPS time"))
+            + (f", starts {entry['utc_start']}" if entry["utc_start"] else ", no GPS time")
+        )
         say(f"  {'signal':<11} {'samples':>8} {'rate Hz':>8}  {'unit':<20} source")
         for name, info in entry["signals"].items():
             say(f"  {name:<11} {info['samples']:>8} {info['rate_hz']:>8.1f}  {info['unit']:<20} {info['source']}")
@@ -143,20 +193,28 @@ def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
             say(f"  missing: {', '.join(entry['missing'])}")
         alignment = entry.get("wind_alignment")
         if alignment:
-            say(f"  wind {alignment['wind_file']}: clock offset {alignment['clock_offset_s']:+.3f} s "
+            say(
+                f"  wind {alignment['wind_file']}: clock offset {alignment['clock_offset_s']:+.3f} s "
                 f"({alignment['clock_offset_source']}), transport delay {alignment['transport_delay_s']:.3f} s "
                 f"({alignment['transport_delay_source']}"
                 + (f", {alignment['distance_m']:.2f} m" if alignment["distance_m"] is not None else "")
-                + f"), mean {alignment['mean_speed_m_s']:.2f} m/s")
+                + f"), mean {alignment['mean_speed_m_s']:.2f} m/s"
+            )
             if alignment["residual_offset_s"] is not None:
-                say(f"    residual clock offset {alignment['residual_offset_s']:+.3f} s against "
-                    f"{alignment['residual_against']} (correlation {alignment['residual_correlation']:.2f})")
+                say(
+                    f"    residual clock offset {alignment['residual_offset_s']:+.3f} s against "
+                    f"{alignment['residual_against']} (correlation {alignment['residual_correlation']:.2f})"
+                )
         for record in entry.get("records", []):
-            say(f"  record {record['label']}: {record['start_s']:.2f}-{record['end_s']:.2f} s, "
-                f"{record['samples']} samples at {entry['rate_hz']:.0f} Hz")
+            say(
+                f"  record {record['label']}: {record['start_s']:.2f}-{record['end_s']:.2f} s, "
+                f"{record['samples']} samples at {entry['rate_hz']:.0f} Hz"
+            )
         for segment in entry.get("segments", []):
             axis = segment["axis"] or "-"
-            say(f"  {segment['kind']:<8} {axis:<4} {segment['start_s']:8.2f}-{segment['end_s']:8.2f} s  ({segment['source']})")
+            say(
+                f"  {segment['kind']:<8} {axis:<4} {segment['start_s']:8.2f}-{segment['end_s']:8.2f} s  ({segment['source']})"
+            )
         for warning in entry["warnings"]:
             say(f"  warning: {warning}")
     if summary["output"]:

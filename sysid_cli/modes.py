@@ -21,21 +21,43 @@ Examples:
 
 @click.command(epilog=_EPILOG)
 @click.argument("model_file", required=False, type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--model", "structure_name", metavar="NAME|FILE",
-              help="A structure (built-in name or TOML file) to take the modes of, with --set values.")
-@click.option("--set", "values", multiple=True, callback=parse_assignments, metavar="NAME=VALUE",
-              help="Parameter value (repeatable); parameters not set are taken as dropped (0).")
-@click.option("--trim", "constants", multiple=True, callback=parse_assignments, metavar="NAME=VALUE",
-              help="Trim constant, e.g. U0=2.24 (default zero trim, g = 9.81).")
+@click.option(
+    "--model",
+    "structure_name",
+    metavar="NAME|FILE",
+    help="A structure (built-in name or TOML file) to take the modes of, with --set values.",
+)
+@click.option(
+    "--set",
+    "values",
+    multiple=True,
+    callback=parse_assignments,
+    metavar="NAME=VALUE",
+    help="Parameter value (repeatable); parameters not set are taken as dropped (0).",
+)
+@click.option(
+    "--trim",
+    "constants",
+    multiple=True,
+    callback=parse_assignments,
+    metavar="NAME=VALUE",
+    help="Trim constant, e.g. U0=2.24 (default zero trim, g = 9.81).",
+)
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No table.")
-def modes(model_file: Path | None, structure_name: str | None, values: dict[str, float], constants: dict[str, float],
-          json_path: str | None, quiet: bool) -> None:
+def modes(
+    model_file: Path | None,
+    structure_name: str | None,
+    values: dict[str, float],
+    constants: dict[str, float],
+    json_path: str | None,
+    quiet: bool,
+) -> None:
     """Modes of MODEL_FILE (from ``sysid fit -o``), or of a structure with published parameter values:
     eigenvalues, damping, natural frequency, time to double or half, and which motion each belongs to."""
     from sysid.fit import mode_summary, read_model
     from sysid.model import load_structure, structure_model
-    from sysid.modes import modes as find_modes
+    from sysid.model.modes import modes as find_modes
 
     if (model_file is None) == (structure_name is None):
         raise click.UsageError("give either MODEL_FILE or --model NAME with --set values")
@@ -49,9 +71,9 @@ def modes(model_file: Path | None, structure_name: str | None, values: dict[str,
         assert structure_name is not None
         linear, unset = structure_model(load_structure(structure_name), values, constants=constants)
         source = structure_name
-    summary: dict[str, Any] = {"model": source, "eigenvalues": mode_summary(find_modes(linear)),
-                               "unset": list(unset)}
+    summary: dict[str, Any] = {"model": source, "eigenvalues": mode_summary(find_modes(linear)), "unset": list(unset)}
     if not quiet:
+
         def say(text: str = "") -> None:
             click.echo(text, err=json_path == "-")
 

@@ -54,32 +54,72 @@ def mrac() -> None:
 
 
 @mrac.command(epilog=_COMPARE_EPILOG)
-@click.option("--height-ratio", "height_ratios", multiple=True, callback=_ratios, metavar="Z/R[,Z/R...]",
-              help="Case(s): Z/R of the rotors at the top of the take-off in ground effect, at the hover "
-                   "height out of it (from 10 up: a 6.2 cm step). Repeatable. [default: 4,3,2]")
-@click.option("--trials", type=click.IntRange(min=1), default=3, show_default=True,
-              help="Trials per case and controller (they differ by the noise seed).")
+@click.option(
+    "--height-ratio",
+    "height_ratios",
+    multiple=True,
+    callback=_ratios,
+    metavar="Z/R[,Z/R...]",
+    help="Case(s): Z/R of the rotors at the top of the take-off in ground effect, at the hover "
+    "height out of it (from 10 up: a 6.2 cm step). Repeatable. [default: 4,3,2]",
+)
+@click.option(
+    "--trials",
+    type=click.IntRange(min=1),
+    default=3,
+    show_default=True,
+    help="Trials per case and controller (they differ by the noise seed).",
+)
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the trials' noise seeds.")
-@click.option("--pid-phase", type=click.FloatRange(min=2.0), default=40.0, show_default=True, metavar="S",
-              help="Length of the PID's take-off and of its landing, s.")
-@click.option("--mrac-phase", type=click.FloatRange(min=2.0), default=20.0, show_default=True, metavar="S",
-              help="Length of each MRAC phase, s.")
-@click.option("--ground-effect", "ground_effect_path", type=click.Path(exists=True, dir_okay=False, path_type=Path),
-              help="A fitted ground-effect model (JSON from 'sysid ground-effect fit -o') acting on the vehicle "
-                   "instead of eq. 2.5.")
-@click.option("--report", "report_path", type=OutputPath(),
-              help="Write the HTML report here.")
-@click.option("-o", "--out", "out_path", type=OutputPath(),
-              help="Write the results (summary and every trial's indices) as JSON here.")
+@click.option(
+    "--pid-phase",
+    type=click.FloatRange(min=2.0),
+    default=40.0,
+    show_default=True,
+    metavar="S",
+    help="Length of the PID's take-off and of its landing, s.",
+)
+@click.option(
+    "--mrac-phase",
+    type=click.FloatRange(min=2.0),
+    default=20.0,
+    show_default=True,
+    metavar="S",
+    help="Length of each MRAC phase, s.",
+)
+@click.option(
+    "--ground-effect",
+    "ground_effect_path",
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    help="A fitted ground-effect model (JSON from 'sysid ground-effect fit -o') acting on the vehicle "
+    "instead of eq. 2.5.",
+)
+@click.option("--report", "report_path", type=OutputPath(), help="Write the HTML report here.")
+@click.option(
+    "-o",
+    "--out",
+    "out_path",
+    type=OutputPath(),
+    help="Write the results (summary and every trial's indices) as JSON here.",
+)
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")
-def compare(height_ratios: tuple[float, ...], trials: int, seed: int, pid_phase: float, mrac_phase: float,
-            ground_effect_path: Path | None, report_path: Path | None, out_path: Path | None, json_path: str | None,
-            quiet: bool) -> None:
+def compare(
+    height_ratios: tuple[float, ...],
+    trials: int,
+    seed: int,
+    pid_phase: float,
+    mrac_phase: float,
+    ground_effect_path: Path | None,
+    report_path: Path | None,
+    out_path: Path | None,
+    json_path: str | None,
+    quiet: bool,
+) -> None:
     """Fly take-off and landing steps with PID, MRAC (linear) and MRAC (RBF) in the simulator with ground
     effect, and report rise time, steady-state error, MSE to the reference model, overshoot and settling
     time (Tables 2.6-2.8)."""
-    from sysid.mrac import CompareConfig, compare_controllers, comparison_json
+    from simulator.mrac import CompareConfig, compare_controllers, comparison_json
 
     law, label = None, None
     if ground_effect_path is not None:
@@ -87,8 +127,9 @@ def compare(height_ratios: tuple[float, ...], trials: int, seed: int, pid_phase:
 
         law = read_ground_effect_model(ground_effect_path)
         label = f"{law.model} fitted to {law.source or ground_effect_path.name} ({ground_effect_path.name})"
-    config = CompareConfig(height_ratios=height_ratios, trials=trials, seed=seed, pid_phase_s=pid_phase,
-                           mrac_phase_s=mrac_phase)
+    config = CompareConfig(
+        height_ratios=height_ratios, trials=trials, seed=seed, pid_phase_s=pid_phase, mrac_phase_s=mrac_phase
+    )
     with progress_bar("flying", quiet=quiet) as bar:
         comparison = compare_controllers(config, ground_effect=law, ground_effect_label=label, progress=bar)
     if out_path is not None:
@@ -107,9 +148,14 @@ def _echo(summary: dict[str, Any], *, err: bool) -> None:
     """Rise times per case and phase, and the MRAC/PID ratios."""
     for case in summary["cases"]:
         for phase, entry in case["phases"].items():
-            rises = ", ".join(f"{name} {s['rise_time_s']['mean']:.2f} s" if s["rise_time_s"]["n"] else f"{name} —"
-                              for name, s in entry["controllers"].items())
+            rises = ", ".join(
+                f"{name} {s['rise_time_s']['mean']:.2f} s" if s["rise_time_s"]["n"] else f"{name} —"
+                for name, s in entry["controllers"].items()
+            )
             ratios = entry.get("rise_time_over_pid", {})
-            extra = ("; rise/PID " + ", ".join(f"{n} {r:.2f}" if r == r else f"{n} —" for n, r in ratios.items())
-                     if ratios else "")
+            extra = (
+                "; rise/PID " + ", ".join(f"{n} {r:.2f}" if r == r else f"{n} —" for n, r in ratios.items())
+                if ratios
+                else ""
+            )
             click.echo(f"Z/R {case['height_ratio']:g} {phase}: rise {rises}{extra}", err=err)

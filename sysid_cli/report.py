@@ -51,15 +51,24 @@ def ingest_card(doc: Any, *, source: str = "ingest summary") -> dict[str, str]:
     card = {"vehicle": "; ".join(dict.fromkeys(str(log.get("vehicle") or "not named in the log") for log in logs))}
     card["flight"] = "; ".join(
         f"{Path(str(log.get('path', '?'))).name}: {log.get('autopilot', '?')} {log.get('log_format', '')} log, "
-        f"{float(log.get('duration_s') or 0.0):.0f} s from {log.get('utc_start') or 'unknown UTC'}" for log in logs)
+        f"{float(log.get('duration_s') or 0.0):.0f} s from {log.get('utc_start') or 'unknown UTC'}"
+        for log in logs
+    )
     alignment = doc.get("wind_alignment")
     if isinstance(alignment, Mapping) and alignment:
-        parts = [f"anemometer clock offset {float(alignment['clock_offset_s']):+.2f} s "
-                 f"({alignment.get('clock_offset_source', '?')})" if "clock_offset_s" in alignment else "",
-                 f"transport delay {float(alignment['transport_delay_s']):.2f} s "
-                 f"({alignment.get('transport_delay_source', '?')})" if "transport_delay_s" in alignment else "",
-                 f"turbulence {100 * float(alignment['turbulence_ratio']):.0f} %"
-                 if alignment.get("turbulence_ratio") is not None else ""]
+        parts = [
+            f"anemometer clock offset {float(alignment['clock_offset_s']):+.2f} s "
+            f"({alignment.get('clock_offset_source', '?')})"
+            if "clock_offset_s" in alignment
+            else "",
+            f"transport delay {float(alignment['transport_delay_s']):.2f} s "
+            f"({alignment.get('transport_delay_source', '?')})"
+            if "transport_delay_s" in alignment
+            else "",
+            f"turbulence {100 * float(alignment['turbulence_ratio']):.0f} %"
+            if alignment.get("turbulence_ratio") is not None
+            else "",
+        ]
         card["wind alignment"] = ", ".join(p for p in parts if p)
     return card
 
@@ -75,36 +84,62 @@ def _read_json(path: Path) -> Any:
 
 @click.command(epilog=_EPILOG)
 @click.argument("model_path", metavar="MODEL.json", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.argument("validation_path", metavar="[VALIDATION.json]", required=False,
-                type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("-o", "--out", type=OutputPath(),
-              help="HTML report to write (default: MODEL with .html).")
-@click.option("--ingest-summary", "ingest_path", type=click.Path(exists=True, dir_okay=False, path_type=Path),
-              help="What 'sysid ingest --json' wrote: adds the vehicle, the flight and the wind alignment.")
+@click.argument(
+    "validation_path",
+    metavar="[VALIDATION.json]",
+    required=False,
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+)
+@click.option("-o", "--out", type=OutputPath(), help="HTML report to write (default: MODEL with .html).")
+@click.option(
+    "--ingest-summary",
+    "ingest_path",
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    help="What 'sysid ingest --json' wrote: adds the vehicle, the flight and the wind alignment.",
+)
 @click.option("--title", help="Page title (default: 'Identified model: STRUCTURE').")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="Print nothing but errors.")
-def report(model_path: Path, validation_path: Path | None, out: Path | None, ingest_path: Path | None,
-           title: str | None, json_path: str | None, quiet: bool) -> None:
+def report(
+    model_path: Path,
+    validation_path: Path | None,
+    out: Path | None,
+    ingest_path: Path | None,
+    title: str | None,
+    json_path: str | None,
+    quiet: bool,
+) -> None:
     """Write the HTML report of MODEL.json (as 'sysid fit --report' does): verdict, responses with the model,
     parameters, costs, correlations, modes; with VALIDATION.json (a saved verification, as 'sysid validate -o'
     and 'sysid demo' write), also the doublets predicted with and without the wind term. One self-contained file."""
-    from reports.model_report import model_report_html, model_verdict
     from reports.html import write_html
+    from reports.model_report import model_report_html, model_verdict
     from sysid.fit import read_model
-    from sysid.verify_io import read_verification
+    from sysid.verify.io import read_verification
 
     model = read_model(model_path)
     saved = read_verification(validation_path) if validation_path is not None else None
     card = ingest_card(_read_json(ingest_path), source=str(ingest_path)) if ingest_path is not None else None
     verification = saved.verification if saved is not None else None
-    text = model_report_html(model, verification=verification, title=title, logs_summary=card,
-                             verification_options=saved.options if saved is not None else None)
+    text = model_report_html(
+        model,
+        verification=verification,
+        title=title,
+        logs_summary=card,
+        verification_options=saved.options if saved is not None else None,
+    )
     target = write_html(out if out is not None else model_path.with_suffix(".html"), text)
     verdict = model_verdict(model, verification)
     if not quiet:
         click.echo(verdict.sentence, err=json_path == "-")
         click.echo(f"wrote {target}", err=json_path == "-")
-    emit_json({"report": str(target), "model": str(model_path),
-               "verification": str(validation_path) if validation_path is not None else None,
-               "verdict": verdict.grade, "sentence": verdict.sentence}, json_path)
+    emit_json(
+        {
+            "report": str(target),
+            "model": str(model_path),
+            "verification": str(validation_path) if validation_path is not None else None,
+            "verdict": verdict.grade,
+            "sentence": verdict.sentence,
+        },
+        json_path,
+    )

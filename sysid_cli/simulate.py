@@ -40,24 +40,38 @@ def _check_trials(trials: list[int] | None, n_trials: int, name: str) -> None:
     if outside:
         valid = "0" if n_trials == 1 else f"0-{n_trials - 1}"
         raise click.BadParameter(
-            f"{', '.join(map(str, outside))}: scenario {name} has trials {valid} only", param_hint="--trials")
+            f"{', '.join(map(str, outside))}: scenario {name} has trials {valid} only", param_hint="--trials"
+        )
 
 
 @click.command(epilog=_EPILOG)
 @click.argument("scenario", required=False)
-@click.option("-o", "--out", "out_dir", type=OutputPath(folder=True), default=None,
-              help="Folder for the logs, anemometer files, truth and campaign.json (default: the scenario name).")
+@click.option(
+    "-o",
+    "--out",
+    "out_dir",
+    type=OutputPath(folder=True),
+    default=None,
+    help="Folder for the logs, anemometer files, truth and campaign.json (default: the scenario name).",
+)
 @click.option("--list", "list_only", is_flag=True, help="List the built-in scenarios and exit.")
-@click.option("--trials", callback=_trial_range,
-              help="Only these trials, e.g. 0-3,7 (numbered from 0, as `--json` lists them).")
+@click.option(
+    "--trials", callback=_trial_range, help="Only these trials, e.g. 0-3,7 (numbered from 0, as `--json` lists them)."
+)
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")
-def simulate(scenario: str | None, out_dir: Path | None, list_only: bool, trials: list[int] | None,
-             json_path: str | None, quiet: bool) -> None:
+def simulate(
+    scenario: str | None,
+    out_dir: Path | None,
+    list_only: bool,
+    trials: list[int] | None,
+    json_path: str | None,
+    quiet: bool,
+) -> None:
     """Fly SCENARIO (a built-in name or a TOML file) and write each trial's logs (ArduPilot .bin,
     PX4 .ulg), the ground anemometer's CSV and a truth JSON."""
-    from sysid.sim.campaign import run_scenario
-    from sysid.sim.scenario import builtin_scenarios, load_builtin, read_scenario
+    from simulator.campaign.fly import run_scenario
+    from simulator.campaign.scenario import builtin_scenarios, load_builtin, read_scenario
 
     if list_only:
         for name, path in sorted(builtin_scenarios().items()):
@@ -73,10 +87,19 @@ def simulate(scenario: str | None, out_dir: Path | None, list_only: bool, trials
     summary = {
         "scenario": plan.name,
         "out": str(folder),
-        "trials": [{"name": t.plan.name, "logs": [str(p) for p in t.logs],
-                    "anemometer": str(t.wind_csv) if t.wind_csv else None, "truth": str(t.truth)} for t in written],
+        "trials": [
+            {
+                "name": t.plan.name,
+                "logs": [str(p) for p in t.logs],
+                "anemometer": str(t.wind_csv) if t.wind_csv else None,
+                "truth": str(t.truth),
+            }
+            for t in written
+        ],
     }
     if not quiet:
-        click.echo(f"{plan.name}: {len(written)} trials written to {folder}/ (index: {folder / 'campaign.json'})",
-                   err=json_path == "-")
+        click.echo(
+            f"{plan.name}: {len(written)} trials written to {folder}/ (index: {folder / 'campaign.json'})",
+            err=json_path == "-",
+        )
     emit_json(summary, json_path)

@@ -10,8 +10,14 @@ import click
 
 from ._common import OutputPath, emit_json, json_option
 from ._flights import conditioned_flights, is_dataset
-from ._wind_options import (segments_from, segments_option, transport_delay_option, wind_distance_option,
-                            wind_offset_option, wind_option)
+from ._wind_options import (
+    segments_from,
+    segments_option,
+    transport_delay_option,
+    wind_distance_option,
+    wind_offset_option,
+    wind_option,
+)
 
 __all__ = ["validate"]
 
@@ -32,23 +38,53 @@ Examples:
 @transport_delay_option()
 @wind_offset_option()
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis, kind) overriding detection.")
-@click.option("--before", "before_s", type=click.FloatRange(min=0), default=0.5, show_default=True, metavar="S",
-              help="Quiet stretch kept before each doublet, s.")
-@click.option("--after", "after_s", type=click.FloatRange(min=0), default=1.0, show_default=True, metavar="S",
-              help="Response kept after each doublet, s (an unstable model diverges over long records).")
-@click.option("--initial-state", type=click.Choice(["measured", "estimated", "zero"]), default="measured",
-              show_default=True, help="Start each simulation from the measured states, from those corrected by "
-                                      "least squares, or from zero.")
-@click.option("-o", "--out", type=OutputPath(),
-              help="Save the verification with its time histories (JSON) for 'sysid report'.")
-@click.option("--report", type=OutputPath(),
-              help="Write the HTML model report, with this verification, here.")
+@click.option(
+    "--before",
+    "before_s",
+    type=click.FloatRange(min=0),
+    default=0.5,
+    show_default=True,
+    metavar="S",
+    help="Quiet stretch kept before each doublet, s.",
+)
+@click.option(
+    "--after",
+    "after_s",
+    type=click.FloatRange(min=0),
+    default=1.0,
+    show_default=True,
+    metavar="S",
+    help="Response kept after each doublet, s (an unstable model diverges over long records).",
+)
+@click.option(
+    "--initial-state",
+    type=click.Choice(["measured", "estimated", "zero"]),
+    default="measured",
+    show_default=True,
+    help="Start each simulation from the measured states, from those corrected by least squares, or from zero.",
+)
+@click.option(
+    "-o", "--out", type=OutputPath(), help="Save the verification with its time histories (JSON) for 'sysid report'."
+)
+@click.option("--report", type=OutputPath(), help="Write the HTML model report, with this verification, here.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
-def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, ...], wind_distance: float | None,
-             transport_delay: float | None, wind_offset: float | None, segments_file: Path | None, before_s: float,
-             after_s: float, initial_state: str, out: Path | None, report: Path | None, json_path: str | None,
-             quiet: bool) -> None:
+def validate(
+    model_path: Path,
+    logs: tuple[Path, ...],
+    wind_paths: tuple[Path, ...],
+    wind_distance: float | None,
+    transport_delay: float | None,
+    wind_offset: float | None,
+    segments_file: Path | None,
+    before_s: float,
+    after_s: float,
+    initial_state: str,
+    out: Path | None,
+    report: Path | None,
+    json_path: str | None,
+    quiet: bool,
+) -> None:
     """Simulate MODEL.json from all the measured inputs of every doublet in LOGS (flight logs, or HDF5 datasets
     written by ``sysid ingest -o``) and report the RMS error and
     Theil inequality coefficient per output (with bias and reference shift estimated, as VERIFY does), judging
@@ -56,29 +92,47 @@ def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, .
     the error."""
     import datetime as dt
 
-    from flightlogs.condition import ConditioningOptions
+    from flightlogs.conditioning.condition import ConditioningOptions
     from reports.model_report import write_model_report
     from sysid.fit import read_model
-    from sysid.verify_io import write_verification
+    from sysid.verify.io import write_verification
 
     identified = read_model(model_path)
     segments = segments_from(segments_file)
     conditioning = ConditioningOptions(
-        wind_offset_s=wind_offset, wind_distance_m=wind_distance, transport_delay_s=transport_delay,
-        segments=segments)
-    log_only = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset,
-                "--transport-delay": transport_delay, "--segments": segments_file}
+        wind_offset_s=wind_offset, wind_distance_m=wind_distance, transport_delay_s=transport_delay, segments=segments
+    )
+    log_only = {
+        "--wind": wind_paths,
+        "--wind-distance": wind_distance,
+        "--wind-offset": wind_offset,
+        "--transport-delay": transport_delay,
+        "--segments": segments_file,
+    }
     flights = conditioned_flights(logs, wind_paths, conditioning, log_only=log_only, quiet=quiet)
     if segments_file is not None and segments is not None:
         _check_segments(segments_file, segments, flights)
-    verification, notes = _verify(identified, flights, dataset=is_dataset(logs[0]), with_wind_files=bool(wind_paths),
-                                  segments_given=segments_file is not None, before_s=before_s, after_s=after_s,
-                                  initial_state=initial_state)
-    saved = {"initial_state": initial_state, "before_s": before_s, "after_s": after_s,
-             "inputs": "all measured", "judged": "on-axis outputs of each doublet's axis",
-             "logs": [p.name for p in logs], "wind": [p.name for p in wind_paths]}
+    verification, notes = _verify(
+        identified,
+        flights,
+        dataset=is_dataset(logs[0]),
+        with_wind_files=bool(wind_paths),
+        segments_given=segments_file is not None,
+        before_s=before_s,
+        after_s=after_s,
+        initial_state=initial_state,
+    )
+    saved = {
+        "initial_state": initial_state,
+        "before_s": before_s,
+        "after_s": after_s,
+        "inputs": "all measured",
+        "judged": "on-axis outputs of each doublet's axis",
+        "logs": [p.name for p in logs],
+        "wind": [p.name for p in wind_paths],
+    }
     if out is not None:
-        created = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+        created = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
         write_verification(out, verification, model=model_path.name, options=saved, created_utc=created)
     if report is not None:
         write_model_report(report, identified, verification=verification, verification_options=saved)
@@ -88,8 +142,17 @@ def validate(model_path: Path, logs: tuple[Path, ...], wind_paths: tuple[Path, .
     emit_json(summary, json_path)
 
 
-def _verify(identified: Any, flights: list[Any], *, dataset: bool, with_wind_files: bool, segments_given: bool,
-            before_s: float, after_s: float, initial_state: str) -> tuple[Any, list[str]]:
+def _verify(
+    identified: Any,
+    flights: list[Any],
+    *,
+    dataset: bool,
+    with_wind_files: bool,
+    segments_given: bool,
+    before_s: float,
+    after_s: float,
+    initial_state: str,
+) -> tuple[Any, list[str]]:
     """Verify the model on the flights' doublets, with its wind term where the flights carry the wind."""
     from sysid.verify import VerificationOptions, axis_outputs, verify_flights
 
@@ -100,14 +163,31 @@ def _verify(identified: Any, flights: list[Any], *, dataset: bool, with_wind_fil
     use_wind = bool(wind_inputs) and (wind_inputs <= signals if dataset else with_wind_files)
     notes = []
     if wind_inputs and not use_wind:
-        notes.append("the model's wind term is not verified: " + (
-            "the dataset holds no aligned wind (ingest it with --wind)" if dataset
-            else "no anemometer file was given (--wind)"))
-    hint = ("" if segments_given else "give their times to `sysid ingest --segments`" if dataset
-            else "give their times with --segments if they were not detected")
-    verification = verify_flights(model, flights, wind_model=with_wind if use_wind else None,
-                                  axes=axis_outputs(identified), before_s=before_s, after_s=after_s, hint=hint,
-                                  options=VerificationOptions(initial_state=initial_state))  # type: ignore[arg-type]
+        notes.append(
+            "the model's wind term is not verified: "
+            + (
+                "the dataset holds no aligned wind (ingest it with --wind)"
+                if dataset
+                else "no anemometer file was given (--wind)"
+            )
+        )
+    hint = (
+        ""
+        if segments_given
+        else "give their times to `sysid ingest --segments`"
+        if dataset
+        else "give their times with --segments if they were not detected"
+    )
+    verification = verify_flights(
+        model,
+        flights,
+        wind_model=with_wind if use_wind else None,
+        axes=axis_outputs(identified),
+        before_s=before_s,
+        after_s=after_s,
+        hint=hint,
+        options=VerificationOptions(initial_state=initial_state),
+    )  # type: ignore[arg-type]
     return verification, notes
 
 
@@ -120,12 +200,17 @@ def _check_segments(path: Path, segments: Any, flights: list[Any]) -> None:
             continue
         if any(r.start_s <= segment.start_s <= r.end_s for f in flights for r in f.records):
             continue
-        spans = "; ".join(f"{f.source.name} {min(r.start_s for r in f.records):.1f}-"
-                          f"{max(r.end_s for r in f.records):.1f} s" for f in flights if f.records)
+        spans = "; ".join(
+            f"{f.source.name} {min(r.start_s for r in f.records):.1f}-{max(r.end_s for r in f.records):.1f} s"
+            for f in flights
+            if f.records
+        )
         line = _line_of(path, segment.start_s, segment.end_s)
         where = f"{path}" + (f" line {line}" if line else "")
-        raise DataError(f"{where}: the {segment.axis} doublet at {segment.start_s:g}-{segment.end_s:g} s starts "
-                        f"outside every log's records ({spans})")
+        raise DataError(
+            f"{where}: the {segment.axis} doublet at {segment.start_s:g}-{segment.end_s:g} s starts "
+            f"outside every log's records ({spans})"
+        )
 
 
 def _line_of(path: Path, start_s: float, end_s: float) -> int | None:
@@ -142,32 +227,62 @@ def _line_of(path: Path, start_s: float, end_s: float) -> int | None:
     return None
 
 
-def _summary(verification: Any, model_path: Path, logs: tuple[Path, ...], report: Path | None,
-             notes: list[str]) -> dict[str, Any]:
+def _summary(
+    verification: Any, model_path: Path, logs: tuple[Path, ...], report: Path | None, notes: list[str]
+) -> dict[str, Any]:
     summary: dict[str, Any] = {
         "model": str(model_path),
         "logs": [str(p) for p in logs],
-        "records": [{"label": r.label, "source": str(r.source), "start_s": float(r.time_s[0]),
-                     "end_s": float(r.time_s[-1]), "rmse": r.rmse, "tic": r.tic, "unstable": r.unstable,
-                     "growth": r.growth, "unstable_modes": list(r.unstable_modes), "notice": r.notice,
-                     "reference_shifts": dict(r.reference_shifts),
-                     "bias": {o.name: o.bias for o in r.outputs}, "excited": r.excited,
-                     "on_axis": [o.name for o in r.judged], "off_axis": list(r.off_axis)}
-                    for r in verification.records],
-        "summary": {s.name: {"unit": s.unit, "rmse": s.rmse, "tic": s.tic, "records": s.n_records,
-                             "one_step_rmse": s.prediction_rmse, "one_step_tic": s.prediction_tic}
-                    for s in verification.summary},
-        "off_axis": {s.name: {"unit": s.unit, "rmse": s.rmse, "tic": s.tic, "records": s.n_records}
-                     for s in verification.off_axis},
+        "records": [
+            {
+                "label": r.label,
+                "source": str(r.source),
+                "start_s": float(r.time_s[0]),
+                "end_s": float(r.time_s[-1]),
+                "rmse": r.rmse,
+                "tic": r.tic,
+                "unstable": r.unstable,
+                "growth": r.growth,
+                "unstable_modes": list(r.unstable_modes),
+                "notice": r.notice,
+                "reference_shifts": dict(r.reference_shifts),
+                "bias": {o.name: o.bias for o in r.outputs},
+                "excited": r.excited,
+                "on_axis": [o.name for o in r.judged],
+                "off_axis": list(r.off_axis),
+            }
+            for r in verification.records
+        ],
+        "summary": {
+            s.name: {
+                "unit": s.unit,
+                "rmse": s.rmse,
+                "tic": s.tic,
+                "records": s.n_records,
+                "one_step_rmse": s.prediction_rmse,
+                "one_step_tic": s.prediction_tic,
+            }
+            for s in verification.summary
+        },
+        "off_axis": {
+            s.name: {"unit": s.unit, "rmse": s.rmse, "tic": s.tic, "records": s.n_records}
+            for s in verification.off_axis
+        },
         "overall": {"rmse": verification.rmse, "tic": verification.tic},
         "unstable": verification.unstable,
         "report": str(report) if report is not None else None,
         "notes": notes,
     }
     if verification.wind_correction:
-        summary["wind_correction"] = {c.name: {"unit": c.unit, "rmse_without": c.rmse_without,
-                                               "rmse_with": c.rmse_with, "reduction_percent": c.reduction_percent}
-                                      for c in verification.wind_correction}
+        summary["wind_correction"] = {
+            c.name: {
+                "unit": c.unit,
+                "rmse_without": c.rmse_without,
+                "rmse_with": c.rmse_with,
+                "reduction_percent": c.reduction_percent,
+            }
+            for c in verification.wind_correction
+        }
     return summary
 
 
@@ -191,18 +306,22 @@ def _print(summary: dict[str, Any], *, to_stderr: bool) -> None:
     if len(unstable) > 1:  # one note, not the same sentence per record
         growth = max(r["growth"] for r in unstable)
         names = mode_names([m for r in unstable for m in r["unstable_modes"]])
-        say(f"  note: the model is unstable open loop in its {names} and grows up to {growth:.0f}-fold over "
+        say(
+            f"  note: the model is unstable open loop in its {names} and grows up to {growth:.0f}-fold over "
             f"{len(unstable)} records "
             f"({'; '.join(r['label'] for r in unstable)}): small input or initial-state errors diverge there, so "
-            "judge them also by the one-step-ahead prediction error (one_step_* in --json)")
+            "judge them also by the one-step-ahead prediction error (one_step_* in --json)"
+        )
     for record in summary["records"]:
         if record["notice"] and (len(unstable) < 2 or not record["unstable"]):
             say(f"  note: {record['label']}: {record['notice']}")
     for note in summary["notes"]:
         say(f"  note: {note}")
     if summary["off_axis"]:
-        say("  off-axis (not judged): " + ", ".join(f"{name} TIC {row['tic']:.2f}"
-                                                    for name, row in summary["off_axis"].items()))
+        say(
+            "  off-axis (not judged): "
+            + ", ".join(f"{name} TIC {row['tic']:.2f}" for name, row in summary["off_axis"].items())
+        )
     for path in (summary["output"], summary["report"]):
         if path:
             say(f"wrote {path}")

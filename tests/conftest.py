@@ -46,8 +46,8 @@ def report_browser() -> ModuleType:
 
 @pytest.fixture(scope="session")
 def excitation_tests() -> ModuleType:
-    """``tests/flightlogs/test_excitation.py``'s closed-loop roll hold: ``_closed_loop``, ``_3211``, ``DT``."""
-    return _test_helper("_excitation_tests", "flightlogs/test_excitation.py")
+    """``tests/flightlogs/maneuvers/test_excitation_recovery.py``'s closed-loop roll hold: ``_closed_loop``, ``_3211``, ``DT``."""
+    return _test_helper("_excitation_tests", "flightlogs/maneuvers/test_excitation_recovery.py")
 
 
 @pytest.fixture(scope="session")

@@ -10,7 +10,7 @@ import re
 
 import pytest
 
-PACKAGES = ["flightlogs", "sysid", "reports"]
+PACKAGES = ["flightlogs", "sysid", "simulator", "reports"]
 
 
 def _public_objects() -> list[tuple[str, object]]:

@@ -7,23 +7,53 @@ by :func:`write_model` and exported by :func:`to_statespace` and
 :func:`write_mat`.
 """
 
-from .accuracy import Accuracy, accuracy
-from .control_adapter import from_control_layout, from_statespace, to_control_layout, to_statespace
-from .cost import CostSummary, CostWeights, FitPoints, ResponseModel, fit_points
-from .engine import FitOptions, FrequencyFit, fit_frequency_responses
-from .identify import FIT_PAIRS, IdentifyOptions, identify_flights, identify_logs, model_from_fit
-from .model_file import SCHEMA_VERSION, model_from_dict, model_to_dict, read_model, write_mat, write_model
-from .reduce import ReductionStep, worst_parameter
-from .result import IdentifiedModel, ParameterEstimate, Provenance, WindFit
-from .summary import fit_summary, mode_summary
-from .synthetic import synthetic_responses
-from .wind import WindStepResult, fit_wind
+from sysid.fit.accuracy import Accuracy, accuracy
+from sysid.fit.control_adapter import from_control_layout, from_statespace, to_control_layout, to_statespace
+from sysid.fit.cost import CostSummary, CostWeights, FitPoints, ResponseModel, fit_points
+from sysid.fit.engine import FitOptions, FrequencyFit, fit_frequency_responses
+from sysid.fit.identify import FIT_PAIRS, IdentifyOptions, identify_flights, identify_logs, model_from_fit
+from sysid.fit.model_file import SCHEMA_VERSION, model_from_dict, model_to_dict, read_model, write_mat, write_model
+from sysid.fit.reduce import ReductionStep, worst_parameter
+from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance, WindFit
+from sysid.fit.summary import fit_summary, mode_summary
+from sysid.fit.synthetic import synthetic_responses
+from sysid.fit.wind import WindStepResult, fit_wind
 
 __all__ = [
-    "Accuracy", "accuracy", "to_statespace", "from_statespace", "to_control_layout", "from_control_layout",
-    "CostSummary", "CostWeights", "FitPoints", "ResponseModel", "fit_points", "FitOptions", "FrequencyFit",
-    "fit_frequency_responses", "FIT_PAIRS", "IdentifyOptions", "identify_flights", "identify_logs", "model_from_fit",
-    "SCHEMA_VERSION", "model_from_dict", "model_to_dict", "read_model", "write_mat", "write_model", "ReductionStep",
-    "worst_parameter", "IdentifiedModel", "ParameterEstimate", "Provenance", "WindFit", "synthetic_responses",
-    "WindStepResult", "fit_wind", "fit_summary", "mode_summary",
+    "Accuracy",
+    "accuracy",
+    "to_statespace",
+    "from_statespace",
+    "to_control_layout",
+    "from_control_layout",
+    "CostSummary",
+    "CostWeights",
+    "FitPoints",
+    "ResponseModel",
+    "fit_points",
+    "FitOptions",
+    "FrequencyFit",
+    "fit_frequency_responses",
+    "FIT_PAIRS",
+    "IdentifyOptions",
+    "identify_flights",
+    "identify_logs",
+    "model_from_fit",
+    "SCHEMA_VERSION",
+    "model_from_dict",
+    "model_to_dict",
+    "read_model",
+    "write_mat",
+    "write_model",
+    "ReductionStep",
+    "worst_parameter",
+    "IdentifiedModel",
+    "ParameterEstimate",
+    "Provenance",
+    "WindFit",
+    "synthetic_responses",
+    "WindStepResult",
+    "fit_wind",
+    "fit_summary",
+    "mode_summary",
 ]

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from .._json import finite_or_none
-from .result import ParameterEstimate
+from sysid._json import finite_or_none
+from sysid.fit.result import ParameterEstimate
 
 __all__ = ["parameter_entry"]
 
@@ -24,6 +24,11 @@ def parameter_entry(p: ParameterEstimate) -> dict[str, Any]:
     -------
     dict
     """
-    return {"value": p.value, "cr_percent": finite_or_none(p.cr_percent),
-            "insensitivity_percent": finite_or_none(p.insensitivity_percent), "status": p.status, "unit": p.unit,
-            "stage": p.stage}
+    return {
+        "value": p.value,
+        "cr_percent": finite_or_none(p.cr_percent),
+        "insensitivity_percent": finite_or_none(p.insensitivity_percent),
+        "status": p.status,
+        "unit": p.unit,
+        "stage": p.stage,
+    }

@@ -61,8 +61,13 @@ class Accuracy:
 
     def __post_init__(self) -> None:
         n = len(self.names)
-        for name, shape in (("values", (n,)), ("hessian", (n, n)), ("cramer_rao", (n,)), ("insensitivity", (n,)),
-                            ("correlation", (n, n))):
+        for name, shape in (
+            ("values", (n,)),
+            ("hessian", (n, n)),
+            ("cramer_rao", (n,)),
+            ("insensitivity", (n,)),
+            ("correlation", (n, n)),
+        ):
             if np.shape(getattr(self, name)) != shape:
                 raise ValueError(f"{name} has shape {np.shape(getattr(self, name))}, expected {shape}")
 

@@ -13,9 +13,10 @@ from typing import Any, Literal
 
 import control
 import numpy as np
-from scipy import linalg, signal as sps
+from scipy import linalg
+from scipy import signal as sps
 
-from ..statespace import DelayedStateSpace
+from sysid.model.statespace import DelayedStateSpace
 
 __all__ = ["to_statespace", "from_statespace", "to_control_layout", "from_control_layout"]
 
@@ -126,6 +127,13 @@ def from_statespace(system: control.StateSpace, input_delays_s: np.ndarray | Non
     """
     n_u = system.ninputs
     delays = np.zeros(n_u) if input_delays_s is None else np.asarray(input_delays_s, dtype=float)
-    return DelayedStateSpace(np.asarray(system.A), np.asarray(system.B), np.asarray(system.C), np.asarray(system.D),
-                             tuple(system.state_labels), tuple(system.input_labels), tuple(system.output_labels),
-                             delays)
+    return DelayedStateSpace(
+        np.asarray(system.A),
+        np.asarray(system.B),
+        np.asarray(system.C),
+        np.asarray(system.D),
+        tuple(system.state_labels),
+        tuple(system.input_labels),
+        tuple(system.output_labels),
+        delays,
+    )

@@ -23,9 +23,8 @@ from types import MappingProxyType
 import numpy as np
 
 from flightlogs.errors import FitError
-
-from ..freqresp import FrequencyResponse
-from ..model.assemble import Assembler, SystemMatrices
+from sysid.freqresp import FrequencyResponse
+from sysid.model.assemble import Assembler, SystemMatrices
 
 __all__ = ["CostWeights", "CostSummary", "FitPoints", "fit_points", "ResponseModel"]
 
@@ -172,8 +171,15 @@ def fit_points(responses: Sequence[FrequencyResponse], *, weights: CostWeights =
         weight.append(20.0 / chosen.size * w_gamma)
         name = fr.pair
         pairs.append(name if name not in pairs else f"{name}#{pairs.count(name) + 1}")
-    return FitPoints(tuple(pairs), tuple(fr.input for fr in responses), tuple(fr.output for fr in responses),
-                     np.concatenate(omega), np.concatenate(index), np.concatenate(log_meas), np.concatenate(weight))
+    return FitPoints(
+        tuple(pairs),
+        tuple(fr.input for fr in responses),
+        tuple(fr.output for fr in responses),
+        np.concatenate(omega),
+        np.concatenate(index),
+        np.concatenate(log_meas),
+        np.concatenate(weight),
+    )
 
 
 def _times_real(left: np.ndarray, right: np.ndarray) -> np.ndarray:
@@ -205,17 +211,21 @@ class ResponseModel:
         signals = [c.signal for c in assembler.channels]
         for pair, i, o in zip(points.pairs, points.inputs, points.outputs):
             if o not in outputs or i not in signals:
-                raise FitError(f"response {pair}: the model {assembler.structure.name} has no "
-                               + (f"output {o}" if o not in outputs else f"input {i}"))
+                raise FitError(
+                    f"response {pair}: the model {assembler.structure.name} has no "
+                    + (f"output {o}" if o not in outputs else f"input {i}")
+                )
         self._row = np.array([outputs.index(points.outputs[r]) for r in points.response])
-        self._select = np.array([[float(signals[c] == points.inputs[r]) for c in range(len(signals))]
-                                 for r in points.response])
+        self._select = np.array(
+            [[float(signals[c] == points.inputs[r]) for c in range(len(signals))] for r in points.response]
+        )
         self._s = 1j * points.omega
         root = np.sqrt(points.weight)
         self._scale = np.concatenate([root * np.sqrt(weights.magnitude) * _DB, root * np.sqrt(weights.phase) * _DEG])
 
-    def log_response(self, theta: np.ndarray, *, with_derivatives: bool = False
-                     ) -> tuple[np.ndarray, np.ndarray | None]:
+    def log_response(
+        self, theta: np.ndarray, *, with_derivatives: bool = False
+    ) -> tuple[np.ndarray, np.ndarray | None]:
         """``ln T`` of the model at each point, and optionally ``d ln T / d theta``.
 
         Parameters
@@ -249,8 +259,16 @@ class ResponseModel:
             return log_t, None
         return log_t, self._derivatives(theta, m, x, z, g, delay, t)
 
-    def _derivatives(self, theta: np.ndarray, m: SystemMatrices, x: np.ndarray, z: np.ndarray, g: np.ndarray,
-                     delay: np.ndarray, t: np.ndarray) -> np.ndarray:
+    def _derivatives(
+        self,
+        theta: np.ndarray,
+        m: SystemMatrices,
+        x: np.ndarray,
+        z: np.ndarray,
+        g: np.ndarray,
+        delay: np.ndarray,
+        t: np.ndarray,
+    ) -> np.ndarray:
         dm = self.assembler.derivatives(theta, m)
         n_p, n, n_c = theta.size, m.a.shape[0], m.b.shape[1]
         z_da = _times_real(z, np.moveaxis(dm.a, 0, 1).reshape(n, n_p * n)).reshape(-1, n_p, n)  # z^T dA_k

@@ -23,13 +23,12 @@ import numpy as np
 from scipy import optimize
 
 from flightlogs.errors import FitError
-
-from ..freqresp import FrequencyResponse
-from ..model.assemble import Assembler
-from ..model.structure import ModelStructure
-from .accuracy import Accuracy, accuracy
-from .cost import CostSummary, CostWeights, FitPoints, ResponseModel, fit_points
-from .reduce import ReductionStep, worst_parameter
+from sysid.fit.accuracy import Accuracy, accuracy
+from sysid.fit.cost import CostSummary, CostWeights, FitPoints, ResponseModel, fit_points
+from sysid.fit.reduce import ReductionStep, worst_parameter
+from sysid.freqresp import FrequencyResponse
+from sysid.model.assemble import Assembler
+from sysid.model.structure import ModelStructure
 
 __all__ = ["FitOptions", "FrequencyFit", "fit_frequency_responses"]
 
@@ -168,25 +167,37 @@ def fit_frequency_responses(
     used = tuple(r for r in responses if r.input in controls and r.output in structure.outputs)
     if not used:
         pairs = ", ".join(r.pair for r in responses) or "none"
-        raise FitError(f"no gated response has a control input and an output of model {structure.name} "
-                       f"(responses: {pairs})")
+        raise FitError(
+            f"no gated response has a control input and an output of model {structure.name} (responses: {pairs})"
+        )
     consts = dict(structure.default_constants()) | dict(constants or {})
     values = structure.values(initial)
     wind = set(structure.wind_parameters)
-    status: dict[str, Status] = {p.name: ("estimated" if p.free else "fixed") for p in structure.parameters
-                                 if p.name not in wind}
+    status: dict[str, Status] = {
+        p.name: ("estimated" if p.free else "fixed") for p in structure.parameters if p.name not in wind
+    }
     points = fit_points(used, weights=options.weights)
     search = _Search(structure, points, consts, options)
     for name in search.uninformed([n for n, s in status.items() if s == "estimated"], values):
         status[name] = "fixed"
     values, evaluations = search.first_fit(values, status)
     values, status, acc, cost, steps, spent = _reduce(search, values, status)
-    return FrequencyFit(structure, MappingProxyType(dict(values)), MappingProxyType(dict(status)), acc, cost,
-                        tuple(steps), MappingProxyType(consts), used, evaluations + spent)
+    return FrequencyFit(
+        structure,
+        MappingProxyType(dict(values)),
+        MappingProxyType(dict(status)),
+        acc,
+        cost,
+        tuple(steps),
+        MappingProxyType(consts),
+        used,
+        evaluations + spent,
+    )
 
 
-def _reduce(search: _Search, values: dict[str, float], status: dict[str, Status]
-            ) -> tuple[dict[str, float], dict[str, Status], Accuracy, CostSummary, list[ReductionStep], int]:
+def _reduce(
+    search: _Search, values: dict[str, float], status: dict[str, Status]
+) -> tuple[dict[str, float], dict[str, Status], Accuracy, CostSummary, list[ReductionStep], int]:
     """Remove the worst parameter and refit until every one meets the guidelines (see :mod:`.reduce`)."""
     options = search.options
     steps: list[ReductionStep] = []
@@ -203,13 +214,25 @@ def _reduce(search: _Search, values: dict[str, float], status: dict[str, Status]
             if previous is not None and _too_costly(steps[-1], options.max_cost_increase):
                 values, status = previous
                 kept.add(steps[-1].parameter)
-                steps[-1] = replace(steps[-1], action="kept", value=steps[-1].estimate,
-                                    reason=steps[-1].reason + f"; removing it raised J_ave to "
-                                    f"{steps[-1].cost_average_after:.3g}, so it stays")
+                steps[-1] = replace(
+                    steps[-1],
+                    action="kept",
+                    value=steps[-1].estimate,
+                    reason=steps[-1].reason + f"; removing it raised J_ave to "
+                    f"{steps[-1].cost_average_after:.3g}, so it stays",
+                )
                 continue
-        worst = None if not options.reduce or len(steps) >= options.max_steps else worst_parameter(
-            acc, max_cr_percent=options.max_cr_percent, max_insensitivity_percent=options.max_insensitivity_percent,
-            max_correlation=options.max_correlation, exclude=frozenset(kept))
+        worst = (
+            None
+            if not options.reduce or len(steps) >= options.max_steps
+            else worst_parameter(
+                acc,
+                max_cr_percent=options.max_cr_percent,
+                max_insensitivity_percent=options.max_insensitivity_percent,
+                max_correlation=options.max_correlation,
+                exclude=frozenset(kept),
+            )
+        )
         if worst is None:
             return values, status, acc, cost, steps, evaluations
         previous = (dict(values), dict(status))
@@ -226,8 +249,15 @@ def _too_costly(step: ReductionStep, tolerance: float | None) -> bool:
     return rise > 1.0 and rise > tolerance * step.cost_average
 
 
-def _remove(structure: ModelStructure, worst: tuple[str, str], acc: Accuracy, values: dict[str, float],
-            status: dict[str, Status], cost_average: float, step: int) -> ReductionStep:
+def _remove(
+    structure: ModelStructure,
+    worst: tuple[str, str],
+    acc: Accuracy,
+    values: dict[str, float],
+    status: dict[str, Status],
+    cost_average: float,
+    step: int,
+) -> ReductionStep:
     name, reason = worst
     k = acc.names.index(name)
     parameter = structure.parameter(name)
@@ -236,15 +266,25 @@ def _remove(structure: ModelStructure, worst: tuple[str, str], acc: Accuracy, va
         values[name], status[name] = parameter.drop_value, "dropped"
     else:
         status[name] = "fixed"
-    return ReductionStep(step, name, "dropped" if parameter.reduce == "drop" else "fixed", values[name], estimate,
-                         float(acc.cramer_rao_percent[k]), float(acc.insensitivity_percent[k]), reason, cost_average)
+    return ReductionStep(
+        step,
+        name,
+        "dropped" if parameter.reduce == "drop" else "fixed",
+        values[name],
+        estimate,
+        float(acc.cramer_rao_percent[k]),
+        float(acc.insensitivity_percent[k]),
+        reason,
+        cost_average,
+    )
 
 
 class _Search:
     """Builds residual models for a set of free parameters and runs the bounded search."""
 
-    def __init__(self, structure: ModelStructure, points: FitPoints, constants: Mapping[str, float],
-                 options: FitOptions) -> None:
+    def __init__(
+        self, structure: ModelStructure, points: FitPoints, constants: Mapping[str, float], options: FitOptions
+    ) -> None:
         self.structure, self.points, self.constants, self.options = structure, points, constants, options
 
     def model(self, free: Sequence[str], values: Mapping[str, float]) -> ResponseModel:
@@ -319,8 +359,15 @@ class _Search:
         theta0 = np.clip(np.array([values[n] for n in free]), lower, upper)
         jac = model.jacobian if self.options.jacobian == "analytic" else "2-point"
         try:
-            result = optimize.least_squares(model.residuals, theta0, jac=jac, bounds=(lower, upper),  # type: ignore[arg-type]
-                                            method="trf", x_scale="jac", max_nfev=self.options.max_evaluations)
+            result = optimize.least_squares(
+                model.residuals,
+                theta0,
+                jac=jac,
+                bounds=(lower, upper),  # type: ignore[arg-type]
+                method="trf",
+                x_scale="jac",
+                max_nfev=self.options.max_evaluations,
+            )
         except (ValueError, np.linalg.LinAlgError) as err:
             raise FitError(f"the search on model {self.structure.name} failed: {err}") from None
         fitted = dict(values) | {n: float(v) for n, v in zip(free, result.x)}

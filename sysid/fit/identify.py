@@ -13,7 +13,7 @@ import dataclasses
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -21,26 +21,36 @@ from typing import Any
 import numpy as np
 from scipy import linalg
 
-from flightlogs.condition import ConditionedFlight, ConditioningOptions
+from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import FitError
 from flightlogs.record import Record
-from flightlogs.store import file_sha256
-
-from ..freqresp import (FrequencyResponse, ResponseOptions, frequency_responses, gate_responses, maneuver_records,
-                        reference_options)
-from ..model.structure import ModelStructure
-from ..model.toml_format import load_structure
-from .engine import FitOptions, FrequencyFit, fit_frequency_responses
-from .reduce import ReductionStep
-from .result import IdentifiedModel, ParameterEstimate, Provenance
-from .wind import WindStepResult, fit_wind
+from flightlogs.store.dataset import file_sha256
+from sysid.fit.engine import FitOptions, FrequencyFit, fit_frequency_responses
+from sysid.fit.reduce import ReductionStep
+from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance
+from sysid.fit.wind import WindStepResult, fit_wind
+from sysid.freqresp import (
+    FrequencyResponse,
+    ResponseOptions,
+    frequency_responses,
+    gate_responses,
+    maneuver_records,
+    reference_options,
+)
+from sysid.model.structure import ModelStructure
+from sysid.model.toml_format import load_structure
 
 __all__ = ["FIT_PAIRS", "IdentifyOptions", "identify_flights", "identify_logs", "model_from_fit"]
 
 #: Outputs fitted per mixer axis (Table 3.4): the input is ``delta_<axis>``.
-FIT_PAIRS: Mapping[str, tuple[str, ...]] = MappingProxyType({
-    "lat": ("v", "p", "ay"), "lon": ("u", "w", "q", "ax"), "yaw": ("r",), "thr": ("az",),
-})
+FIT_PAIRS: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {
+        "lat": ("v", "p", "ay"),
+        "lon": ("u", "w", "q", "ax"),
+        "yaw": ("r",),
+        "thr": ("az",),
+    }
+)
 _AXES = ("lat", "lon", "yaw", "thr")
 
 Progress = Callable[[str, int, int], None]
@@ -110,8 +120,9 @@ def _report(progress: Progress | None, stage: str, done: int, total: int) -> Non
         progress(stage, done, total)
 
 
-def _axis_responses(structure: ModelStructure, records: list[Record], axis: str, options: IdentifyOptions,
-                    notes: list[str]) -> tuple[FrequencyResponse, ...]:
+def _axis_responses(
+    structure: ModelStructure, records: list[Record], axis: str, options: IdentifyOptions, notes: list[str]
+) -> tuple[FrequencyResponse, ...]:
     control = f"delta_{axis}"
     logged = set.intersection(*(set(r.signals) for r in records))
     if options.pairs is not None:
@@ -184,8 +195,9 @@ def identify_flights(
         if not flights:
             raise FitError(f"{given}: no flight to fit the model {structure.name} to")
         names = ", ".join(f.source.name for f in flights)
-        raise FitError(f"{given}: no {options.kind} in flight {names} gives a response the model "
-                       f"{structure.name} can be fitted to")
+        raise FitError(
+            f"{given}: no {options.kind} in flight {names} gives a response the model {structure.name} can be fitted to"
+        )
     gated = gate_responses(responses, min_coherence=options.min_coherence, min_decades=options.min_decades)
     notes += [d.reason for d in gated.dropped]
     if not gated.kept:
@@ -193,17 +205,25 @@ def identify_flights(
     trim = _mean_trim([r for records in used.values() for r in records])
     constants = structure.constants_from_trim(trim) | dict(options.constants or {})
     _report(progress, "fitting F, G_u", len(_AXES), len(_AXES) + 2)
-    fit = fit_frequency_responses(structure, gated.kept, constants=constants, initial=options.initial,
-                                  options=options.fit)
+    fit = fit_frequency_responses(
+        structure, gated.kept, constants=constants, initial=options.initial, options=options.fit
+    )
     wind = None
     if structure.wind_parameters:
         _report(progress, "wind step", len(_AXES) + 1, len(_AXES) + 2)
         signals = {c.signal for c in structure.wind_inputs}
         records = [r for axis in options.wind_axes for r in used.get(axis, [])]
         if any(signals <= set(r.signals) for r in records):
-            wind = fit_wind(structure, fit.values, constants, records, outputs=options.wind_outputs,
-                            reduce=options.fit.reduce, max_cr_percent=options.fit.max_cr_percent,
-                            max_insensitivity_percent=options.fit.max_insensitivity_percent)
+            wind = fit_wind(
+                structure,
+                fit.values,
+                constants,
+                records,
+                outputs=options.wind_outputs,
+                reduce=options.fit.reduce,
+                max_cr_percent=options.fit.max_cr_percent,
+                max_insensitivity_percent=options.fit.max_insensitivity_percent,
+            )
         else:
             notes.append(f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give --wind)")
     _report(progress, "done", len(_AXES) + 2, len(_AXES) + 2)
@@ -247,13 +267,14 @@ def identify_logs(
     FitError
         If nothing can be fitted.
     """
-    from flightlogs.campaign import expand_wind_paths, ingest_campaign
+    from flightlogs.store.campaign import expand_wind_paths, ingest_campaign
 
     def reading(name: str, done: int, total: int) -> None:
         _report(progress, f"reading {name}", done, total)
 
-    campaign = ingest_campaign([Path(p) for p in log_paths], [Path(p) for p in wind_paths], options=conditioning,
-                               progress=reading)
+    campaign = ingest_campaign(
+        [Path(p) for p in log_paths], [Path(p) for p in wind_paths], options=conditioning, progress=reading
+    )
     flights = list(campaign.require_flights())
     winds = expand_wind_paths([Path(p) for p in wind_paths])
     return identify_flights(flights, structure, options=options, files=[*log_paths, *winds], progress=progress)
@@ -286,12 +307,23 @@ def _provenance(files: Sequence[str | Path], options: IdentifyOptions) -> Proven
         except PackageNotFoundError:
             versions[package] = "unknown"
     paths = [str(p) for p in files]
-    return Provenance(tuple(paths), {p: file_sha256(p) for p in paths}, _jsonable(options), versions,
-                      datetime.now(timezone.utc).isoformat(timespec="seconds"))
+    return Provenance(
+        tuple(paths),
+        {p: file_sha256(p) for p in paths},
+        _jsonable(options),
+        versions,
+        datetime.now(UTC).isoformat(timespec="seconds"),
+    )
 
 
-def model_from_fit(fit: FrequencyFit, wind: WindStepResult | None = None, *, trim: Mapping[str, float] | None = None,
-                   provenance: Provenance = Provenance(), notes: Sequence[str] = ()) -> IdentifiedModel:
+def model_from_fit(
+    fit: FrequencyFit,
+    wind: WindStepResult | None = None,
+    *,
+    trim: Mapping[str, float] | None = None,
+    provenance: Provenance = Provenance(),
+    notes: Sequence[str] = (),
+) -> IdentifiedModel:
     """Assemble an :class:`IdentifiedModel` from the two steps' results.
 
     Parameters
@@ -331,16 +363,49 @@ def model_from_fit(fit: FrequencyFit, wind: WindStepResult | None = None, *, tri
             status, value, stage = wind.status[p.name], wind.values[p.name], "wind"
         else:
             status, value, stage = "dropped", p.drop_value, "wind"
-            reduction.append(ReductionStep(len(reduction) + 1, p.name, "dropped", value, math.nan, math.nan,
-                                           math.nan, "no wind record to fit it", fit.cost.average, fit.cost.average))
+            reduction.append(
+                ReductionStep(
+                    len(reduction) + 1,
+                    p.name,
+                    "dropped",
+                    value,
+                    math.nan,
+                    math.nan,
+                    math.nan,
+                    "no wind record to fit it",
+                    fit.cost.average,
+                    fit.cost.average,
+                )
+            )
         estimated = status == "estimated"
-        estimates.append(ParameterEstimate(p.name, float(value), cr[p.name] if estimated else math.nan,
-                                           ins[p.name] if estimated else math.nan, status, unit, stage))  # type: ignore[arg-type]
+        estimates.append(
+            ParameterEstimate(
+                p.name,
+                float(value),
+                cr[p.name] if estimated else math.nan,
+                ins[p.name] if estimated else math.nan,
+                status,
+                unit,
+                stage,
+            )
+        )  # type: ignore[arg-type]
     reduction = [dataclasses.replace(step, step=k + 1) for k, step in enumerate(reduction)]
     names = fit.accuracy.names + (wind.accuracy.names if wind is not None else ())
     blocks = [fit.accuracy.correlation] + ([wind.accuracy.correlation] if wind is not None else [])
     correlation = linalg.block_diag(*blocks) if names else np.zeros((0, 0))
     return IdentifiedModel(
-        structure.name, structure.text, tuple(estimates), names, correlation.reshape(len(names), len(names)), fit.cost,
-        fit.responses, MappingProxyType(dict(trim or {})), fit.constants, tuple(reduction), provenance,
-        None if wind is None else wind.fit, units, tuple(notes))
+        structure.name,
+        structure.text,
+        tuple(estimates),
+        names,
+        correlation.reshape(len(names), len(names)),
+        fit.cost,
+        fit.responses,
+        MappingProxyType(dict(trim or {})),
+        fit.constants,
+        tuple(reduction),
+        provenance,
+        None if wind is None else wind.fit,
+        units,
+        tuple(notes),
+    )

@@ -15,19 +15,18 @@ from typing import Any
 import numpy as np
 from scipy import io as sio
 
-from flightlogs.atomic import atomic_output
 from flightlogs.errors import ModelError
-
-from .._json import finite_or_none as _num
-from .._json import float_array as _vector
-from .._json import json_floats as _array
-from .._json import read_json_object, write_json
-from .._json import value_text as _show
-from ..freqresp import FrequencyResponse
-from ._json import parameter_entry
-from .cost import CostSummary
-from .reduce import ReductionStep
-from .result import IdentifiedModel, ParameterEstimate, Provenance, WindFit
+from flightlogs.writers.atomic import atomic_output
+from sysid._json import finite_or_none as _num
+from sysid._json import float_array as _vector
+from sysid._json import json_floats as _array
+from sysid._json import read_json_object, write_json
+from sysid._json import value_text as _show
+from sysid.fit._json import parameter_entry
+from sysid.fit.cost import CostSummary
+from sysid.fit.reduce import ReductionStep
+from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance, WindFit
+from sysid.freqresp import FrequencyResponse
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "model_to_dict", "model_from_dict", "write_model", "read_model", "write_mat"]
 
@@ -48,47 +47,89 @@ def model_to_dict(model: IdentifiedModel) -> dict[str, Any]:
     dict
         JSON-compatible (NaN as None).
     """
-    from ..modes import modes
+    from sysid.model.modes import modes
 
     linear = model.linear_model()
     return {
-        "schema": SCHEMA, "schema_version": SCHEMA_VERSION,
+        "schema": SCHEMA,
+        "schema_version": SCHEMA_VERSION,
         "structure": {"name": model.structure_name, "text": model.structure_text},
         "parameters": {p.name: parameter_entry(p) | {"value": _num(p.value)} for p in model.parameters},
         "correlation": {"names": list(model.correlation_names), "matrix": _array(model.correlation)},
-        "cost": {"average": _num(model.cost.average), "responses": {k: _num(v) for k, v in model.cost.responses.items()}},
+        "cost": {
+            "average": _num(model.cost.average),
+            "responses": {k: _num(v) for k, v in model.cost.responses.items()},
+        },
         "trim": {k: _num(v) for k, v in model.trim.items()},
         "constants": {k: _num(v) for k, v in model.constants.items()},
         "input_units": dict(model.input_units),
         "notes": list(model.notes),
-        "reduction": [{"step": s.step, "parameter": s.parameter, "action": s.action, "value": _num(s.value),
-                       "estimate": _num(s.estimate), "cr_percent": _num(s.cr_percent),
-                       "insensitivity_percent": _num(s.insensitivity_percent), "reason": s.reason,
-                       "cost_average": _num(s.cost_average), "cost_average_after": _num(s.cost_average_after)}
-                      for s in model.reduction],
-        "wind": None if model.wind is None else {
-            "outputs": list(model.wind.outputs), "rms_before": [_num(v) for v in model.wind.rms_before],
-            "rms_after": [_num(v) for v in model.wind.rms_after], "samples": model.wind.samples},
-        "provenance": {"files": list(model.provenance.files), "sha256": dict(model.provenance.sha256),
-                       "options": dict(model.provenance.options), "versions": dict(model.provenance.versions),
-                       "created_utc": model.provenance.created_utc},
-        "linear_model": {"states": list(linear.states), "inputs": list(linear.inputs), "outputs": list(linear.outputs),
-                         "a": _array(linear.a), "b": _array(linear.b), "c": _array(linear.c), "d": _array(linear.d),
-                         "input_delays_s": _array(linear.input_delays_s)},
+        "reduction": [
+            {
+                "step": s.step,
+                "parameter": s.parameter,
+                "action": s.action,
+                "value": _num(s.value),
+                "estimate": _num(s.estimate),
+                "cr_percent": _num(s.cr_percent),
+                "insensitivity_percent": _num(s.insensitivity_percent),
+                "reason": s.reason,
+                "cost_average": _num(s.cost_average),
+                "cost_average_after": _num(s.cost_average_after),
+            }
+            for s in model.reduction
+        ],
+        "wind": None
+        if model.wind is None
+        else {
+            "outputs": list(model.wind.outputs),
+            "rms_before": [_num(v) for v in model.wind.rms_before],
+            "rms_after": [_num(v) for v in model.wind.rms_after],
+            "samples": model.wind.samples,
+        },
+        "provenance": {
+            "files": list(model.provenance.files),
+            "sha256": dict(model.provenance.sha256),
+            "options": dict(model.provenance.options),
+            "versions": dict(model.provenance.versions),
+            "created_utc": model.provenance.created_utc,
+        },
+        "linear_model": {
+            "states": list(linear.states),
+            "inputs": list(linear.inputs),
+            "outputs": list(linear.outputs),
+            "a": _array(linear.a),
+            "b": _array(linear.b),
+            "c": _array(linear.c),
+            "d": _array(linear.d),
+            "input_delays_s": _array(linear.input_delays_s),
+        },
         "eigenvalues": [{"real": m.real, "imag": m.imag, "mode": m.mode} for m in modes(linear)],
         "responses": [_response_to_dict(r) for r in model.responses],
     }
 
 
 def _response_to_dict(r: FrequencyResponse) -> dict[str, Any]:
-    return {"input": r.input, "output": r.output, "omega": _array(r.omega),
-            "response_real": _array(r.response.real), "response_imag": _array(r.response.imag),
-            "coherence": _array(r.coherence), "random_error": _array(r.random_error),
-            "input_autospectrum": _array(r.input_autospectrum), "output_autospectrum": _array(r.output_autospectrum),
-            "cross_spectrum_real": _array(r.cross_spectrum.real), "cross_spectrum_imag": _array(r.cross_spectrum.imag),
-            "windows_s": list(r.windows_s), "conditioned_on": list(r.conditioned_on), "input_unit": r.input_unit,
-            "output_unit": r.output_unit, "fit_range": None if r.fit_range is None else list(r.fit_range),
-            "reference": r.reference, "whole_record": r.whole_record}
+    return {
+        "input": r.input,
+        "output": r.output,
+        "omega": _array(r.omega),
+        "response_real": _array(r.response.real),
+        "response_imag": _array(r.response.imag),
+        "coherence": _array(r.coherence),
+        "random_error": _array(r.random_error),
+        "input_autospectrum": _array(r.input_autospectrum),
+        "output_autospectrum": _array(r.output_autospectrum),
+        "cross_spectrum_real": _array(r.cross_spectrum.real),
+        "cross_spectrum_imag": _array(r.cross_spectrum.imag),
+        "windows_s": list(r.windows_s),
+        "conditioned_on": list(r.conditioned_on),
+        "input_unit": r.input_unit,
+        "output_unit": r.output_unit,
+        "fit_range": None if r.fit_range is None else list(r.fit_range),
+        "reference": r.reference,
+        "whole_record": r.whole_record,
+    }
 
 
 _REQUIRED: Any = object()
@@ -154,16 +195,23 @@ def _response_from_dict(d: Mapping[str, Any], f: _Fields, where: str) -> Frequen
     windows = f.numbers(d, "windows_s", where, finite=True)
     try:
         return FrequencyResponse(
-            f.get(d, "input", where, str), f.get(d, "output", where, str), f.numbers(d, "omega", where),
+            f.get(d, "input", where, str),
+            f.get(d, "output", where, str),
+            f.numbers(d, "omega", where),
             f.numbers(d, "response_real", where) + 1j * f.numbers(d, "response_imag", where),
-            f.numbers(d, "coherence", where), f.numbers(d, "random_error", where),
-            f.numbers(d, "input_autospectrum", where), f.numbers(d, "output_autospectrum", where),
+            f.numbers(d, "coherence", where),
+            f.numbers(d, "random_error", where),
+            f.numbers(d, "input_autospectrum", where),
+            f.numbers(d, "output_autospectrum", where),
             f.numbers(d, "cross_spectrum_real", where) + 1j * f.numbers(d, "cross_spectrum_imag", where),
-            tuple(float(v) for v in windows), tuple(f.get(d, "conditioned_on", where, list, [])),
-            f.get(d, "input_unit", where, str, ""), f.get(d, "output_unit", where, str, ""),
+            tuple(float(v) for v in windows),
+            tuple(f.get(d, "conditioned_on", where, list, [])),
+            f.get(d, "input_unit", where, str, ""),
+            f.get(d, "output_unit", where, str, ""),
             None if fit_range is None else (float(fit_range[0]), float(fit_range[1])),
             reference=f.get(d, "reference", where, object, None),
-            whole_record=bool(f.get(d, "whole_record", where, bool, False)))
+            whole_record=bool(f.get(d, "whole_record", where, bool, False)),
+        )
     except (TypeError, ValueError) as err:
         raise f.fail(f"{where} is inconsistent: {err}") from None
 
@@ -178,9 +226,17 @@ def _parameters(doc: Mapping[str, Any], f: _Fields) -> tuple[ParameterEstimate, 
             raise f.fail(f"{where}: status is {status!r}, not estimated, fixed or dropped")
         if stage not in ("frequency", "wind"):
             raise f.fail(f"{where}: stage is {stage!r}, not frequency or wind")
-        out.append(ParameterEstimate(name, f.number(p, "value", where, finite=True), f.number(p, "cr_percent", where),
-                                     f.number(p, "insensitivity_percent", where), status,  # type: ignore[arg-type]
-                                     f.get(p, "unit", where, str, ""), stage))  # type: ignore[arg-type]
+        out.append(
+            ParameterEstimate(
+                name,
+                f.number(p, "value", where, finite=True),
+                f.number(p, "cr_percent", where),
+                f.number(p, "insensitivity_percent", where),
+                status,  # type: ignore[arg-type]
+                f.get(p, "unit", where, str, ""),
+                stage,
+            )
+        )  # type: ignore[arg-type]
     return tuple(out)
 
 
@@ -201,12 +257,31 @@ def _reduction(doc: Mapping[str, Any], f: _Fields) -> tuple[ReductionStep, ...]:
     for k, s in enumerate(f.get(doc, "reduction", "the file", list)):
         where = f"reduction step {k + 1}"
         s = f.check(s, where, dict)
-        n = {key: f.number(s, key, where) for key in ("value", "estimate", "cr_percent", "insensitivity_percent",
-                                                      "cost_average", "cost_average_after")}
-        steps.append(ReductionStep(f.get(s, "step", where, int), f.get(s, "parameter", where, str),
-                                   f.get(s, "action", where, str), n["value"], n["estimate"], n["cr_percent"],
-                                   n["insensitivity_percent"], f.get(s, "reason", where, str), n["cost_average"],
-                                   n["cost_average_after"]))
+        n = {
+            key: f.number(s, key, where)
+            for key in (
+                "value",
+                "estimate",
+                "cr_percent",
+                "insensitivity_percent",
+                "cost_average",
+                "cost_average_after",
+            )
+        }
+        steps.append(
+            ReductionStep(
+                f.get(s, "step", where, int),
+                f.get(s, "parameter", where, str),
+                f.get(s, "action", where, str),
+                n["value"],
+                n["estimate"],
+                n["cr_percent"],
+                n["insensitivity_percent"],
+                f.get(s, "reason", where, str),
+                n["cost_average"],
+                n["cost_average_after"],
+            )
+        )
     return tuple(steps)
 
 
@@ -218,8 +293,9 @@ def _wind(doc: Mapping[str, Any], f: _Fields) -> WindFit | None:
     before, after = f.numbers(wind, "rms_before", "wind"), f.numbers(wind, "rms_after", "wind")
     if not len(outputs) == len(before) == len(after):
         raise f.fail("wind: outputs, rms_before and rms_after differ in length")
-    return WindFit(outputs, tuple(float(v) for v in before), tuple(float(v) for v in after),
-                   f.get(wind, "samples", "wind", int))
+    return WindFit(
+        outputs, tuple(float(v) for v in before), tuple(float(v) for v in after), f.get(wind, "samples", "wind", int)
+    )
 
 
 def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> IdentifiedModel:
@@ -243,11 +319,12 @@ def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Identi
     if schema is None:
         raise ModelError(f"{source}: not a flight-sysid model file (it has no schema field)")
     if schema != SCHEMA:
-        raise ModelError(f"{source}: not a flight-sysid model file (it is a {_show(schema)} file, "
-                         f"not {SCHEMA!r})")
+        raise ModelError(f"{source}: not a flight-sysid model file (it is a {_show(schema)} file, not {SCHEMA!r})")
     if doc.get("schema_version") != SCHEMA_VERSION:
-        raise ModelError(f"{source}: model schema version {_show(doc.get('schema_version'))} is not supported "
-                         f"(this version reads {SCHEMA_VERSION})")
+        raise ModelError(
+            f"{source}: model schema version {_show(doc.get('schema_version'))} is not supported "
+            f"(this version reads {SCHEMA_VERSION})"
+        )
     f = _Fields(source)
     head = f.get(doc, "structure", "the file", dict)
     cost = f.get(doc, "cost", "the file", dict)
@@ -255,17 +332,28 @@ def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Identi
     names, matrix = _correlation(doc, f)
     try:
         model = IdentifiedModel(
-            f.get(head, "name", "structure", str), f.get(head, "text", "structure", str), _parameters(doc, f),
-            names, matrix, CostSummary(f.number(cost, "average", "cost"), f.table(cost, "responses", "cost")),
-            tuple(_response_from_dict(r, f, f"response {k + 1}")
-                  for k, r in enumerate(f.get(doc, "responses", "the file", list, []))),
-            f.table(doc, "trim", "the file"), f.table(doc, "constants", "the file", finite=True),
+            f.get(head, "name", "structure", str),
+            f.get(head, "text", "structure", str),
+            _parameters(doc, f),
+            names,
+            matrix,
+            CostSummary(f.number(cost, "average", "cost"), f.table(cost, "responses", "cost")),
+            tuple(
+                _response_from_dict(r, f, f"response {k + 1}")
+                for k, r in enumerate(f.get(doc, "responses", "the file", list, []))
+            ),
+            f.table(doc, "trim", "the file"),
+            f.table(doc, "constants", "the file", finite=True),
             _reduction(doc, f),
-            Provenance(tuple(f.get(prov, "files", "provenance", list, [])),
-                       f.get(prov, "sha256", "provenance", dict, {}), f.get(prov, "options", "provenance", dict, {}),
-                       f.get(prov, "versions", "provenance", dict, {}),
-                       f.get(prov, "created_utc", "provenance", str, "")),
-            _wind(doc, f), dict(f.get(doc, "input_units", "the file", dict, {})),
+            Provenance(
+                tuple(f.get(prov, "files", "provenance", list, [])),
+                f.get(prov, "sha256", "provenance", dict, {}),
+                f.get(prov, "options", "provenance", dict, {}),
+                f.get(prov, "versions", "provenance", dict, {}),
+                f.get(prov, "created_utc", "provenance", str, ""),
+            ),
+            _wind(doc, f),
+            dict(f.get(doc, "input_units", "the file", dict, {})),
             tuple(f.get(doc, "notes", "the file", list, [])),
         )
     except (TypeError, ValueError) as err:
@@ -350,17 +438,23 @@ def write_mat(path: str | Path, model: IdentifiedModel) -> Path:
     ``parameter_status``, ``cost_average``, ``structure`` (the TOML text).
     """
     linear = model.linear_model()
-    cell = lambda names: np.array(list(names), dtype=object)  # noqa: E731 - MATLAB cell array of strings
+    cell = lambda names: np.array(list(names), dtype=object)
     content = {
-        "A": linear.a, "B": linear.b, "C": linear.c, "D": linear.d,
-        "states": cell(linear.states), "inputs": cell(linear.inputs), "outputs": cell(linear.outputs),
+        "A": linear.a,
+        "B": linear.b,
+        "C": linear.c,
+        "D": linear.d,
+        "states": cell(linear.states),
+        "inputs": cell(linear.inputs),
+        "outputs": cell(linear.outputs),
         "input_delays_s": linear.input_delays_s,
         "parameter_names": cell(p.name for p in model.parameters),
         "parameter_values": np.array([p.value for p in model.parameters]),
         "cr_percent": np.array([p.cr_percent for p in model.parameters]),
         "insensitivity_percent": np.array([p.insensitivity_percent for p in model.parameters]),
         "parameter_status": cell(p.status for p in model.parameters),
-        "cost_average": model.cost.average, "structure": model.structure_text,
+        "cost_average": model.cost.average,
+        "structure": model.structure_text,
     }
     with atomic_output(path) as tmp:
         sio.savemat(tmp, content, appendmat=False, oned_as="column")

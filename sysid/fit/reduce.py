@@ -28,7 +28,7 @@ from typing import Literal
 
 import numpy as np
 
-from .accuracy import Accuracy
+from sysid.fit.accuracy import Accuracy
 
 __all__ = ["ReductionStep", "worst_parameter"]
 
@@ -74,9 +74,14 @@ class ReductionStep:
     cost_average_after: float = math.nan
 
 
-def worst_parameter(acc: Accuracy, *, max_cr_percent: float = 20.0, max_insensitivity_percent: float = 10.0,
-                    max_correlation: float | None = None, exclude: frozenset[str] = frozenset()
-                    ) -> tuple[str, str] | None:
+def worst_parameter(
+    acc: Accuracy,
+    *,
+    max_cr_percent: float = 20.0,
+    max_insensitivity_percent: float = 10.0,
+    max_correlation: float | None = None,
+    exclude: frozenset[str] = frozenset(),
+) -> tuple[str, str] | None:
     """The parameter to remove next, and why; None when every parameter meets the guidelines.
 
     Parameters
@@ -120,6 +125,7 @@ def worst_parameter(acc: Accuracy, *, max_cr_percent: float = 20.0, max_insensit
         i, j = np.unravel_index(int(np.argmax(corr)), corr.shape)
         if corr[i, j] > max_correlation:
             k = int(i if cr[i] >= cr[j] else j)
-            return acc.names[k], (f"|correlation| with {acc.names[int(j if k == i else i)]} = {corr[i, j]:.3f} "
-                                  f"> {max_correlation:g}")
+            return acc.names[k], (
+                f"|correlation| with {acc.names[int(j if k == i else i)]} = {corr[i, j]:.3f} > {max_correlation:g}"
+            )
     return None

@@ -11,14 +11,13 @@ from typing import Any, Literal
 import numpy as np
 
 from flightlogs.errors import ModelError
-
-from ..freqresp import FrequencyResponse
-from ..model.assemble import Assembler
-from ..model.structure import ModelStructure
-from ..model.toml_format import parse_structure
-from ..statespace import DelayedStateSpace
-from .cost import CostSummary
-from .reduce import ReductionStep
+from sysid.fit.cost import CostSummary
+from sysid.fit.reduce import ReductionStep
+from sysid.freqresp import FrequencyResponse
+from sysid.model.assemble import Assembler
+from sysid.model.statespace import DelayedStateSpace
+from sysid.model.structure import ModelStructure
+from sysid.model.toml_format import parse_structure
 
 __all__ = ["ParameterEstimate", "WindFit", "Provenance", "IdentifiedModel"]
 
@@ -236,6 +235,7 @@ class IdentifiedModel:
             holds the flight's trim.
         """
         structure = self.structure
-        assembler = Assembler(structure, free=(), fixed=self.values, constants=self.constants,
-                              include_wind=include_wind)
+        assembler = Assembler(
+            structure, free=(), fixed=self.values, constants=self.constants, include_wind=include_wind
+        )
         return assembler.state_space(np.zeros(0), trim=self.trim)

@@ -5,10 +5,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from ..modes import Mode, modes
-from .._json import finite_or_none as _num
-from ._json import parameter_entry
-from .result import IdentifiedModel
+from sysid._json import finite_or_none as _num
+from sysid.fit._json import parameter_entry
+from sysid.fit.result import IdentifiedModel
+from sysid.model.modes import Mode, modes
 
 __all__ = ["mode_summary", "fit_summary"]
 
@@ -19,7 +19,7 @@ def mode_summary(found: Sequence[Mode]) -> list[dict[str, Any]]:
     Parameters
     ----------
     found : sequence of Mode
-        Modes, e.g. from :func:`sysid.modes.modes`.
+        Modes, e.g. from :func:`sysid.model.modes.modes`.
 
     Returns
     -------
@@ -28,9 +28,19 @@ def mode_summary(found: Sequence[Mode]) -> list[dict[str, Any]]:
         ``time_to_double_s``, ``time_to_half_s`` (None when infinite),
         ``mode``, ``stability``.
     """
-    return [{"real": m.real, "imag": m.imag, "damping": _num(m.damping),
-             "natural_frequency_rad_s": m.natural_frequency_rad_s, "time_to_double_s": _num(m.time_to_double_s),
-             "time_to_half_s": _num(m.time_to_half_s), "mode": m.mode, "stability": m.stability} for m in found]
+    return [
+        {
+            "real": m.real,
+            "imag": m.imag,
+            "damping": _num(m.damping),
+            "natural_frequency_rad_s": m.natural_frequency_rad_s,
+            "time_to_double_s": _num(m.time_to_double_s),
+            "time_to_half_s": _num(m.time_to_half_s),
+            "mode": m.mode,
+            "stability": m.stability,
+        }
+        for m in found
+    ]
 
 
 def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
@@ -57,12 +67,26 @@ def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
         "cost": {"average": model.cost.average, "responses": dict(model.cost.responses)},
         "eigenvalues": mode_summary(modes(model.linear_model())),
         "dropped": [p.name for p in model.parameters if p.dropped],
-        "reduction": [{"step": s.step, "parameter": s.parameter, "action": s.action, "value": s.value,
-                       "reason": s.reason, "cost_average": _num(s.cost_average),
-                       "cost_average_after": _num(s.cost_average_after)} for s in model.reduction],
-        "wind": None if model.wind is None else {
-            "outputs": list(model.wind.outputs), "rms_before": list(model.wind.rms_before),
-            "rms_after": list(model.wind.rms_after), "samples": model.wind.samples},
+        "reduction": [
+            {
+                "step": s.step,
+                "parameter": s.parameter,
+                "action": s.action,
+                "value": s.value,
+                "reason": s.reason,
+                "cost_average": _num(s.cost_average),
+                "cost_average_after": _num(s.cost_average_after),
+            }
+            for s in model.reduction
+        ],
+        "wind": None
+        if model.wind is None
+        else {
+            "outputs": list(model.wind.outputs),
+            "rms_before": list(model.wind.rms_before),
+            "rms_after": list(model.wind.rms_after),
+            "samples": model.wind.samples,
+        },
         "trim": dict(model.trim),
         "input_units": dict(model.input_units),
         "notes": list(model.notes),

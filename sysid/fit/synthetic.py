@@ -11,8 +11,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..freqresp import FrequencyResponse
-from ..statespace import DelayedStateSpace
+from sysid.freqresp import FrequencyResponse
+from sysid.model.statespace import DelayedStateSpace
 
 __all__ = ["synthetic_responses"]
 
@@ -76,11 +76,25 @@ def synthetic_responses(
         columns = [k for k, name in enumerate(model.inputs) if name == signal]
         exact = full[:, model.outputs.index(output), columns].sum(axis=1)
         perturbation = rng.normal(scale=noise_db / 20.0 * np.log(10.0), size=omega.size) + 1j * rng.normal(
-            scale=np.radians(noise_deg), size=omega.size)
+            scale=np.radians(noise_deg), size=omega.size
+        )
         response = exact * np.exp(perturbation)
         auto = np.ones(omega.size)
         error = np.sqrt(1.0 - gamma2) / np.sqrt(np.maximum(gamma2, 1e-12) * 2.0 * 20.0)
         span = fit_range.get(pair, (1.0, 40.0)) if isinstance(fit_range, Mapping) else fit_range
-        found.append(FrequencyResponse(signal, output, omega, response, gamma2, error, auto, np.abs(response) ** 2,
-                                       response, (10.0,), fit_range=(float(span[0]), float(span[1]))))
+        found.append(
+            FrequencyResponse(
+                signal,
+                output,
+                omega,
+                response,
+                gamma2,
+                error,
+                auto,
+                np.abs(response) ** 2,
+                response,
+                (10.0,),
+                fit_range=(float(span[0]), float(span[1])),
+            )
+        )
     return tuple(found)

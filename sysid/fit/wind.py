@@ -30,16 +30,16 @@ from types import MappingProxyType
 from typing import Literal
 
 import numpy as np
-from scipy import optimize, signal as sps
+from scipy import optimize
+from scipy import signal as sps
 
 from flightlogs.errors import FitError
 from flightlogs.record import Record
-
-from ..model.assemble import Assembler, SystemMatrices
-from ..model.structure import ModelStructure
-from .accuracy import Accuracy, accuracy
-from .reduce import ReductionStep, worst_parameter
-from .result import WindFit
+from sysid.fit.accuracy import Accuracy, accuracy
+from sysid.fit.reduce import ReductionStep, worst_parameter
+from sysid.fit.result import WindFit
+from sysid.model.assemble import Assembler, SystemMatrices
+from sysid.model.structure import ModelStructure
 
 __all__ = ["WindStepResult", "fit_wind"]
 
@@ -84,11 +84,21 @@ class _Data:
     scale: np.ndarray
 
 
-def _prediction_data(structure: ModelStructure, values: Mapping[str, float], constants: Mapping[str, float],
-                     records: Sequence[Record], outputs: Sequence[str]) -> _Data:
+def _prediction_data(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    constants: Mapping[str, float],
+    records: Sequence[Record],
+    outputs: Sequence[str],
+) -> _Data:
     wind = set(structure.wind_parameters)
-    plain = Assembler(structure, free=(), fixed={k: v for k, v in values.items() if k not in wind},
-                      constants=constants, include_wind=False)
+    plain = Assembler(
+        structure,
+        free=(),
+        fixed={k: v for k, v in values.items() if k not in wind},
+        constants=constants,
+        include_wind=False,
+    )
     m = plain.matrices(np.zeros(0))
     rows = [structure.outputs.index(o) for o in outputs]
     signals = [c.signal for c in structure.wind_inputs]
@@ -103,8 +113,9 @@ def _prediction_data(structure: ModelStructure, values: Mapping[str, float], con
     return _Data(residual, winds, times, rows, scale)
 
 
-def _states(record: Record, structure: ModelStructure, plain: Assembler, m: SystemMatrices
-            ) -> tuple[np.ndarray, np.ndarray]:
+def _states(
+    record: Record, structure: ModelStructure, plain: Assembler, m: SystemMatrices
+) -> tuple[np.ndarray, np.ndarray]:
     """Recorded states (others simulated from their own rows) and delayed inputs, of one record."""
     t = record.time_s
     u = np.column_stack([np.interp(t - tau, t, record[c.signal]) for c, tau in zip(plain.channels, m.delays)])
@@ -135,7 +146,7 @@ def _simulate(a: np.ndarray, forcing: np.ndarray, t: np.ndarray, x0: np.ndarray)
     for k, pole in enumerate(np.diag(a)):
         phi = np.exp(pole * dt)
         g0 = (phi - 1.0) / pole  # exact for a first-order hold on f, as lsim does
-        g1 = (phi - 1.0 - pole * dt) / (pole ** 2 * dt)
+        g1 = (phi - 1.0 - pole * dt) / (pole**2 * dt)
         b, den = np.array([g1, g0 - g1]), np.array([1.0, -phi])
         zi = sps.lfiltic(b, den, y=[x0[k]], x=[forcing[0, k]])  # x0 and f[0] as the samples before f[1]
         out[0, k] = x0[k]
@@ -146,8 +157,14 @@ def _simulate(a: np.ndarray, forcing: np.ndarray, t: np.ndarray, x0: np.ndarray)
 class _Problem:
     """Weighted residual after the wind terms, for a set of free wind parameters."""
 
-    def __init__(self, structure: ModelStructure, values: Mapping[str, float], constants: Mapping[str, float],
-                 data: _Data, free: Sequence[str]) -> None:
+    def __init__(
+        self,
+        structure: ModelStructure,
+        values: Mapping[str, float],
+        constants: Mapping[str, float],
+        data: _Data,
+        free: Sequence[str],
+    ) -> None:
         self.structure, self.data, self.free = structure, data, tuple(free)
         self.assembler = Assembler(structure, free=self.free, fixed=values, constants=constants, include_wind=True)
         self.columns = [j for j, c in enumerate(self.assembler.channels) if c.wind]
@@ -172,12 +189,12 @@ class _Problem:
     def vector(self, theta: np.ndarray) -> np.ndarray:
         m, winds = self.parts(theta)
         d_w = m.d[self.data.rows][:, self.columns]
-        return np.concatenate([((r - w @ d_w.T) * self.data.scale).ravel()
-                               for r, w in zip(self.data.residual, winds)])
+        return np.concatenate([((r - w @ d_w.T) * self.data.scale).ravel() for r, w in zip(self.data.residual, winds)])
 
     def delay_and_gain_index(self) -> tuple[list[int], list[int]]:
-        delays = [k for k, n in enumerate(self.free)
-                  if any(n in self.assembler.channels[j].delay.names for j in self.columns)]
+        delays = [
+            k for k, n in enumerate(self.free) if any(n in self.assembler.channels[j].delay.names for j in self.columns)
+        ]
         return delays, [k for k in range(len(self.free)) if k not in delays]
 
 
@@ -193,7 +210,7 @@ class _Normal:
         self.d0 = m0.d[rows][:, columns]  # (n_out, n_wind): what does not scale with a gain
         dm = problem.assembler.derivatives(zero, m0)
         self.e = np.array([dm.d[k][rows][:, columns] for k in self.gains]).reshape(len(self.gains), *self.d0.shape)
-        self.weight = problem.data.scale ** 2
+        self.weight = problem.data.scale**2
         residual = np.vstack(problem.data.residual)
         self.rr = np.einsum("nr,nr->r", residual, residual)
         self.residual = residual
@@ -211,7 +228,8 @@ class _Normal:
         if self.gains:
             normal = np.einsum("r,grc,cd,hrd->gh", self.weight, self.e, gram, self.e)
             rhs = np.einsum("r,grc,cr->g", self.weight, self.e, cross) - np.einsum(
-                "r,grc,cd,rd->g", self.weight, self.e, gram, self.d0)
+                "r,grc,cd,rd->g", self.weight, self.e, gram, self.d0
+            )
             solution = np.linalg.lstsq(normal, rhs, rcond=None)[0]
             out[self.gains] = solution
             cost -= float(rhs @ solution)
@@ -246,12 +264,17 @@ def _inflation(residual: np.ndarray) -> float:
         acf = np.fft.irfft(np.abs(np.fft.rfft(c, 2 * c.size)) ** 2)[: c.size]
         rho = acf / acf[0] if acf[0] > 0 else np.zeros(1)
         cut = int(np.argmax(rho < 0.05)) if np.any(rho < 0.05) else rho.size
-        factor = max(factor, (1.0 + 2.0 * float(np.sum(rho[1:cut]))) * float(np.mean(column ** 2)))
+        factor = max(factor, (1.0 + 2.0 * float(np.sum(rho[1:cut]))) * float(np.mean(column**2)))
     return max(factor, 1e-12)
 
 
-def _fit_free(structure: ModelStructure, values: Mapping[str, float], constants: Mapping[str, float], data: _Data,
-              free: Sequence[str]) -> tuple[dict[str, float], Accuracy, float, list[np.ndarray]]:
+def _fit_free(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    constants: Mapping[str, float],
+    data: _Data,
+    free: Sequence[str],
+) -> tuple[dict[str, float], Accuracy, float, list[np.ndarray]]:
     """Fit the free wind parameters; values, accuracy, weighted cost per sample and the final residuals."""
     problem = _Problem(structure, values, constants, data, free)
     out = dict(values)
@@ -262,8 +285,9 @@ def _fit_free(structure: ModelStructure, values: Mapping[str, float], constants:
     else:
         lower = np.array([structure.parameter(n).lower for n in free])
         upper = np.array([structure.parameter(n).upper for n in free])
-        solved = optimize.least_squares(problem.vector, np.clip(_scan(problem), lower, upper), bounds=(lower, upper),
-                                        x_scale="jac", method="trf")
+        solved = optimize.least_squares(
+            problem.vector, np.clip(_scan(problem), lower, upper), bounds=(lower, upper), x_scale="jac", method="trf"
+        )
         theta = solved.x
         out |= dict(zip(free, theta.tolist()))
         m, winds = problem.parts(theta)
@@ -336,20 +360,38 @@ def fit_wind(
         current, acc, cost, after = _fit_free(structure, current, constants, data, free)
         if steps:
             steps[-1] = replace(steps[-1], cost_average_after=cost)
-        worst = worst_parameter(acc, max_cr_percent=max_cr_percent,
-                                max_insensitivity_percent=max_insensitivity_percent) if reduce else None
+        worst = (
+            worst_parameter(acc, max_cr_percent=max_cr_percent, max_insensitivity_percent=max_insensitivity_percent)
+            if reduce
+            else None
+        )
         if worst is None:
             break
         name, reason = worst
         k = acc.names.index(name)
         parameter = structure.parameter(name)
-        steps.append(ReductionStep(len(steps) + 1, name, "dropped", parameter.drop_value, current[name],
-                                   float(acc.cramer_rao_percent[k]), float(acc.insensitivity_percent[k]),
-                                   reason + " (wind step)", cost))
+        steps.append(
+            ReductionStep(
+                len(steps) + 1,
+                name,
+                "dropped",
+                parameter.drop_value,
+                current[name],
+                float(acc.cramer_rao_percent[k]),
+                float(acc.insensitivity_percent[k]),
+                reason + " (wind step)",
+                cost,
+            )
+        )
         current[name], status[name] = parameter.drop_value, "dropped"
     rms_before = np.sqrt(np.mean(np.vstack(data.residual) ** 2, axis=0))
     rms_after = np.sqrt(np.mean(np.vstack(after) ** 2, axis=0))
-    fit = WindFit(tuple(outputs), tuple(float(v) for v in rms_before), tuple(float(v) for v in rms_after),
-                  int(sum(a.shape[0] for a in after)))
-    return WindStepResult(MappingProxyType({n: current[n] for n in names}), MappingProxyType(status), acc, fit,
-                          tuple(steps))
+    fit = WindFit(
+        tuple(outputs),
+        tuple(float(v) for v in rms_before),
+        tuple(float(v) for v in rms_after),
+        int(sum(a.shape[0] for a in after)),
+    )
+    return WindStepResult(
+        MappingProxyType({n: current[n] for n in names}), MappingProxyType(status), acc, fit, tuple(steps)
+    )

@@ -12,20 +12,40 @@ records' whole-length transforms, the composite's bias-free member),
 ``_composite``.
 """
 
-from .estimate import automatic_window_lengths, frequency_responses
-from .gating import DroppedResponse, GatingResult, fit_range, gate_responses
-from .io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
-from .options import ResponseOptions
-from .records import (
-    DEFAULT_PAIRS, EXCITATION, FlightResponses, default_pairs, flight_responses, maneuver_records, parse_pairs,
+from sysid.freqresp.estimate import automatic_window_lengths, frequency_responses
+from sysid.freqresp.gating import DroppedResponse, GatingResult, fit_range, gate_responses
+from sysid.freqresp.io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
+from sysid.freqresp.options import ResponseOptions
+from sysid.freqresp.records import (
+    DEFAULT_PAIRS,
+    EXCITATION,
+    FlightResponses,
+    default_pairs,
+    flight_responses,
+    maneuver_records,
+    parse_pairs,
     reference_options,
 )
-from .response import FrequencyResponse
+from sysid.freqresp.response import FrequencyResponse
 
 __all__ = [
-    "FrequencyResponse", "ResponseOptions", "frequency_responses", "automatic_window_lengths",
-    "DroppedResponse", "GatingResult", "gate_responses", "fit_range",
-    "write_responses", "read_responses", "RESPONSES_SCHEMA_VERSION",
-    "DEFAULT_PAIRS", "EXCITATION", "maneuver_records", "parse_pairs", "default_pairs", "reference_options", "FlightResponses",
+    "FrequencyResponse",
+    "ResponseOptions",
+    "frequency_responses",
+    "automatic_window_lengths",
+    "DroppedResponse",
+    "GatingResult",
+    "gate_responses",
+    "fit_range",
+    "write_responses",
+    "read_responses",
+    "RESPONSES_SCHEMA_VERSION",
+    "DEFAULT_PAIRS",
+    "EXCITATION",
+    "maneuver_records",
+    "parse_pairs",
+    "default_pairs",
+    "reference_options",
+    "FlightResponses",
     "flight_responses",
 ]

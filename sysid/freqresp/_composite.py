@@ -33,9 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._conditioning import pair_estimate, random_error
-from ._spectra import WindowSpectra
-from ._whole import significance_threshold
+from sysid.freqresp._conditioning import pair_estimate, random_error
+from sysid.freqresp._spectra import WindowSpectra
+from sysid.freqresp._whole import significance_threshold
 
 __all__: list[str] = []
 
@@ -55,7 +55,11 @@ class PairEstimate:
 
 
 def composite_pair(
-    windows: Sequence[WindowSpectra], omega: np.ndarray, inputs: Sequence[int], j: int, y: int,
+    windows: Sequence[WindowSpectra],
+    omega: np.ndarray,
+    inputs: Sequence[int],
+    j: int,
+    y: int,
     instrument: int | None = None,
 ) -> PairEstimate:
     """Composite estimate of channel `y` against input channel ``inputs[j]`` (conditioned, or by `instrument`)."""
@@ -82,8 +86,9 @@ def composite_pair(
     # averages credited: each member's, by its share of the estimate (weight x the spectrum H is divided by)
     divisor = instrument if instrument is not None and j == 0 else inputs[j]
     share = weights * np.abs(stacked[:, :, divisor, inputs[j]])
-    n_d_mean = np.where(share.sum(axis=0) > 0, (share.T @ n_d) / np.maximum(share.sum(axis=0), np.finfo(float).tiny),
-                        weights.T @ n_d)
+    n_d_mean = np.where(
+        share.sum(axis=0) > 0, (share.T @ n_d) / np.maximum(share.sum(axis=0), np.finfo(float).tiny), weights.T @ n_d
+    )
     used = tuple(float(w.window_s) for k, w in enumerate(windows) if w.noise_dof is None and np.any(weights[k] > 0))
     return PairEstimate(
         response=response,

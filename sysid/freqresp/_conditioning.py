@@ -26,7 +26,7 @@ It is neither the product nor the minimum of ``gamma^2_rx`` and
 is its first-order approximation when the errors of ``G_rx`` and ``G_ry``
 are small and independent, which in closed loop they are not (both carry the
 fed-back noise); the minimum ignores one channel's error and, with sensor
-noise fed back, understates the scatter by 40 % (tests/sysid/test_freqresp.py).
+noise fed back, understates the scatter by 40 % (tests/sysid/freqresp/test_estimate.py).
 """
 
 from __future__ import annotations
@@ -61,8 +61,14 @@ def conditioned_spectra(
     return g_jj, g_yy, g_aa[..., 0, 1]
 
 
-def coherence(g_xx: np.ndarray, g_yy: np.ndarray, g_xy: np.ndarray, *, g_xx_total: np.ndarray | None = None,
-              g_yy_total: np.ndarray | None = None) -> np.ndarray:
+def coherence(
+    g_xx: np.ndarray,
+    g_yy: np.ndarray,
+    g_xy: np.ndarray,
+    *,
+    g_xx_total: np.ndarray | None = None,
+    g_yy_total: np.ndarray | None = None,
+) -> np.ndarray:
     """``|G_xy|^2 / (G_xx G_yy)`` clipped to [0, 1].
 
     Zero where either autospectrum vanishes, or, given the unconditioned
@@ -99,8 +105,9 @@ def random_error(gamma2: np.ndarray, n_effective: float | np.ndarray) -> np.ndar
         return np.where(g2 > 0, np.sqrt(1.0 - g2) / np.sqrt(np.where(g2 > 0, g2, 1.0) * 2.0 * n_d), np.inf)
 
 
-def pair_estimate(spectra: np.ndarray, inputs: Sequence[int], j: int, y: int,
-                  instrument: int | None = None) -> Estimate:
+def pair_estimate(
+    spectra: np.ndarray, inputs: Sequence[int], j: int, y: int, instrument: int | None = None
+) -> Estimate:
     """Response of channel `y` to input channel ``inputs[j]`` from a spectral matrix, shape (n_freq, n_ch, n_ch).
 
     Returns ``(response, coherence, g_jj, g_yy, g_jy)``, each (n_freq,): the
@@ -138,8 +145,9 @@ def residual_noise(spectra: np.ndarray, inputs: Sequence[int], y: int, instrumen
     return np.where(np.isfinite(noise), np.maximum(noise, 0.0), 0.0)
 
 
-def _instrumental(spectra: np.ndarray, inputs: list[int], y: int, instrument: int
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _instrumental(
+    spectra: np.ndarray, inputs: list[int], y: int, instrument: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``H`` (n_freq, q), residual autospectrum (n_freq,) and ``diag(G_zx^-1 G_zz G_zx^-H)`` (n_freq, q)."""
     z = [instrument, *inputs[1:]]
     g_zx = spectra[..., z, :][..., :, inputs]
@@ -150,7 +158,10 @@ def _instrumental(spectra: np.ndarray, inputs: list[int], y: int, instrument: in
     loaded = g_zx + (_RIDGE * np.maximum(scale, np.finfo(float).tiny))[..., None, None] * np.eye(len(z))
     inverse = np.linalg.inv(loaded)
     h = np.einsum("...ab,...b->...a", inverse, spectra[..., z, y])
-    noise = (np.real(spectra[..., y, y]) - 2.0 * np.real(np.einsum("...a,...a->...", np.conj(h), g_xy))
-             + np.real(np.einsum("...a,...ab,...b->...", np.conj(h), g_xx, h)))
+    noise = (
+        np.real(spectra[..., y, y])
+        - 2.0 * np.real(np.einsum("...a,...a->...", np.conj(h), g_xy))
+        + np.real(np.einsum("...a,...ab,...b->...", np.conj(h), g_xx, h))
+    )
     spread = np.real(np.einsum("...ab,...bc,...ac->...a", inverse, g_zz, np.conj(inverse)))
     return h, noise, spread

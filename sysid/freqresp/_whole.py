@@ -44,8 +44,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ._conditioning import residual_noise
-from ._spectra import WindowSpectra
+from sysid.freqresp._conditioning import residual_noise
+from sysid.freqresp._spectra import WindowSpectra
 
 __all__: list[str] = []
 
@@ -81,8 +81,9 @@ def whole_record_spectra(
     edge = max(1, int(round(EDGE_S / dt)))
     for k, block in enumerate(data):
         taper = _edge_taper(block.shape[1], dt)
-        stacked[k * n_channels:(k + 1) * n_channels, : block.shape[1]] = (
-            block - block[:, :edge].mean(axis=1, keepdims=True)) * taper
+        stacked[k * n_channels : (k + 1) * n_channels, : block.shape[1]] = (
+            block - block[:, :edge].mean(axis=1, keepdims=True)
+        ) * taper
         energy += float(np.sum(taper**2))
     x = np.zeros((omega.size, n_records * n_channels), dtype=complex)
     for start in range(0, longest, _CHUNK):  # a long record's kernel would not fit in memory at once
@@ -115,7 +116,7 @@ def _edge_taper(n_samples: int, dt: float) -> np.ndarray:
     edge = min(int(round(EDGE_S / dt)), n_samples // 4)
     if edge > 0:
         ramp = 0.5 - 0.5 * np.cos(np.pi * (np.arange(edge) + 0.5) / edge)
-        taper[:edge], taper[n_samples - edge:] = ramp, ramp[::-1]
+        taper[:edge], taper[n_samples - edge :] = ramp, ramp[::-1]
     return taper
 
 
@@ -128,8 +129,16 @@ def _kernel(step_rad: np.ndarray, start: int, stop: int, block: int = 64) -> np.
     return (outer[:, :, None] * inner[:, None, :]).reshape(step_rad.size, n_blocks * block)[:, : stop - start]
 
 
-def _smooth_noise(spectra: np.ndarray, omega: np.ndarray, valid: np.ndarray, inputs: Sequence[int],
-                  outputs: Sequence[int], instrument: int | None, n_records: int, bin_rad_s: float) -> np.ndarray:
+def _smooth_noise(
+    spectra: np.ndarray,
+    omega: np.ndarray,
+    valid: np.ndarray,
+    inputs: Sequence[int],
+    outputs: Sequence[int],
+    instrument: int | None,
+    n_records: int,
+    bin_rad_s: float,
+) -> np.ndarray:
     """Replace each output's noise in `spectra` (in place) by its frequency average; its degrees of freedom."""
     n_inputs = len(inputs)
     half = np.maximum(SMOOTH_BINS * bin_rad_s, SMOOTH_FRACTION * omega)

@@ -8,12 +8,11 @@ import numpy as np
 
 from flightlogs.errors import DataError, MissingSignalError
 from flightlogs.record import Record
-
-from ._composite import composite_pair
-from ._spectra import WindowSpectra, window_spectra
-from ._whole import whole_record_spectra
-from .options import ResponseOptions
-from .response import FrequencyResponse
+from sysid.freqresp._composite import composite_pair
+from sysid.freqresp._spectra import WindowSpectra, window_spectra
+from sysid.freqresp._whole import whole_record_spectra
+from sysid.freqresp.options import ResponseOptions
+from sysid.freqresp.response import FrequencyResponse
 
 __all__ = ["frequency_responses", "automatic_window_lengths"]
 
@@ -97,8 +96,10 @@ def frequency_responses(
         raise DataError("no records to compute frequency responses from")
     dt = _common_step(records)
     if options.omega_max > np.pi / dt:
-        raise DataError(f"omega_max={options.omega_max:g} rad/s is above the Nyquist frequency "
-                        f"{np.pi / dt:.1f} rad/s of the {1 / dt:g} Hz records")
+        raise DataError(
+            f"omega_max={options.omega_max:g} rad/s is above the Nyquist frequency "
+            f"{np.pi / dt:.1f} rad/s of the {1 / dt:g} Hz records"
+        )
     extra = () if reference is None else (reference,)
     channels = inputs + extra + outputs
     data = [_channels(record, channels) for record in records]
@@ -115,23 +116,40 @@ def frequency_responses(
     omega = _grid(options, dt, longest)
     windows = [_spectra(data, dt, n, omega, options) for n in lengths]
     if whole:
-        member = whole_record_spectra(data, dt, omega, inputs=input_rows, outputs=output_rows, instrument=instrument,
-                                      min_cycles=options.min_cycles)
+        member = whole_record_spectra(
+            data,
+            dt,
+            omega,
+            inputs=input_rows,
+            outputs=output_rows,
+            instrument=instrument,
+            min_cycles=options.min_cycles,
+        )
         windows += [member] if member is not None else []
     units = _units(records, channels)
     found = []
     for o, output in enumerate(outputs):
         for j, name in enumerate(inputs):
             estimate = composite_pair(windows, omega, input_rows, j, output_rows[o], instrument)
-            found.append(FrequencyResponse(
-                input=name, output=output, omega=omega.copy(), response=estimate.response,
-                coherence=estimate.coherence, random_error=estimate.random_error,
-                input_autospectrum=estimate.input_autospectrum, output_autospectrum=estimate.output_autospectrum,
-                cross_spectrum=estimate.cross_spectrum, windows_s=estimate.windows_s,
-                conditioned_on=tuple(other for other in inputs if other != name),
-                input_unit=units[name], output_unit=units[output], reference=reference,
-                whole_record=estimate.whole_record,
-            ))
+            found.append(
+                FrequencyResponse(
+                    input=name,
+                    output=output,
+                    omega=omega.copy(),
+                    response=estimate.response,
+                    coherence=estimate.coherence,
+                    random_error=estimate.random_error,
+                    input_autospectrum=estimate.input_autospectrum,
+                    output_autospectrum=estimate.output_autospectrum,
+                    cross_spectrum=estimate.cross_spectrum,
+                    windows_s=estimate.windows_s,
+                    conditioned_on=tuple(other for other in inputs if other != name),
+                    input_unit=units[name],
+                    output_unit=units[output],
+                    reference=reference,
+                    whole_record=estimate.whole_record,
+                )
+            )
     return tuple(found)
 
 
@@ -186,7 +204,8 @@ def _channels(record: Record, channels: tuple[str, ...]) -> np.ndarray:
     if missing:
         raise MissingSignalError(
             f"{record.source.name}: record {record.label!r} has no signal {', '.join(missing)} "
-            f"(it has {', '.join(record.signals)})")
+            f"(it has {', '.join(record.signals)})"
+        )
     block = np.ascontiguousarray(np.vstack([record[name] for name in channels]))
     bad = [name for name, row in zip(channels, block) if not np.all(np.isfinite(row))]
     if bad:
@@ -203,8 +222,9 @@ def _window_samples(data: Sequence[np.ndarray], dt: float, options: ResponseOpti
         raise DataError(f"window of {too_short[0]:g} s holds fewer than {_MIN_WINDOW_SAMPLES} samples at {1 / dt:g} Hz")
     too_long = [n * dt for n in samples if n > longest]
     if too_long:
-        raise DataError(f"a window of {too_long[0]:g} s is longer than every record (the longest lasts "
-                        f"{(longest - 1) * dt:.2f} s)")
+        raise DataError(
+            f"a window of {too_long[0]:g} s is longer than every record (the longest lasts {(longest - 1) * dt:.2f} s)"
+        )
     return samples
 
 
@@ -214,15 +234,26 @@ def _grid(options: ResponseOptions, dt: float, longest: int) -> np.ndarray:
     lowest = 2.0 * np.pi * options.min_cycles / (longest * dt)
     kept = omega[omega >= lowest * (1.0 - 1e-12)]
     if kept.size < 2:
-        raise DataError(f"the longest window ({longest * dt:.2f} s) resolves nothing below "
-                        f"{lowest:.3g} rad/s, at or above omega_max={options.omega_max:g} rad/s")
+        raise DataError(
+            f"the longest window ({longest * dt:.2f} s) resolves nothing below "
+            f"{lowest:.3g} rad/s, at or above omega_max={options.omega_max:g} rad/s"
+        )
     return kept
 
 
-def _spectra(data: Sequence[np.ndarray], dt: float, n_window: int, omega: np.ndarray,
-             options: ResponseOptions) -> WindowSpectra:
-    found = window_spectra(data, dt, n_window, omega, overlap=options.overlap, taper=options.taper,
-                           min_cycles=options.min_cycles, spacing=options.spacing)
+def _spectra(
+    data: Sequence[np.ndarray], dt: float, n_window: int, omega: np.ndarray, options: ResponseOptions
+) -> WindowSpectra:
+    found = window_spectra(
+        data,
+        dt,
+        n_window,
+        omega,
+        overlap=options.overlap,
+        taper=options.taper,
+        min_cycles=options.min_cycles,
+        spacing=options.spacing,
+    )
     assert found is not None  # every length fits the longest record (checked in _window_samples)
     return found
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .response import FrequencyResponse
+from sysid.freqresp.response import FrequencyResponse
 
 __all__ = ["DroppedResponse", "GatingResult", "gate_responses", "fit_range"]
 
@@ -138,16 +138,25 @@ def gate_responses(
         span = fit_range(response.omega, response.coherence, min_coherence)
         if span is None:
             best = float(np.nanmax(response.coherence)) if np.any(np.isfinite(response.coherence)) else 0.0
-            dropped.append(DroppedResponse(response.input, response.output,
-                                           f"{response.pair}: coherence never reaches {min_coherence:g} "
-                                           f"(at most {best:.2f})."))
+            dropped.append(
+                DroppedResponse(
+                    response.input,
+                    response.output,
+                    f"{response.pair}: coherence never reaches {min_coherence:g} (at most {best:.2f}).",
+                )
+            )
             continue
         decades = float(np.log10(span[1] / span[0]))
         if decades < min_decades:
-            dropped.append(DroppedResponse(response.input, response.output,
-                                           f"{response.pair}: coherence reaches {min_coherence:g} over only "
-                                           f"{decades:.2f} decade ({span[0]:.3g}-{span[1]:.3g} rad/s), less than "
-                                           f"the {min_decades:g} decade required."))
+            dropped.append(
+                DroppedResponse(
+                    response.input,
+                    response.output,
+                    f"{response.pair}: coherence reaches {min_coherence:g} over only "
+                    f"{decades:.2f} decade ({span[0]:.3g}-{span[1]:.3g} rad/s), less than "
+                    f"the {min_decades:g} decade required.",
+                )
+            )
             continue
         kept.append(replace(response, fit_range=span))
     return GatingResult(tuple(kept), tuple(dropped))

@@ -29,18 +29,24 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from flightlogs.atomic import atomic_output
-from flightlogs.hdf5 import open_schema, stamp_schema
-
-from .response import FrequencyResponse
+from flightlogs.store.schema import open_schema, stamp_schema
+from flightlogs.writers.atomic import atomic_output
+from sysid.freqresp.response import FrequencyResponse
 
 __all__ = ["write_responses", "read_responses", "RESPONSES_SCHEMA_VERSION"]
 
 _SCHEMA = "flight-sysid frequency responses"
 #: Layout version written by :func:`write_responses`.
 RESPONSES_SCHEMA_VERSION = 1
-_ARRAYS = ("omega", "response", "coherence", "random_error", "input_autospectrum", "output_autospectrum",
-           "cross_spectrum")
+_ARRAYS = (
+    "omega",
+    "response",
+    "coherence",
+    "random_error",
+    "input_autospectrum",
+    "output_autospectrum",
+    "cross_spectrum",
+)
 
 
 def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) -> None:
@@ -91,8 +97,14 @@ def read_responses(path: str | Path) -> tuple[FrequencyResponse, ...]:
     LogFormatError
         If the file is not a responses file of this schema, or of a newer version.
     """
-    with open_schema(Path(path), _SCHEMA, RESPONSES_SCHEMA_VERSION, what="responses", not_hdf5="an HDF5 file",
-                     wrong_schema="HDF5 file holds no flight-sysid frequency responses.") as (h5, _):
+    with open_schema(
+        Path(path),
+        _SCHEMA,
+        RESPONSES_SCHEMA_VERSION,
+        what="responses",
+        not_hdf5="an HDF5 file",
+        wrong_schema="HDF5 file holds no flight-sysid frequency responses.",
+    ) as (h5, _):
         group = h5["responses"]
         return tuple(_read_one(group[key]) for key in sorted(group))
 
@@ -117,9 +129,15 @@ def _write_one(group: h5py.Group, response: FrequencyResponse) -> None:
 
 def _units(response: FrequencyResponse) -> dict[str, str]:
     x, y = response.input_unit or "input", response.output_unit or "output"
-    return {"omega": "rad/s", "response": f"({y})/({x})", "coherence": "1", "random_error": "1",
-            "input_autospectrum": f"({x})^2/(rad/s)", "output_autospectrum": f"({y})^2/(rad/s)",
-            "cross_spectrum": f"({x})*({y})/(rad/s)"}
+    return {
+        "omega": "rad/s",
+        "response": f"({y})/({x})",
+        "coherence": "1",
+        "random_error": "1",
+        "input_autospectrum": f"({x})^2/(rad/s)",
+        "output_autospectrum": f"({y})^2/(rad/s)",
+        "cross_spectrum": f"({x})*({y})/(rad/s)",
+    }
 
 
 def _read_one(group: h5py.Group) -> FrequencyResponse:
@@ -127,10 +145,12 @@ def _read_one(group: h5py.Group) -> FrequencyResponse:
     fit = group.attrs.get("fit_range")
     reference = group.attrs.get("reference")
     return FrequencyResponse(
-        input=_text(group.attrs["input"]), output=_text(group.attrs["output"]),
+        input=_text(group.attrs["input"]),
+        output=_text(group.attrs["output"]),
         windows_s=tuple(float(t) for t in np.atleast_1d(group.attrs["windows_s"])),
         conditioned_on=tuple(json.loads(_text(group.attrs["conditioned_on"]))),
-        input_unit=_text(group.attrs["input_unit"]), output_unit=_text(group.attrs["output_unit"]),
+        input_unit=_text(group.attrs["input_unit"]),
+        output_unit=_text(group.attrs["output_unit"]),
         fit_range=None if fit is None else (float(fit[0]), float(fit[1])),
         reference=None if reference is None else _text(reference),
         whole_record=bool(group.attrs.get("whole_record", False)),

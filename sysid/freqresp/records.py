@@ -8,28 +8,34 @@ from types import MappingProxyType
 
 import numpy as np
 
-from flightlogs.condition import ConditionedFlight
+from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import DataError
+from flightlogs.maneuvers.segments import AXES
 from flightlogs.record import Record
-from flightlogs.segments import AXES
-
-from .estimate import frequency_responses
-from .options import ResponseOptions
-from .response import FrequencyResponse
+from sysid.freqresp.estimate import frequency_responses
+from sysid.freqresp.options import ResponseOptions
+from sysid.freqresp.response import FrequencyResponse
 
 __all__ = [
-    "DEFAULT_PAIRS", "EXCITATION", "maneuver_records", "parse_pairs", "default_pairs",
-    "reference_options", "FlightResponses",
+    "DEFAULT_PAIRS",
+    "EXCITATION",
+    "maneuver_records",
+    "parse_pairs",
+    "default_pairs",
+    "reference_options",
+    "FlightResponses",
     "flight_responses",
 ]
 
 #: Outputs per mixer axis, after the chapter 3 model (eqs. 3.10-3.13, accelerations by eq. 3.7); inputs ``delta_<axis>``.
-DEFAULT_PAIRS: Mapping[str, tuple[str, ...]] = MappingProxyType({
-    "lon": ("q", "ax", "theta", "u"),
-    "lat": ("p", "ay", "phi", "v"),
-    "yaw": ("r", "psi"),
-    "thr": ("az", "w"),
-})
+DEFAULT_PAIRS: Mapping[str, tuple[str, ...]] = MappingProxyType(
+    {
+        "lon": ("q", "ax", "theta", "u"),
+        "lat": ("p", "ay", "phi", "v"),
+        "yaw": ("r", "psi"),
+        "thr": ("az", "w"),
+    }
+)
 _MIN_PIECE_SAMPLES = 16
 #: The canonical signal holding the injected excitation (ArduPilot SIDD), used as reference when logged.
 EXCITATION = "excitation"
@@ -245,8 +251,14 @@ def flight_responses(
     return FlightResponses(tuple(found[pair] for pair in chosen), MappingProxyType(pieces), tuple(notes))
 
 
-def reference_options(records: Sequence[Record], axis: str, inputs: Sequence[str], kind: str,
-                      options: ResponseOptions, use_excitation: bool = True) -> tuple[ResponseOptions, str]:
+def reference_options(
+    records: Sequence[Record],
+    axis: str,
+    inputs: Sequence[str],
+    kind: str,
+    options: ResponseOptions,
+    use_excitation: bool = True,
+) -> tuple[ResponseOptions, str]:
     """The options for one axis's responses (excitation as reference or not) and a note saying which and why.
 
     The logged ``excitation`` becomes the reference of the mixer input's
@@ -286,11 +298,14 @@ def reference_options(records: Sequence[Record], axis: str, inputs: Sequence[str
     carrying = [r for r in records if EXCITATION in r.signals and np.ptp(r[EXCITATION]) > 0]
     if len(carrying) == len(records):
         return replace(options, reference=EXCITATION), (
-            f"{axis}: the logged {EXCITATION} (SIDD) is the reference of the {mixer} responses, H = G_ry / G_rx.")
+            f"{axis}: the logged {EXCITATION} (SIDD) is the reference of the {mixer} responses, H = G_ry / G_rx."
+        )
     which = "none" if not carrying else f"only {len(carrying)} of {len(records)}"
-    return options, (f"{axis}: {which} of the {kind} pieces carry a logged {EXCITATION} (PX4 logs none): responses "
-                     f"computed from the mixer input {mixer}, which in closed loop also carries the feedback of "
-                     f"noise and turbulence.")
+    return options, (
+        f"{axis}: {which} of the {kind} pieces carry a logged {EXCITATION} (PX4 logs none): responses "
+        f"computed from the mixer input {mixer}, which in closed loop also carries the feedback of "
+        f"noise and turbulence."
+    )
 
 
 def _axis_of(input_: str, pairs: Sequence[tuple[str, str]]) -> str:

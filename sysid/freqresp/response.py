@@ -73,8 +73,14 @@ class FrequencyResponse:
             raise ValueError(f"omega must be 1-D with at least 2 points, got shape {n_freq}")
         if np.any(np.diff(self.omega) <= 0):
             raise ValueError("omega must be strictly increasing")
-        for name in ("response", "coherence", "random_error", "input_autospectrum", "output_autospectrum",
-                     "cross_spectrum"):
+        for name in (
+            "response",
+            "coherence",
+            "random_error",
+            "input_autospectrum",
+            "output_autospectrum",
+            "cross_spectrum",
+        ):
             shape = np.shape(getattr(self, name))
             if shape != n_freq:
                 raise ValueError(f"{name} has shape {shape}, expected {n_freq} like omega")

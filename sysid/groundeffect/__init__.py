@@ -11,7 +11,7 @@ chosen model for a controller study (:func:`write_ground_effect_model`,
 
 from __future__ import annotations
 
-from .data import (
+from sysid.groundeffect.data import (
     GroundEffectDataConfig,
     HoverStep,
     HoverSteps,
@@ -19,11 +19,24 @@ from .data import (
     load_thrust_ratio,
     rig_thrust_ratio,
 )
-from .fitting import FitConfig, fit_ground_effect, fit_model
-from .flight import flight_thrust_ratio, plateaus
-from .models import MODEL_NAMES, PARAMETER_NAMES, Criterion, GroundEffectFit, ModelFit, ModelName, evaluate_model
-from .modelfile import FittedGroundEffect, fit_summary, read_ground_effect_model, write_ground_effect_model
-from .spacing import SpacingStudy, default_families, spacing_study, spacing_summary
+from sysid.groundeffect.fitting import FitConfig, fit_ground_effect, fit_model
+from sysid.groundeffect.flight import flight_thrust_ratio, plateaus
+from sysid.groundeffect.modelfile import (
+    FittedGroundEffect,
+    fit_summary,
+    read_ground_effect_model,
+    write_ground_effect_model,
+)
+from sysid.groundeffect.models import (
+    MODEL_NAMES,
+    PARAMETER_NAMES,
+    Criterion,
+    GroundEffectFit,
+    ModelFit,
+    ModelName,
+    evaluate_model,
+)
+from sysid.groundeffect.spacing import SpacingStudy, default_families, spacing_study, spacing_summary
 
 __all__ = [
     "GroundEffectDataConfig",

@@ -160,7 +160,7 @@ class GroundEffectDataConfig:
     height_column, thrust_column : str
         Rig CSV column names.
     height_unit, thrust_unit : str or None
-        Rig CSV units (default from the column names; see :func:`flightlogs.rig.read_rig_csv`).
+        Rig CSV units (default from the column names; see :func:`flightlogs.readers.rig.read_rig_csv`).
     kf_n_per_count : float
         Flight: motor force constant k_f of eq. 2.6, N per PWM count (Table 2.1: 2.083e-6).
     mass_kg : float or None
@@ -195,8 +195,14 @@ class GroundEffectDataConfig:
     gravity_m_s2: float = 9.81
 
     def __post_init__(self) -> None:
-        for name in ("rotor_radius_m", "reference_height_ratio", "kf_n_per_count", "pwm_full_scale",
-                     "min_hold_s", "gravity_m_s2"):
+        for name in (
+            "rotor_radius_m",
+            "reference_height_ratio",
+            "kf_n_per_count",
+            "pwm_full_scale",
+            "min_hold_s",
+            "gravity_m_s2",
+        ):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise ValueError(f"{name}={value} must be finite and > 0")
@@ -260,9 +266,11 @@ def rig_thrust_ratio(
     if f0_n is None:
         reference = x > reference_height_ratio
         if not np.any(reference):
-            raise DataError(f"{source or 'rig data'}: no reading above Z/R = {reference_height_ratio:g} "
-                            f"(height {reference_height_ratio * rotor_radius_m:.3f} m) to give F0; "
-                            "give F0 (--f0) or add readings out of ground effect")
+            raise DataError(
+                f"{source or 'rig data'}: no reading above Z/R = {reference_height_ratio:g} "
+                f"(height {reference_height_ratio * rotor_radius_m:.3f} m) to give F0; "
+                "give F0 (--f0) or add readings out of ground effect"
+            )
         f0 = float(np.mean(thrust[reference]))
         how = f"mean of {int(reference.sum())} row{'s' if reference.sum() > 1 else ''} with Z/R > {reference_height_ratio:g}"
     else:
@@ -270,19 +278,22 @@ def rig_thrust_ratio(
     ratio = thrust / f0
     median = float(np.median(ratio)) if ratio.size else 1.0
     if not _PLAUSIBLE_MEDIAN[0] <= median <= _PLAUSIBLE_MEDIAN[1]:
-        raise DataError(f"{source or 'rig data'}: with F0 = {f0:.4g} N ({how}) the median F/F0 of the readings is "
-                        f"{median:.3g}, far from 1 out of ground effect; check F0 (--f0) and the thrust unit "
-                        f"(median thrust {float(np.median(thrust)):.4g} N)")
+        raise DataError(
+            f"{source or 'rig data'}: with F0 = {f0:.4g} N ({how}) the median F/F0 of the readings is "
+            f"{median:.3g}, far from 1 out of ground effect; check F0 (--f0) and the thrust unit "
+            f"(median thrust {float(np.median(thrust)):.4g} N)"
+        )
     return ThrustRatioData(x, ratio, rotor_radius_m, source, how, f0)
 
 
-def load_thrust_ratio(path: str | Path, config: GroundEffectDataConfig, *,
-                      progress: Callable[[int, int], None] | None = None) -> ThrustRatioData:
+def load_thrust_ratio(
+    path: str | Path, config: GroundEffectDataConfig, *, progress: Callable[[int, int], None] | None = None
+) -> ThrustRatioData:
     """F/F0 against Z/R from a rig CSV or a flight log, told apart by content.
 
     A file that reads as a PX4 ULog, ArduPilot DataFlash or MAVLink
     telemetry log is a flight log (:func:`sysid.groundeffect.flight.flight_thrust_ratio`);
-    any other text file is a rig CSV (:func:`flightlogs.rig.read_rig_csv`), unless
+    any other text file is a rig CSV (:func:`flightlogs.readers.rig.read_rig_csv`), unless
     it is named ``.ulg``, ``.bin`` or ``.tlog``: then the log reader's error stands.
 
     Parameters
@@ -303,8 +314,8 @@ def load_thrust_ratio(path: str | Path, config: GroundEffectDataConfig, *,
     DataError, LogFormatError, MissingSignalError
         If the file cannot be read or holds no usable points.
     """
-    from flightlogs.detect import detect_format
     from flightlogs.errors import LogFormatError
+    from flightlogs.readers.detect import detect_format
 
     path = Path(path)
     try:
@@ -313,9 +324,8 @@ def load_thrust_ratio(path: str | Path, config: GroundEffectDataConfig, *,
         if _is_text(path) and path.suffix.lower() not in _LOG_SUFFIXES:
             return _rig(path, config)
         raise
-    from flightlogs.reader import read_log
-
-    from .flight import flight_thrust_ratio
+    from flightlogs.readers.dispatch import read_log
+    from sysid.groundeffect.flight import flight_thrust_ratio
 
     return flight_thrust_ratio(read_log(path, progress=progress), config)
 
@@ -330,9 +340,20 @@ def _is_text(path: Path) -> bool:
 
 
 def _rig(path: Path, config: GroundEffectDataConfig) -> ThrustRatioData:
-    from flightlogs.rig import read_rig_csv
+    from flightlogs.readers.rig import read_rig_csv
 
-    rig = read_rig_csv(path, height_column=config.height_column, thrust_column=config.thrust_column,
-                       height_unit=config.height_unit, thrust_unit=config.thrust_unit)
-    return rig_thrust_ratio(rig.height_m, rig.thrust_n, rotor_radius_m=config.rotor_radius_m, f0_n=config.f0_n,
-                            reference_height_ratio=config.reference_height_ratio, source=path.name)
+    rig = read_rig_csv(
+        path,
+        height_column=config.height_column,
+        thrust_column=config.thrust_column,
+        height_unit=config.height_unit,
+        thrust_unit=config.thrust_unit,
+    )
+    return rig_thrust_ratio(
+        rig.height_m,
+        rig.thrust_n,
+        rotor_radius_m=config.rotor_radius_m,
+        f0_n=config.f0_n,
+        reference_height_ratio=config.reference_height_ratio,
+        source=path.name,
+    )

@@ -40,10 +40,17 @@ import numpy as np
 from scipy import optimize, stats
 
 from flightlogs.errors import FitError
-
-from . import formulas
-from .data import ThrustRatioData
-from .models import MODEL_NAMES, PARAMETER_NAMES, Criterion, GroundEffectFit, ModelFit, ModelName, evaluate_model
+from sysid.groundeffect import formulas
+from sysid.groundeffect.data import ThrustRatioData
+from sysid.groundeffect.models import (
+    MODEL_NAMES,
+    PARAMETER_NAMES,
+    Criterion,
+    GroundEffectFit,
+    ModelFit,
+    ModelName,
+    evaluate_model,
+)
 
 __all__ = ["FitConfig", "fit_ground_effect", "fit_model"]
 
@@ -76,6 +83,7 @@ class FitConfig:
             raise ValueError(f"criterion={self.criterion!r} must be 'aicc' or 'bic'")
         if not 0 < self.confidence < 1:
             raise ValueError(f"confidence={self.confidence} must lie in (0, 1)")
+
 
 def fit_ground_effect(data: ThrustRatioData, config: FitConfig | None = None) -> GroundEffectFit:
     """Fit each family to F/F0 against Z/R and choose by information criterion.
@@ -110,13 +118,16 @@ def fit_ground_effect(data: ThrustRatioData, config: FitConfig | None = None) ->
         if data.n_points == 1:
             what = what.replace("steps", "step").replace("points", "point").replace("were", "was")
         raise FitError(f"{data.source or 'data'}: {data.n_points} {what}; at least 3 are needed to fit")
-    fits = tuple(fit_model(name, data.height_ratio, data.thrust_ratio, confidence=config.confidence)
-                 for name in config.models)
+    fits = tuple(
+        fit_model(name, data.height_ratio, data.thrust_ratio, confidence=config.confidence) for name in config.models
+    )
     scores = np.array([f.criterion(config.criterion) for f in fits])
     scores = np.where(np.isnan(scores), np.inf, scores)  # -inf (an exact fit) stays the best
     if np.all(scores == np.inf):
-        raise FitError(f"{data.source or 'data'}: {data.n_points} points are too few for {config.criterion} "
-                       f"to compare {', '.join(config.models)}")
+        raise FitError(
+            f"{data.source or 'data'}: {data.n_points} points are too few for {config.criterion} "
+            f"to compare {', '.join(config.models)}"
+        )
     best = fits[int(np.argmin(scores))].name
     return GroundEffectFit(data, fits, best, config.criterion, config.confidence)
 
@@ -192,8 +203,11 @@ def _fit_exponential(x: np.ndarray, y: np.ndarray) -> _Fitted:
         safe = np.where(ee > 0, ee, 1.0)
         return np.where(ee > 0, er / safe, 0.0), float(r @ r) - np.where(ee > 0, er * er / safe, 0.0)
 
-    b0 = _profile(lambda b: float(linear_fit(np.array(b))[1][0]), lambda g: linear_fit(g)[1],
-                  np.geomspace(bounds[0][1], bounds[1][1], 120))
+    b0 = _profile(
+        lambda b: float(linear_fit(np.array(b))[1][0]),
+        lambda g: linear_fit(g)[1],
+        np.geomspace(bounds[0][1], bounds[1][1], 120),
+    )
     a0 = float(linear_fit(np.array(b0))[0][0])
 
     def residual(p: np.ndarray) -> np.ndarray:
@@ -222,8 +236,11 @@ def _fit_piecewise_linear(x: np.ndarray, y: np.ndarray) -> _Fitted:
         safe = np.where(dd > 0, dd, 1.0)
         return np.where(dd > 0, dr / safe, 0.0), float(r @ r) - np.where(dd > 0, dr * dr / safe, 0.0)
 
-    bp = _profile(lambda b: float(linear_fit(np.array(b))[1][0]), lambda g: linear_fit(g)[1],
-                  np.union1d(np.linspace(lo, hi_bp, _GRID), x))
+    bp = _profile(
+        lambda b: float(linear_fit(np.array(b))[1][0]),
+        lambda g: linear_fit(g)[1],
+        np.union1d(np.linspace(lo, hi_bp, _GRID), x),
+    )
     slope = float(linear_fit(np.array(bp))[0][0])
     notes = []
     below = int(np.sum(x < bp))
@@ -242,8 +259,9 @@ def _profile(cost: Callable[[float], float], costs: Callable[[np.ndarray], np.nd
     left, right = float(grid[max(i - 1, 0)]), float(grid[min(i + 1, grid.size - 1)])
     best, best_cost = float(grid[i]), float(values[i])
     if right > left:
-        refined = optimize.minimize_scalar(cost, bounds=(left, right), method="bounded",
-                                           options={"xatol": 1e-10 * max(1.0, abs(right))})
+        refined = optimize.minimize_scalar(
+            cost, bounds=(left, right), method="bounded", options={"xatol": 1e-10 * max(1.0, abs(right))}
+        )
         if refined.fun < best_cost:
             best = float(refined.x)
     return best
@@ -260,8 +278,9 @@ _FITTERS: dict[str, Callable[[np.ndarray, np.ndarray], _Fitted]] = {
 # --------------------------------------------------------------------------- statistics
 
 
-def _summarise(name: str, x: np.ndarray, y: np.ndarray, free: np.ndarray, jacobian: np.ndarray,
-               notes: list[str], confidence: float) -> ModelFit:
+def _summarise(
+    name: str, x: np.ndarray, y: np.ndarray, free: np.ndarray, jacobian: np.ndarray, notes: list[str], confidence: float
+) -> ModelFit:
     """Values, covariance, intervals and goodness of fit of a fitted family."""
     n, p = x.size, free.size
     values = free if name != "piecewise_linear" else np.array([free[0], 1.0 - free[0] * free[1], free[1]])
@@ -282,10 +301,20 @@ def _summarise(name: str, x: np.ndarray, y: np.ndarray, free: np.ndarray, jacobi
     aicc = log_term + 2 * k + (2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else math.inf)
     bic = log_term + k * math.log(n)
     return ModelFit(
-        name=name, param_names=PARAMETER_NAMES[name], values=values, stderr=stderr, ci_low=values - half,
-        ci_high=values + half, n_free=p, residuals=residuals, rss=rss,
-        rmse=math.sqrt(rss / dof) if dof > 0 else math.nan, r2=1.0 - rss / tss if tss > 0 else math.nan,
-        aicc=aicc, bic=bic, notes=tuple(notes),
+        name=name,
+        param_names=PARAMETER_NAMES[name],
+        values=values,
+        stderr=stderr,
+        ci_low=values - half,
+        ci_high=values + half,
+        n_free=p,
+        residuals=residuals,
+        rss=rss,
+        rmse=math.sqrt(rss / dof) if dof > 0 else math.nan,
+        r2=1.0 - rss / tss if tss > 0 else math.nan,
+        aicc=aicc,
+        bic=bic,
+        notes=tuple(notes),
     )
 
 

@@ -20,8 +20,7 @@ import numpy as np
 
 from flightlogs.errors import DataError, MissingSignalError
 from flightlogs.flightlog import FlightLog, Signal
-
-from .data import GroundEffectDataConfig, HoverStep, HoverSteps, ThrustRatioData
+from sysid.groundeffect.data import GroundEffectDataConfig, HoverStep, HoverSteps, ThrustRatioData
 
 __all__ = ["flight_thrust_ratio", "plateaus"]
 
@@ -66,17 +65,21 @@ def flight_thrust_ratio(log: FlightLog, config: GroundEffectDataConfig) -> Thrus
     if time_s.size < 2:
         raise DataError(f"{log.path.name}: height_agl and the motor signals do not overlap in time")
     block_t, block_z, bounds = _blocks(time_s, z)
-    segments = plateaus(block_z, min_length=max(2, math.ceil(config.min_hold_s / _BLOCK_S)),
-                        transition=round(_TRANSITION_S / _BLOCK_S))
+    segments = plateaus(
+        block_z, min_length=max(2, math.ceil(config.min_hold_s / _BLOCK_S)), transition=round(_TRANSITION_S / _BLOCK_S)
+    )
     steps, dropped = _steps(time_s, z, f0, block_t, bounds, segments, config)
     if not steps:
-        raise DataError(f"{log.path.name}: no hover step of at least {config.min_hold_s:g} s with plausible "
-                        f"thrust found" + (f" ({'; '.join(dropped)})" if dropped else ""))
+        raise DataError(
+            f"{log.path.name}: no hover step of at least {config.min_hold_s:g} s with plausible "
+            f"thrust found" + (f" ({'; '.join(dropped)})" if dropped else "")
+        )
     weight, how = _weight(log, steps, config)
     steps = [_with_ratio(step, weight) for step in steps]
     kept = [s for s in steps if _PLAUSIBLE[0] <= s.thrust_ratio <= _PLAUSIBLE[1]]
-    dropped += [f"{s.start_s:.1f}-{s.end_s:.1f} s: F/F0 = {s.thrust_ratio:.3g} implausible" for s in steps
-                if s not in kept]
+    dropped += [
+        f"{s.start_s:.1f}-{s.end_s:.1f} s: F/F0 = {s.thrust_ratio:.3g} implausible" for s in steps if s not in kept
+    ]
     if not kept:
         raise DataError(f"{log.path.name}: no hover step with plausible F/F0 ({'; '.join(dropped)})")
     found = HoverSteps(block_t, block_z, tuple(kept), tuple(dropped))
@@ -86,8 +89,9 @@ def flight_thrust_ratio(log: FlightLog, config: GroundEffectDataConfig) -> Thrus
     return ThrustRatioData(x, ratio, config.rotor_radius_m, log.path.name, f0_source, None, found)
 
 
-def plateaus(values: np.ndarray, *, min_length: int, noise: float | None = None,
-             transition: int = 0) -> list[tuple[int, int]]:
+def plateaus(
+    values: np.ndarray, *, min_length: int, noise: float | None = None, transition: int = 0
+) -> list[tuple[int, int]]:
     """Split a series into piecewise-constant segments (optimal partitioning, penalised least squares).
 
     Parameters
@@ -160,8 +164,9 @@ def _noise(y: np.ndarray) -> float:
 
 def _eq_2_6(log: FlightLog, config: GroundEffectDataConfig) -> tuple[np.ndarray, np.ndarray, str]:
     """Time base and F0 = sum k_f PWM_i (eq. 2.6), N, on the first motor's time base."""
-    motors: list[Signal] = sorted((s for n, s in log.signals.items() if n.startswith("motor_")),
-                                  key=lambda s: int(s.name.split("_")[1]))
+    motors: list[Signal] = sorted(
+        (s for n, s in log.signals.items() if n.startswith("motor_")), key=lambda s: int(s.name.split("_")[1])
+    )
     if not motors:
         raise MissingSignalError(f"{log.path.name}: no motor signals (motor_1..n) for eq. 2.6")
     units = {m.unit for m in motors}
@@ -188,8 +193,15 @@ def _blocks(time_s: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
     return (np.add.reduceat(time_s, starts) / counts, np.add.reduceat(z, starts) / counts, bounds)
 
 
-def _steps(time_s: np.ndarray, z: np.ndarray, f0: np.ndarray, block_t: np.ndarray, bounds: np.ndarray,
-           segments: list[tuple[int, int]], config: GroundEffectDataConfig) -> tuple[list[HoverStep], list[str]]:
+def _steps(
+    time_s: np.ndarray,
+    z: np.ndarray,
+    f0: np.ndarray,
+    block_t: np.ndarray,
+    bounds: np.ndarray,
+    segments: list[tuple[int, int]],
+    config: GroundEffectDataConfig,
+) -> tuple[list[HoverStep], list[str]]:
     """Steady-half statistics of each segment; segments on the ground or too short are dropped."""
     steps, dropped = [], []
     for first, last in segments:
@@ -204,8 +216,11 @@ def _steps(time_s: np.ndarray, z: np.ndarray, f0: np.ndarray, block_t: np.ndarra
             dropped.append(f"{start:.1f}-{end:.1f} s: motors off")
             continue
         rate = float(np.polyfit(t - t.mean(), h, 1)[0])
-        steps.append(HoverStep(start, end, middle, float(np.mean(h)), float(np.std(h)), rate, float(np.mean(f)),
-                               math.nan, int(t.size)))
+        steps.append(
+            HoverStep(
+                start, end, middle, float(np.mean(h)), float(np.std(h)), rate, float(np.mean(f)), math.nan, int(t.size)
+            )
+        )
     return steps, dropped
 
 
@@ -215,11 +230,24 @@ def _weight(log: FlightLog, steps: list[HoverStep], config: GroundEffectDataConf
         return config.mass_kg * config.gravity_m_s2, f"m g with m = {config.mass_kg:g} kg"
     high = [s.f0_n for s in steps if s.height_m / config.rotor_radius_m > config.reference_height_ratio]
     if not high:
-        raise DataError(f"{log.path.name}: no hover step above Z/R = {config.reference_height_ratio:g} to give "
-                        "the weight; give the mass (--mass)")
-    return float(np.mean(high)), f"mean eq. 2.6 thrust of {len(high)} step(s) above Z/R = {config.reference_height_ratio:g}"
+        raise DataError(
+            f"{log.path.name}: no hover step above Z/R = {config.reference_height_ratio:g} to give "
+            "the weight; give the mass (--mass)"
+        )
+    return float(
+        np.mean(high)
+    ), f"mean eq. 2.6 thrust of {len(high)} step(s) above Z/R = {config.reference_height_ratio:g}"
 
 
 def _with_ratio(step: HoverStep, weight_n: float) -> HoverStep:
-    return HoverStep(step.start_s, step.end_s, step.steady_start_s, step.height_m, step.height_std_m,
-                     step.climb_rate_m_s, step.f0_n, weight_n / step.f0_n, step.samples)
+    return HoverStep(
+        step.start_s,
+        step.end_s,
+        step.steady_start_s,
+        step.height_m,
+        step.height_std_m,
+        step.climb_rate_m_s,
+        step.f0_n,
+        weight_n / step.f0_n,
+        step.samples,
+    )

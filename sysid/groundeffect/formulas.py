@@ -1,7 +1,7 @@
 """Thrust ratio F/F0 against height ratio Z/R: the ground-effect laws of chapter 2 (eqs. 2.1-2.5).
 
 Pure formulas, shared by the fitting code (:mod:`sysid.groundeffect`) and the
-simulator (:func:`sysid.sim.environment.thrust_ratio`, which clamps Z/R from
+simulator (:func:`simulator.world.environment.thrust_ratio`, which clamps Z/R from
 below before calling them). Z is the height of the rotor plane above the
 ground and R the propeller radius, so both ratios are dimensionless.
 """

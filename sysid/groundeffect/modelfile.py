@@ -14,13 +14,17 @@ from typing import Any
 import numpy as np
 
 from flightlogs.errors import ModelError
+from sysid._json import read_json_object, write_json
+from sysid._json import value_text as _show
+from sysid.groundeffect.models import PARAMETER_NAMES, GroundEffectFit, evaluate_model
 
-from .._json import read_json_object, write_json
-from .._json import value_text as _show
-from .models import PARAMETER_NAMES, GroundEffectFit, evaluate_model
-
-__all__ = ["FittedGroundEffect", "fit_summary", "write_ground_effect_model", "read_ground_effect_model",
-           "MODEL_FILE_FORMAT"]
+__all__ = [
+    "FittedGroundEffect",
+    "fit_summary",
+    "write_ground_effect_model",
+    "read_ground_effect_model",
+    "MODEL_FILE_FORMAT",
+]
 
 #: Value of the file's ``format`` key.
 MODEL_FILE_FORMAT = "flight-sysid ground-effect model"
@@ -62,7 +66,9 @@ class FittedGroundEffect:
             raise ModelError(f"{self.model} takes parameters {PARAMETER_NAMES[self.model]}, got {self.param_names}")
         values = np.asarray(self.values, dtype=np.float64)
         if values.shape != (len(self.param_names),) or not np.all(np.isfinite(values)):
-            raise ModelError(f"{self.model}: parameter values {values.tolist()} must be {len(self.param_names)} finite numbers")
+            raise ModelError(
+                f"{self.model}: parameter values {values.tolist()} must be {len(self.param_names)} finite numbers"
+            )
         if not (self.rotor_radius_m > 0 and self.min_height_ratio >= 0):
             raise ModelError(f"rotor_radius_m={self.rotor_radius_m} must be > 0 and min_height_ratio >= 0")
         object.__setattr__(self, "param_names", tuple(self.param_names))
@@ -103,8 +109,14 @@ class FittedGroundEffect:
         FittedGroundEffect
         """
         best = fit.model(fit.best)
-        return cls(best.name, best.param_names, best.values, fit.data.rotor_radius_m,
-                   float(fit.data.height_ratio.min()), fit.data.source)
+        return cls(
+            best.name,
+            best.param_names,
+            best.values,
+            fit.data.rotor_radius_m,
+            float(fit.data.height_ratio.min()),
+            fit.data.source,
+        )
 
 
 def fit_summary(fit: GroundEffectFit) -> dict[str, Any]:
@@ -127,20 +139,41 @@ def fit_summary(fit: GroundEffectFit) -> dict[str, Any]:
             "params": m.params,
             "stderr": {n: float(v) for n, v in zip(m.param_names, m.stderr)},
             "ci": m.intervals,
-            "n_free": m.n_free, "rmse": m.rmse, "r2": m.r2, "aicc": m.aicc, "bic": m.bic,
-            "delta": fit.delta(m.name), "notes": list(m.notes),
+            "n_free": m.n_free,
+            "rmse": m.rmse,
+            "r2": m.r2,
+            "aicc": m.aicc,
+            "bic": m.bic,
+            "delta": fit.delta(m.name),
+            "notes": list(m.notes),
         }
     summary: dict[str, Any] = {
-        "best": fit.best, "criterion": fit.criterion, "confidence": fit.confidence, "models": models,
-        "source": data.source, "f0_source": data.f0_source, "f0_n": data.f0_n,
-        "rotor_radius_m": data.rotor_radius_m, "n_points": data.n_points,
-        "height_ratio": data.height_ratio.tolist(), "thrust_ratio": data.thrust_ratio.tolist(),
+        "best": fit.best,
+        "criterion": fit.criterion,
+        "confidence": fit.confidence,
+        "models": models,
+        "source": data.source,
+        "f0_source": data.f0_source,
+        "f0_n": data.f0_n,
+        "rotor_radius_m": data.rotor_radius_m,
+        "n_points": data.n_points,
+        "height_ratio": data.height_ratio.tolist(),
+        "thrust_ratio": data.thrust_ratio.tolist(),
     }
     if data.steps is not None:
-        summary["steps"] = [{"start_s": s.start_s, "end_s": s.end_s, "steady_start_s": s.steady_start_s,
-                             "height_m": s.height_m, "height_ratio": s.height_m / data.rotor_radius_m,
-                             "climb_rate_m_s": s.climb_rate_m_s, "f0_n": s.f0_n, "thrust_ratio": s.thrust_ratio}
-                            for s in data.steps.steps]
+        summary["steps"] = [
+            {
+                "start_s": s.start_s,
+                "end_s": s.end_s,
+                "steady_start_s": s.steady_start_s,
+                "height_m": s.height_m,
+                "height_ratio": s.height_m / data.rotor_radius_m,
+                "climb_rate_m_s": s.climb_rate_m_s,
+                "f0_n": s.f0_n,
+                "thrust_ratio": s.thrust_ratio,
+            }
+            for s in data.steps.steps
+        ]
         summary["dropped_steps"] = list(data.steps.dropped)
     return summary
 
@@ -162,9 +195,14 @@ def write_ground_effect_model(fit: GroundEffectFit, path: str | Path) -> Path:
     """
     chosen = FittedGroundEffect.from_fit(fit)
     document = {
-        "format": MODEL_FILE_FORMAT, "version": _VERSION, "model": chosen.model, "params": chosen.params,
-        "rotor_radius_m": chosen.rotor_radius_m, "min_height_ratio": chosen.min_height_ratio,
-        "source": chosen.source, "fit": _finite(fit_summary(fit)),
+        "format": MODEL_FILE_FORMAT,
+        "version": _VERSION,
+        "model": chosen.model,
+        "params": chosen.params,
+        "rotor_radius_m": chosen.rotor_radius_m,
+        "min_height_ratio": chosen.min_height_ratio,
+        "source": chosen.source,
+        "fit": _finite(fit_summary(fit)),
     }
     return write_json(path, document)
 
@@ -201,34 +239,46 @@ def read_ground_effect_model(path: str | Path) -> FittedGroundEffect:
     path = Path(path)
     document = read_json_object(path, ModelError, "ground-effect model")
     if document.get("format") != MODEL_FILE_FORMAT:
-        raise ModelError(f"{path}: not a ground-effect model (no \"format\": {MODEL_FILE_FORMAT!r})")
+        raise ModelError(f'{path}: not a ground-effect model (no "format": {MODEL_FILE_FORMAT!r})')
     if document.get("version") != _VERSION:
         raise ModelError(f"{path}: ground-effect model version {document.get('version')!r}; this tool reads {_VERSION}")
     model = document.get("model")
     if not isinstance(model, str):
-        raise ModelError(f"{path}: no ground-effect model named (\"model\" is {_show(model)})")
+        raise ModelError(f'{path}: no ground-effect model named ("model" is {_show(model)})')
     if model not in PARAMETER_NAMES:
         raise ModelError(f"{path}: unknown ground-effect model {model!r}; choose from {', '.join(PARAMETER_NAMES)}")
     params = document.get("params")
     if not isinstance(params, dict):
-        raise ModelError(f"{path}: the {model} model has no parameters (\"params\" is {_show(params)})")
-    values = [_number(path, params, name, f"the {model} model needs parameter {name}",
-                      label=f"parameter {name} of the {model} model") for name in PARAMETER_NAMES[model]]
+        raise ModelError(f'{path}: the {model} model has no parameters ("params" is {_show(params)})')
+    values = [
+        _number(
+            path,
+            params,
+            name,
+            f"the {model} model needs parameter {name}",
+            label=f"parameter {name} of the {model} model",
+        )
+        for name in PARAMETER_NAMES[model]
+    ]
     extra = sorted(set(params) - set(PARAMETER_NAMES[model]))
     if extra:
-        raise ModelError(f"{path}: {', '.join(extra)} is not a parameter of the {model} model "
-                         f"(it takes {', '.join(PARAMETER_NAMES[model]) or 'none'})")
+        raise ModelError(
+            f"{path}: {', '.join(extra)} is not a parameter of the {model} model "
+            f"(it takes {', '.join(PARAMETER_NAMES[model]) or 'none'})"
+        )
     radius = _number(path, document, "rotor_radius_m", "the rotor radius (rotor_radius_m) is missing")
     lowest = _number(path, document, "min_height_ratio", "", default=0.0)
     try:
-        return FittedGroundEffect(model, PARAMETER_NAMES[model], np.array(values), radius, lowest,
-                                  str(document.get("source", "")))
+        return FittedGroundEffect(
+            model, PARAMETER_NAMES[model], np.array(values), radius, lowest, str(document.get("source", ""))
+        )
     except ModelError as err:
         raise ModelError(f"{path}: {err}") from None
 
 
-def _number(path: Path, table: dict[str, Any], key: str, missing: str, *, default: float | None = None,
-            label: str = "") -> float:
+def _number(
+    path: Path, table: dict[str, Any], key: str, missing: str, *, default: float | None = None, label: str = ""
+) -> float:
     """A finite number from a JSON object, or a ModelError naming the file and the key."""
     if key not in table and default is not None:
         return default

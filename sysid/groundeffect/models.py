@@ -11,8 +11,8 @@ from typing import Literal
 
 import numpy as np
 
-from . import formulas
-from .data import ThrustRatioData
+from sysid.groundeffect import formulas
+from sysid.groundeffect.data import ThrustRatioData
 
 __all__ = [
     "ModelName",
@@ -245,4 +245,3 @@ class GroundEffectFit:
         """
         lowest = min(m.criterion(self.criterion) for m in self.models)
         return self.model(name).criterion(self.criterion) - lowest
-

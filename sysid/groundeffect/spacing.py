@@ -20,10 +20,9 @@ from typing import Any
 import numpy as np
 
 from flightlogs.errors import DataError
-
-from .data import ThrustRatioData
-from .fitting import FitConfig, fit_ground_effect
-from .models import MODEL_NAMES, GroundEffectFit, ModelName
+from sysid.groundeffect.data import ThrustRatioData
+from sysid.groundeffect.fitting import FitConfig, fit_ground_effect
+from sysid.groundeffect.models import MODEL_NAMES, GroundEffectFit, ModelName
 
 __all__ = ["SpacingStudy", "spacing_study", "default_families", "spacing_summary"]
 
@@ -77,7 +76,9 @@ class SpacingStudy:
     def __post_init__(self) -> None:
         spacings = np.asarray(self.spacings_m, dtype=np.float64)
         if spacings.ndim != 1 or spacings.size != len(self.fits) or spacings.size != len(self.chosen):
-            raise ValueError(f"spacings_m {spacings.shape}, {len(self.fits)} fits and {len(self.chosen)} choices differ")
+            raise ValueError(
+                f"spacings_m {spacings.shape}, {len(self.fits)} fits and {len(self.chosen)} choices differ"
+            )
         if np.any(np.diff(spacings) <= 0):
             raise ValueError(f"spacings_m {spacings.tolist()} must increase")
         object.__setattr__(self, "spacings_m", spacings)
@@ -187,8 +188,9 @@ def spacing_study(
         if progress is not None:
             progress(done, len(order))
     chosen = tuple(min(compared, key=lambda name: fit.model(name).criterion(fit_config.criterion)) for fit in fits)
-    return SpacingStudy(spacings[order], tuple(fits), tuple(compared), chosen,
-                        _transition(spacings[order], chosen, compared), rotors)
+    return SpacingStudy(
+        spacings[order], tuple(fits), tuple(compared), chosen, _transition(spacings[order], chosen, compared), rotors
+    )
 
 
 def _transition(spacings: np.ndarray, chosen: tuple[str, ...], families: tuple[str, ...]) -> float | None:
@@ -218,12 +220,26 @@ def spacing_summary(study: SpacingStudy) -> dict[str, Any]:
     """
     sets = []
     for spacing, fit, chosen in zip(study.spacings_m, study.fits, study.chosen):
-        models = {m.name: {"params": m.params, "ci": m.intervals, "rmse": m.rmse, "r2": m.r2, "aicc": m.aicc,
-                           "bic": m.bic} for m in fit.models}
-        sets.append({"spacing_mm": float(spacing) * 1e3, "source": fit.data.source, "n_points": fit.data.n_points,
-                     "chosen": chosen, "best": fit.best, "models": models})
+        models = {
+            m.name: {"params": m.params, "ci": m.intervals, "rmse": m.rmse, "r2": m.r2, "aicc": m.aicc, "bic": m.bic}
+            for m in fit.models
+        }
+        sets.append(
+            {
+                "spacing_mm": float(spacing) * 1e3,
+                "source": fit.data.source,
+                "n_points": fit.data.n_points,
+                "chosen": chosen,
+                "best": fit.best,
+                "models": models,
+            }
+        )
     return {
-        "rotors": study.rotors, "families": list(study.families), "criterion": study.fits[0].criterion,
-        "spacing_mm": (study.spacings_m * 1e3).tolist(), "chosen": list(study.chosen),
-        "transition_mm": None if study.transition_m is None else study.transition_m * 1e3, "sets": sets,
+        "rotors": study.rotors,
+        "families": list(study.families),
+        "criterion": study.fits[0].criterion,
+        "spacing_mm": (study.spacings_m * 1e3).tolist(),
+        "chosen": list(study.chosen),
+        "transition_mm": None if study.transition_m is None else study.transition_m * 1e3,
+        "sets": sets,
     }

@@ -16,9 +16,8 @@ from types import MappingProxyType
 import numpy as np
 
 from flightlogs.errors import ModelError
-
-from ..statespace import DelayedStateSpace
-from .structure import Entry, ModelStructure
+from sysid.model.statespace import DelayedStateSpace
+from sysid.model.structure import Entry, ModelStructure
 
 __all__ = ["SystemMatrices", "Assembler", "structure_model"]
 
@@ -73,8 +72,15 @@ class Assembler:
     -0.5
     """
 
-    def __init__(self, structure: ModelStructure, *, free: Sequence[str], fixed: Mapping[str, float],
-                 constants: Mapping[str, float], include_wind: bool = True) -> None:
+    def __init__(
+        self,
+        structure: ModelStructure,
+        *,
+        free: Sequence[str],
+        fixed: Mapping[str, float],
+        constants: Mapping[str, float],
+        include_wind: bool = True,
+    ) -> None:
         self.structure = structure
         self.free = tuple(free)
         for name in self.free:
@@ -82,24 +88,35 @@ class Assembler:
         channels = [k for k, c in enumerate(structure.inputs) if include_wind or not c.wind]
         self.channels = tuple(structure.inputs[k] for k in channels)
         self._column = {k: j for j, k in enumerate(channels)}
-        self._entries = tuple(e for e in structure.entries
-                              if e.matrix not in ("G_u", "G_w") or e.column in self._column)
+        self._entries = tuple(
+            e for e in structure.entries if e.matrix not in ("G_u", "G_w") or e.column in self._column
+        )
         base = dict(constants) | {k: float(v) for k, v in fixed.items() if k not in self.free}
-        needed = set().union(*(e.expression.names for e in self._entries),
-                             *(c.delay.names for c in self.channels)) - set(self.free)
+        needed = set().union(
+            *(e.expression.names for e in self._entries), *(c.delay.names for c in self.channels)
+        ) - set(self.free)
         missing = sorted(needed - set(base))
         if missing:
             raise ModelError(f"structure {structure.name}: no value for {', '.join(missing)}")
         self._base = MappingProxyType(base)
         self._reads = tuple(tuple(e for e in self._entries if name in e.expression.names) for name in self.free)
-        self._delay_reads = tuple(tuple(j for j, c in enumerate(self.channels) if name in c.delay.names)
-                                  for name in self.free)
+        self._delay_reads = tuple(
+            tuple(j for j, c in enumerate(self.channels) if name in c.delay.names) for name in self.free
+        )
         n_x, n_y = len(structure.states), len(structure.outputs)
-        self._identity_outputs = [(k, structure.states.index(o)) for k, o in enumerate(structure.outputs)
-                                  if o in structure.states and not any(
-                                      e.matrix in ("H0", "H1") and e.row == k for e in structure.entries)]
-        self._shapes = {"M": (n_x, n_x), "F": (n_x, n_x), "G_u": (n_x, len(channels)), "G_w": (n_x, len(channels)),
-                        "H0": (n_y, n_x), "H1": (n_y, n_x)}
+        self._identity_outputs = [
+            (k, structure.states.index(o))
+            for k, o in enumerate(structure.outputs)
+            if o in structure.states and not any(e.matrix in ("H0", "H1") and e.row == k for e in structure.entries)
+        ]
+        self._shapes = {
+            "M": (n_x, n_x),
+            "F": (n_x, n_x),
+            "G_u": (n_x, len(channels)),
+            "G_w": (n_x, len(channels)),
+            "H0": (n_y, n_x),
+            "H1": (n_y, n_x),
+        }
 
     def environment(self, theta: np.ndarray) -> dict[str, float | complex]:
         """Values of every name the expressions read.
@@ -206,8 +223,17 @@ class Assembler:
         if np.any(m.delays < 0):
             bad = self.channels[int(np.argmin(m.delays))]
             raise ModelError(f"structure {self.structure.name}: delay of input {bad.name} is negative")
-        return DelayedStateSpace(m.a, m.b, m.c, m.d, self.structure.states, tuple(c.signal for c in self.channels),
-                                 self.structure.outputs, m.delays, MappingProxyType(dict(trim or {})))
+        return DelayedStateSpace(
+            m.a,
+            m.b,
+            m.c,
+            m.d,
+            self.structure.states,
+            tuple(c.signal for c in self.channels),
+            self.structure.outputs,
+            m.delays,
+            MappingProxyType(dict(trim or {})),
+        )
 
     def _place(self, mats: dict[str, np.ndarray], entry: Entry, value: float) -> None:
         key = "G" if entry.matrix in ("G_u", "G_w") else entry.matrix
@@ -223,9 +249,13 @@ class Assembler:
             raise ModelError(f"structure {self.structure.name}: the mass matrix M is singular") from None
 
 
-def structure_model(structure: ModelStructure, values: Mapping[str, float], *,
-                    constants: Mapping[str, float] | None = None, include_wind: bool = True
-                    ) -> tuple[DelayedStateSpace, tuple[str, ...]]:
+def structure_model(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    *,
+    constants: Mapping[str, float] | None = None,
+    include_wind: bool = True,
+) -> tuple[DelayedStateSpace, tuple[str, ...]]:
     """A structure with given parameter values (published derivatives) as a :class:`DelayedStateSpace`.
 
     Parameters not given take their drop value (0: a term the publication

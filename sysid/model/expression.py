@@ -27,10 +27,17 @@ _Compiled = Callable[[Mapping[str, Value]], Value]
 
 #: Functions an expression may call (all analytic, so complex-step derivatives are exact).
 FUNCTIONS: Mapping[str, Callable[[Value], Value]] = {
-    "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "sqrt": np.sqrt,
+    "sin": np.sin,
+    "cos": np.cos,
+    "tan": np.tan,
+    "exp": np.exp,
+    "sqrt": np.sqrt,
 }
 _BINARY: dict[type, Callable[[Value, Value], Value]] = {
-    ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
     ast.Pow: operator.pow,
 }
 _UNARY: dict[type, Callable[[Value], Value]] = {ast.UAdd: operator.pos, ast.USub: operator.neg}
@@ -140,17 +147,29 @@ def _compile(node: ast.AST, text: str, label: str, names: set[str]) -> _Compiled
         names.add(name)
         return lambda values: values[name]
     if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-        op, left, right = _BINARY[type(node.op)], _compile(node.left, text, label, names), _compile(
-            node.right, text, label, names)
+        op, left, right = (
+            _BINARY[type(node.op)],
+            _compile(node.left, text, label, names),
+            _compile(node.right, text, label, names),
+        )
         return lambda values: op(left(values), right(values))
     if isinstance(node, ast.UnaryOp) and type(node.op) in _UNARY:
         unary, operand = _UNARY[type(node.op)], _compile(node.operand, text, label, names)
         return lambda values: unary(operand(values))
-    if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS
-            and len(node.args) == 1 and not node.keywords):
+    if (
+        isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and node.func.id in FUNCTIONS
+        and len(node.args) == 1
+        and not node.keywords
+    ):
         function, argument = FUNCTIONS[node.func.id], _compile(node.args[0], text, label, names)
         return lambda values: function(argument(values))
-    what = f"a call of {node.func.id}" if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) else (
-        f"{type(node).__name__}")
-    raise ModelError(f"{label}entry {text}: only numbers, names, + - * / ** and sin cos tan exp sqrt are allowed, "
-                     f"not {what}")
+    what = (
+        f"a call of {node.func.id}"
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+        else (f"{type(node).__name__}")
+    )
+    raise ModelError(
+        f"{label}entry {text}: only numbers, names, + - * / ** and sin cos tan exp sqrt are allowed, not {what}"
+    )

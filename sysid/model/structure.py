@@ -19,8 +19,7 @@ from types import MappingProxyType
 from typing import Literal
 
 from flightlogs.errors import ModelError
-
-from .expression import Expression
+from sysid.model.expression import Expression
 
 __all__ = ["Parameter", "Constant", "InputChannel", "Entry", "ModelStructure", "MATRICES"]
 
@@ -71,8 +70,10 @@ class Parameter:
         if not math.isfinite(self.value):
             raise ModelError(f"parameter {self.name}: value {self.value} must be finite")
         if self.free and not self.lower <= self.value <= self.upper:
-            raise ModelError(f"parameter {self.name}: initial value {self.value} lies outside its bounds "
-                             f"[{self.lower}, {self.upper}]")
+            raise ModelError(
+                f"parameter {self.name}: initial value {self.value} lies outside its bounds "
+                f"[{self.lower}, {self.upper}]"
+            )
         if self.reduce not in ("drop", "fix"):
             raise ModelError(f"parameter {self.name}: reduce={self.reduce!r} must be 'drop' or 'fix'")
 
@@ -183,9 +184,13 @@ class ModelStructure:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_index", MappingProxyType({p.name: p for p in self.parameters}))
-        for label, names in (("state", self.states), ("output", self.outputs),
-                             ("input", [c.name for c in self.inputs]), ("parameter", list(self._index)),
-                             ("constant", [c.name for c in self.constants])):
+        for label, names in (
+            ("state", self.states),
+            ("output", self.outputs),
+            ("input", [c.name for c in self.inputs]),
+            ("parameter", list(self._index)),
+            ("constant", [c.name for c in self.constants]),
+        ):
             duplicates = sorted({n for n in names if list(names).count(n) > 1})
             if duplicates:
                 raise ModelError(f"structure {self.name}: {label} names repeated: {', '.join(duplicates)}")
@@ -196,8 +201,10 @@ class ModelStructure:
         for item in [e.expression for e in self.entries] + [c.delay for c in self.inputs]:
             unknown = sorted(item.names - known)
             if unknown:
-                raise ModelError(f"structure {self.name}: expression {item.text!r} reads unknown name "
-                                 f"{unknown[0]!r} (not a parameter or constant)")
+                raise ModelError(
+                    f"structure {self.name}: expression {item.text!r} reads unknown name "
+                    f"{unknown[0]!r} (not a parameter or constant)"
+                )
 
     def parameter(self, name: str) -> Parameter:
         """The parameter called `name`.
@@ -215,8 +222,9 @@ class ModelStructure:
         try:
             return self._index[name]
         except KeyError:
-            raise ModelError(f"structure {self.name} has no parameter {name!r} "
-                             f"(it has {', '.join(self._index)})") from None
+            raise ModelError(
+                f"structure {self.name} has no parameter {name!r} (it has {', '.join(self._index)})"
+            ) from None
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -238,7 +246,9 @@ class ModelStructure:
         """Parameters read only by the wind columns and wind delays (fitted in the wind step)."""
         wind_columns = {k for k, c in enumerate(self.inputs) if c.wind}
         in_wind: set[str] = set().union(*(c.delay.names for c in self.wind_inputs)) if self.wind_inputs else set()
-        elsewhere: set[str] = set().union(*(c.delay.names for c in self.control_inputs)) if self.control_inputs else set()
+        elsewhere: set[str] = (
+            set().union(*(c.delay.names for c in self.control_inputs)) if self.control_inputs else set()
+        )
         for entry in self.entries:
             is_wind = entry.matrix == "G_w" and entry.column in wind_columns
             (in_wind if is_wind else elsewhere).update(entry.expression.names)
@@ -273,8 +283,10 @@ class ModelStructure:
         known = [c.name for c in self.constants]
         unknown = [n for n in names if n not in known]
         if unknown:
-            raise ModelError(f"structure {self.name} has no trim constant {unknown[0]!r} "
-                             f"(its trim constants: {', '.join(known) or 'none'})")
+            raise ModelError(
+                f"structure {self.name} has no trim constant {unknown[0]!r} "
+                f"(its trim constants: {', '.join(known) or 'none'})"
+            )
 
     def constants_from_trim(self, trim: Mapping[str, float]) -> dict[str, float]:
         """Constant values with each trim-linked constant set from `trim`.
@@ -284,8 +296,9 @@ class ModelStructure:
         trim : Mapping[str, float]
             Trim value of canonical signals (a record's ``trim``), SI.
         """
-        return {c.name: float(trim[c.trim]) if c.trim is not None and c.trim in trim else c.value
-                for c in self.constants}
+        return {
+            c.name: float(trim[c.trim]) if c.trim is not None and c.trim in trim else c.value for c in self.constants
+        }
 
     def values(self, overrides: Mapping[str, float] | None = None) -> dict[str, float]:
         """Parameter values: declared values with `overrides` applied.

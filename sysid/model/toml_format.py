@@ -41,9 +41,8 @@ from pathlib import Path
 from typing import Any
 
 from flightlogs.errors import ModelError
-
-from .expression import parse_expression
-from .structure import MATRICES, Constant, Entry, InputChannel, ModelStructure, Parameter
+from sysid.model.expression import parse_expression
+from sysid.model.structure import MATRICES, Constant, Entry, InputChannel, ModelStructure, Parameter
 
 __all__ = ["parse_structure", "read_structure", "builtin_structures", "load_structure"]
 
@@ -108,10 +107,13 @@ def parse_structure(text: str, *, source: str = "<text>") -> ModelStructure:
     inputs_named = {c.name for c in inputs}
     for parameter in parameters:
         if parameter.input is not None and parameter.input not in inputs_named:
-            raise ModelError(f"{source}: parameter {parameter.name} is per unit of input {parameter.input!r}, "
-                             "which is not an input of the structure")
-    structure = ModelStructure(name, str(doc.get("description", "")), states, inputs, outputs, parameters,
-                               constants, entries, text)
+            raise ModelError(
+                f"{source}: parameter {parameter.name} is per unit of input {parameter.input!r}, "
+                "which is not an input of the structure"
+            )
+    structure = ModelStructure(
+        name, str(doc.get("description", "")), states, inputs, outputs, parameters, constants, entries, text
+    )
     _check_outputs(structure, source)
     return structure
 
@@ -152,7 +154,9 @@ def builtin_structures() -> dict[str, str]:
     found = {}
     for item in sorted(folder.iterdir(), key=lambda p: p.name):
         if item.name.endswith(".toml"):
-            found[item.name[: -len(".toml")]] = str(tomllib.loads(item.read_text(encoding="utf-8")).get("description", ""))
+            found[item.name[: -len(".toml")]] = str(
+                tomllib.loads(item.read_text(encoding="utf-8")).get("description", "")
+            )
     return found
 
 
@@ -175,8 +179,9 @@ def load_structure(name_or_path: str | Path) -> ModelStructure:
         return parse_structure(item.read_text(encoding="utf-8"), source=text)
     if Path(text).is_file():
         return read_structure(text)
-    raise ModelError(f"model {text!r} is neither a built-in structure ({', '.join(builtin_structures())}) "
-                     "nor a structure file")
+    raise ModelError(
+        f"model {text!r} is neither a built-in structure ({', '.join(builtin_structures())}) nor a structure file"
+    )
 
 
 def _names(doc: Mapping[str, Any], key: str, source: str) -> tuple[str, ...]:
@@ -202,8 +207,9 @@ def _list_of_tables(value: Any, key: str, source: str) -> list[Mapping[str, Any]
 def _input(item: Mapping[str, Any], source: str) -> InputChannel:
     unknown = sorted(set(item) - {"name", "signal", "delay", "wind"})
     if unknown or not isinstance(item.get("name"), str):
-        raise ModelError(f"{source}: each [[inputs]] needs a name and may have signal, delay, wind "
-                         f"(got {sorted(item)})")
+        raise ModelError(
+            f"{source}: each [[inputs]] needs a name and may have signal, delay, wind (got {sorted(item)})"
+        )
     name = item["name"]
     delay = parse_expression(item.get("delay", 0.0), where=f"{source}: delay of {name}")
     return InputChannel(name, str(item.get("signal", name)), delay, bool(item.get("wind", False)))
@@ -213,13 +219,23 @@ def _parameter(name: str, spec: Any, source: str) -> Parameter:
     if isinstance(spec, (int, float)) and not isinstance(spec, bool):
         spec = {"value": spec}
     if not isinstance(spec, dict) or "value" not in spec or set(spec) - _PARAMETER_KEYS:
-        raise ModelError(f"{source}: parameter {name} must be a number or a table with value "
-                         f"(and optionally {', '.join(sorted(_PARAMETER_KEYS - {'value'}))})")
+        raise ModelError(
+            f"{source}: parameter {name} must be a number or a table with value "
+            f"(and optionally {', '.join(sorted(_PARAMETER_KEYS - {'value'}))})"
+        )
     lower, upper = spec.get("bounds", [-math.inf, math.inf])
     try:
-        return Parameter(name, float(spec["value"]), float(lower), float(upper), bool(spec.get("free", True)),
-                         str(spec.get("unit", "")), spec.get("reduce", "drop"), float(spec.get("drop_value", 0.0)),
-                         spec.get("input"))
+        return Parameter(
+            name,
+            float(spec["value"]),
+            float(lower),
+            float(upper),
+            bool(spec.get("free", True)),
+            str(spec.get("unit", "")),
+            spec.get("reduce", "drop"),
+            float(spec.get("drop_value", 0.0)),
+            spec.get("input"),
+        )
     except (TypeError, ValueError) as err:
         raise ModelError(f"{source}: parameter {name}: {err}") from None
 
@@ -229,17 +245,28 @@ def _constant(name: str, spec: Any, source: str) -> Constant:
         return Constant(name, float(spec))
     if isinstance(spec, dict) and "value" in spec and not set(spec) - {"value", "trim"}:
         return Constant(name, float(spec["value"]), spec.get("trim"))
-    raise ModelError(f"{source}: constant {name} must be a number or {{ value = ..., trim = \"signal\" }}")
+    raise ModelError(f'{source}: constant {name} must be a number or {{ value = ..., trim = "signal" }}')
 
 
-def _entries(doc: Mapping[str, Any], states: tuple[str, ...], outputs: tuple[str, ...],
-             inputs: tuple[InputChannel, ...], source: str) -> tuple[Entry, ...]:
+def _entries(
+    doc: Mapping[str, Any],
+    states: tuple[str, ...],
+    outputs: tuple[str, ...],
+    inputs: tuple[InputChannel, ...],
+    source: str,
+) -> tuple[Entry, ...]:
     state_index = {n: k for k, n in enumerate(states)}
     output_index = {n: k for k, n in enumerate(outputs)}
     control_index = {c.name: k for k, c in enumerate(inputs) if not c.wind}
     wind_index = {c.name: k for k, c in enumerate(inputs) if c.wind}
-    layout = {"M": (state_index, state_index), "F": (state_index, state_index), "G_u": (state_index, control_index),
-              "G_w": (state_index, wind_index), "H0": (output_index, state_index), "H1": (output_index, state_index)}
+    layout = {
+        "M": (state_index, state_index),
+        "F": (state_index, state_index),
+        "G_u": (state_index, control_index),
+        "G_w": (state_index, wind_index),
+        "H0": (output_index, state_index),
+        "H1": (output_index, state_index),
+    }
     entries = []
     for matrix, (rows, columns) in layout.items():
         for row, cells in _table(doc, matrix, source).items():
@@ -249,8 +276,10 @@ def _entries(doc: Mapping[str, Any], states: tuple[str, ...], outputs: tuple[str
                 raise ModelError(f"{source}: [{matrix}] row {row} must be a table {{ column = entry }}")
             for column, text in cells.items():
                 if column not in columns:
-                    raise ModelError(f"{source}: [{matrix}] column {column!r} (row {row}) is not one of "
-                                     f"{', '.join(columns) or 'nothing'}")
+                    raise ModelError(
+                        f"{source}: [{matrix}] column {column!r} (row {row}) is not one of "
+                        f"{', '.join(columns) or 'nothing'}"
+                    )
                 expression = parse_expression(text, where=f"{source}: {matrix}[{row}, {column}]")
                 entries.append(Entry(matrix, rows[row], columns[column], expression))
     return tuple(entries)

@@ -7,14 +7,37 @@ simulated from all measured inputs and judged on the outputs of the axis it
 excites (:func:`axis_outputs`).
 """
 
-from .engine import VerificationOptions, verify, verify_record
-from .logs import verify_flights, verify_logs
-from .records import DoubletRecords, doublet_records
-from .submodel import axis_outputs, driven_part
-from .results import (OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, mode_names,
-                      rms_error, theil_inequality)
+from sysid.verify.engine import VerificationOptions, verify, verify_record
+from sysid.verify.logs import verify_flights, verify_logs
+from sysid.verify.records import DoubletRecords, doublet_records
+from sysid.verify.results import (
+    OutputSummary,
+    OutputVerification,
+    RecordVerification,
+    Verification,
+    WindCorrection,
+    mode_names,
+    rms_error,
+    theil_inequality,
+)
+from sysid.verify.submodel import axis_outputs, driven_part
 
-__all__ = ["VerificationOptions", "verify_record", "verify", "verify_logs", "verify_flights", "driven_part",
-           "axis_outputs",
-           "doublet_records", "DoubletRecords", "OutputVerification", "RecordVerification", "OutputSummary",
-           "WindCorrection", "Verification", "rms_error", "theil_inequality", "mode_names"]
+__all__ = [
+    "VerificationOptions",
+    "verify_record",
+    "verify",
+    "verify_logs",
+    "verify_flights",
+    "driven_part",
+    "axis_outputs",
+    "doublet_records",
+    "DoubletRecords",
+    "OutputVerification",
+    "RecordVerification",
+    "OutputSummary",
+    "WindCorrection",
+    "Verification",
+    "rms_error",
+    "theil_inequality",
+    "mode_names",
+]

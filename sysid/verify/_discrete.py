@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg
 
-from ..statespace import DelayedStateSpace
+from sysid.model.statespace import DelayedStateSpace
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,8 +78,16 @@ def discretize(model: DelayedStateSpace, dt_s: float) -> DiscreteModel:
         if f > 0:
             _, gamma_first = _phi_gamma(a, b[:, [j]], f * dt_s)
             gamma_prev[:, j] = (phi_rest @ gamma_first)[:, 0]
-    return DiscreteModel(ad, gamma_now, gamma_prev, np.asarray(model.c, dtype=float), np.asarray(model.d, dtype=float),
-                         whole, fraction, float(dt_s))
+    return DiscreteModel(
+        ad,
+        gamma_now,
+        gamma_prev,
+        np.asarray(model.c, dtype=float),
+        np.asarray(model.d, dtype=float),
+        whole,
+        fraction,
+        float(dt_s),
+    )
 
 
 def shifted(inputs: np.ndarray, lag: np.ndarray) -> np.ndarray:

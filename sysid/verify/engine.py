@@ -48,13 +48,20 @@ import numpy as np
 
 from flightlogs.errors import DataError
 from flightlogs.record import Record
-
-from ..modes import state_modes
-from ..statespace import DelayedStateSpace
-from ._discrete import DiscreteModel, delayed_inputs, discretize, predict_one_step, simulate
-from .results import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection, mode_names
-from .results import rms_error, theil_inequality
-from .submodel import driven_part, reachable
+from sysid.model.modes import state_modes
+from sysid.model.statespace import DelayedStateSpace
+from sysid.verify._discrete import DiscreteModel, delayed_inputs, discretize, predict_one_step, simulate
+from sysid.verify.results import (
+    OutputSummary,
+    OutputVerification,
+    RecordVerification,
+    Verification,
+    WindCorrection,
+    mode_names,
+    rms_error,
+    theil_inequality,
+)
+from sysid.verify.submodel import driven_part, reachable
 
 __all__ = ["VerificationOptions", "verify_record", "verify"]
 
@@ -111,13 +118,13 @@ def _weight(unit: str) -> float:
 def _signals(record: Record, names: Sequence[str], what: str) -> np.ndarray:
     missing = [n for n in dict.fromkeys(names) if n not in record.signals]
     if missing:
-        raise DataError(f"{record.source.name}: record {record.label!r} lacks the model {what} "
-                        f"{', '.join(missing)}")
+        raise DataError(f"{record.source.name}: record {record.label!r} lacks the model {what} {', '.join(missing)}")
     return np.column_stack([record[n] for n in names]) if names else np.zeros((record.time_s.size, 0))
 
 
-def _initial_state(model: DelayedStateSpace, disc: DiscreteModel, record: Record, inputs: np.ndarray,
-                   options: VerificationOptions) -> np.ndarray:
+def _initial_state(
+    model: DelayedStateSpace, disc: DiscreteModel, record: Record, inputs: np.ndarray, options: VerificationOptions
+) -> np.ndarray:
     """Measured states at the first sample (line fit), the rest at rest given them; zero if asked."""
     n_x = len(model.states)
     x0 = np.zeros(n_x)
@@ -139,8 +146,7 @@ def _initial_state(model: DelayedStateSpace, disc: DiscreteModel, record: Record
     return x0
 
 
-def _shift_responses(model: DelayedStateSpace, disc: DiscreteModel, names: Sequence[str],
-                     n_samples: int) -> np.ndarray:
+def _shift_responses(model: DelayedStateSpace, disc: DiscreteModel, names: Sequence[str], n_samples: int) -> np.ndarray:
     """Each named input's response to a unit constant, shape (n_names, n_samples, n_outputs)."""
     responses = np.empty((len(names), n_samples, len(model.outputs)))
     for k, name in enumerate(names):
@@ -152,8 +158,11 @@ def _shift_responses(model: DelayedStateSpace, disc: DiscreteModel, names: Seque
 def _free_responses(model: DelayedStateSpace, disc: DiscreteModel, n_samples: int) -> np.ndarray:
     """Response to a unit initial value of each state, no input, shape (n_states, n_samples, n_outputs)."""
     zero = np.zeros((n_samples, len(model.inputs)))
-    return np.stack([simulate(disc, zero, unit) for unit in np.eye(len(model.states))]) if model.states else (
-        np.zeros((0, n_samples, len(model.outputs))))
+    return (
+        np.stack([simulate(disc, zero, unit) for unit in np.eye(len(model.states))])
+        if model.states
+        else (np.zeros((0, n_samples, len(model.outputs))))
+    )
 
 
 def _offsets(residual: np.ndarray, regressors: list[np.ndarray], weights: np.ndarray) -> list[np.ndarray]:
@@ -172,8 +181,7 @@ def _growth(model: DelayedStateSpace, judged: Sequence[int], duration_s: float) 
     labels of its unstable modes (``("pitch",)``), largest real part first."""
     a, c = np.asarray(model.a, dtype=float), np.asarray(model.c, dtype=float)
     seen = reachable(a.T, np.any(c[list(judged)] != 0, axis=0))
-    unstable = [m for m in state_modes(a[np.ix_(seen, seen)], tuple(np.asarray(model.states)[seen]))
-                if m.unstable]
+    unstable = [m for m in state_modes(a[np.ix_(seen, seen)], tuple(np.asarray(model.states)[seen])) if m.unstable]
     if not unstable:
         return 1.0, ()
     rate = max(m.real for m in unstable)
@@ -181,8 +189,15 @@ def _growth(model: DelayedStateSpace, judged: Sequence[int], duration_s: float) 
     return float(np.exp(min(rate * duration_s, 700.0))), labels
 
 
-def _one_step(model: DelayedStateSpace, disc: DiscreteModel, record: Record, inputs: np.ndarray, x0: np.ndarray,
-              outputs: list[int], measured: np.ndarray) -> np.ndarray:
+def _one_step(
+    model: DelayedStateSpace,
+    disc: DiscreteModel,
+    record: Record,
+    inputs: np.ndarray,
+    x0: np.ndarray,
+    outputs: list[int],
+    measured: np.ndarray,
+) -> np.ndarray:
     """One-step-ahead outputs (columns `outputs`), their mean residual removed as the bias."""
     states = np.full((inputs.shape[0], len(model.states)), np.nan)
     for i, name in enumerate(model.states):
@@ -196,9 +211,14 @@ def _overall(measured: np.ndarray, simulated: np.ndarray, weights: np.ndarray) -
     return rms_error(measured * weights, simulated * weights), theil_inequality(measured * weights, simulated * weights)
 
 
-def verify_record(model: DelayedStateSpace, record: Record, *, on_axis: Sequence[str] | None = None,
-                  excited: str | None = None,
-                  options: VerificationOptions = VerificationOptions()) -> RecordVerification:
+def verify_record(
+    model: DelayedStateSpace,
+    record: Record,
+    *,
+    on_axis: Sequence[str] | None = None,
+    excited: str | None = None,
+    options: VerificationOptions = VerificationOptions(),
+) -> RecordVerification:
     """Simulate `model` from the measured inputs of `record` and compare its outputs.
 
     Parameters
@@ -245,8 +265,9 @@ def verify_record(model: DelayedStateSpace, record: Record, *, on_axis: Sequence
     wanted = tuple(model.outputs) if on_axis is None else tuple(on_axis)
     judged = [j for j, k in enumerate(outputs) if model.outputs[k] in wanted]
     if not judged:
-        raise DataError(f"{record.source.name}: record {record.label!r} has none of the model outputs "
-                        f"{', '.join(wanted)}")
+        raise DataError(
+            f"{record.source.name}: record {record.label!r} has none of the model outputs {', '.join(wanted)}"
+        )
     inputs = _signals(record, model.inputs, "inputs")
     disc = discretize(model, 1.0 / record.rate_hz)
     measured = np.column_stack([record[model.outputs[k]] for k in outputs])
@@ -260,24 +281,56 @@ def verify_record(model: DelayedStateSpace, record: Record, *, on_axis: Sequence
     predicted = None
     if options.one_step == "always" or (options.one_step == "auto" and unstable):
         predicted = _one_step(model, disc, record, inputs, x0 + correction, outputs, measured)
-    results = tuple(_output(model.outputs[k], units[j], measured[:, j], simulated[:, j], float(biases[j]),
-                            None if predicted is None else predicted[:, j]) for j, k in enumerate(outputs))
+    results = tuple(
+        _output(
+            model.outputs[k],
+            units[j],
+            measured[:, j],
+            simulated[:, j],
+            float(biases[j]),
+            None if predicted is None else predicted[:, j],
+        )
+        for j, k in enumerate(outputs)
+    )
     rmse, tic = _overall(measured[:, judged], simulated[:, judged], weights[judged])
     notice = ""
     if unstable:
         reach = ", ".join(model.outputs[outputs[j]] for j in judged)
-        notice = (f"the model is unstable open loop in its {mode_names(unstable_modes)}, which {reach} depend"
-                  f"{'s' if len(judged) == 1 else ''} on, and grows {growth:.0f}-fold over this "
-                  f"{record.end_s - record.start_s:.1f} s record (limit {options.max_growth:g}): small input or "
-                  "initial-state errors diverge, so judge it also by the one-step-ahead prediction error")
+        notice = (
+            f"the model is unstable open loop in its {mode_names(unstable_modes)}, which {reach} depend"
+            f"{'s' if len(judged) == 1 else ''} on, and grows {growth:.0f}-fold over this "
+            f"{record.end_s - record.start_s:.1f} s record (limit {options.max_growth:g}): small input or "
+            "initial-state errors diverge, so judge it also by the one-step-ahead prediction error"
+        )
     off_axis = tuple(o.name for j, o in enumerate(results) if j not in judged)
-    return RecordVerification(record.label, record.source, record.time_s, tuple(model.inputs), results, shifts,
-                              rmse, tic, growth, unstable, notice, excited, off_axis, unstable_modes)
+    return RecordVerification(
+        record.label,
+        record.source,
+        record.time_s,
+        tuple(model.inputs),
+        results,
+        shifts,
+        rmse,
+        tic,
+        growth,
+        unstable,
+        notice,
+        excited,
+        off_axis,
+        unstable_modes,
+    )
 
 
-def _fit_offsets(model: DelayedStateSpace, disc: DiscreteModel, raw: np.ndarray, measured: np.ndarray,
-                 outputs: list[int], weights: np.ndarray, judged: list[int], options: VerificationOptions
-                 ) -> tuple[np.ndarray, dict[str, float], np.ndarray, np.ndarray]:
+def _fit_offsets(
+    model: DelayedStateSpace,
+    disc: DiscreteModel,
+    raw: np.ndarray,
+    measured: np.ndarray,
+    outputs: list[int],
+    weights: np.ndarray,
+    judged: list[int],
+    options: VerificationOptions,
+) -> tuple[np.ndarray, dict[str, float], np.ndarray, np.ndarray]:
     """Reference shifts, biases and (if asked) the initial-state correction; the simulation with them applied.
 
     Shifts and the correction are fitted on the judged outputs only, so that an off-axis output the model
@@ -286,13 +339,16 @@ def _fit_offsets(model: DelayedStateSpace, disc: DiscreteModel, raw: np.ndarray,
     n_samples, n_out = measured.shape
     none = np.zeros((0, n_samples, n_out))
     names = list(dict.fromkeys(model.inputs))
-    groups = [_shift_responses(model, disc, names, n_samples)[:, :, outputs] if options.fit_reference_shift else none,
-              np.eye(n_out)[:, None, :] * np.ones((1, n_samples, 1)) if options.fit_bias else none,
-              _free_responses(model, disc, n_samples)[:, :, outputs] if options.initial_state == "estimated" else none]
+    groups = [
+        _shift_responses(model, disc, names, n_samples)[:, :, outputs] if options.fit_reference_shift else none,
+        np.eye(n_out)[:, None, :] * np.ones((1, n_samples, 1)) if options.fit_bias else none,
+        _free_responses(model, disc, n_samples)[:, :, outputs] if options.initial_state == "estimated" else none,
+    ]
     on_axis = np.isin(np.arange(n_out), judged)
     shifts, biases, correction = _offsets(measured - raw, groups, np.where(on_axis, weights, 0.0))
-    simulated = raw + sum((np.tensordot(c, g, axes=1) for c, g in zip((shifts, correction), groups[::2])),
-                          np.zeros_like(raw))
+    simulated = raw + sum(
+        (np.tensordot(c, g, axes=1) for c, g in zip((shifts, correction), groups[::2])), np.zeros_like(raw)
+    )
     biases = biases if options.fit_bias else np.zeros(n_out)
     if options.fit_bias:
         biases[~on_axis] = (measured - simulated)[:, ~on_axis].mean(axis=0)
@@ -302,12 +358,21 @@ def _fit_offsets(model: DelayedStateSpace, disc: DiscreteModel, raw: np.ndarray,
     return simulated, dict(zip(names, (float(v) for v in shifts))), biases, correction
 
 
-def _output(name: str, unit: str, measured: np.ndarray, simulated: np.ndarray, bias: float,
-            predicted: np.ndarray | None) -> OutputVerification:
+def _output(
+    name: str, unit: str, measured: np.ndarray, simulated: np.ndarray, bias: float, predicted: np.ndarray | None
+) -> OutputVerification:
     return OutputVerification(
-        name, unit, measured, simulated, bias, rms_error(measured, simulated), theil_inequality(measured, simulated),
-        predicted, None if predicted is None else rms_error(measured, predicted),
-        None if predicted is None else theil_inequality(measured, predicted))
+        name,
+        unit,
+        measured,
+        simulated,
+        bias,
+        rms_error(measured, simulated),
+        theil_inequality(measured, simulated),
+        predicted,
+        None if predicted is None else rms_error(measured, predicted),
+        None if predicted is None else theil_inequality(measured, predicted),
+    )
 
 
 def _pooled(records: Sequence[RecordVerification], *, judged: bool = True) -> tuple[OutputSummary, ...]:
@@ -327,9 +392,18 @@ def _pooled(records: Sequence[RecordVerification], *, judged: bool = True) -> tu
             m = np.concatenate([p.measured for p in with_prediction])
             s = np.concatenate([p.predicted for p in with_prediction if p.predicted is not None])
             prediction_rmse, prediction_tic = rms_error(m, s), theil_inequality(m, s)
-        summaries.append(OutputSummary(name, pieces[0].unit, rms_error(measured, simulated),
-                                       theil_inequality(measured, simulated), len(pieces), int(measured.size),
-                                       prediction_rmse, prediction_tic))
+        summaries.append(
+            OutputSummary(
+                name,
+                pieces[0].unit,
+                rms_error(measured, simulated),
+                theil_inequality(measured, simulated),
+                len(pieces),
+                int(measured.size),
+                prediction_rmse,
+                prediction_tic,
+            )
+        )
     return tuple(summaries)
 
 
@@ -339,9 +413,15 @@ def _overall_pooled(records: Sequence[RecordVerification]) -> tuple[float, float
     return rms_error(measured, simulated), theil_inequality(measured, simulated)
 
 
-def verify(model: DelayedStateSpace, records: Sequence[Record], *, wind_model: DelayedStateSpace | None = None,
-           excited: Sequence[str | None] | None = None, axes: Mapping[str, Sequence[str]] | None = None,
-           options: VerificationOptions = VerificationOptions()) -> Verification:
+def verify(
+    model: DelayedStateSpace,
+    records: Sequence[Record],
+    *,
+    wind_model: DelayedStateSpace | None = None,
+    excited: Sequence[str | None] | None = None,
+    axes: Mapping[str, Sequence[str]] | None = None,
+    options: VerificationOptions = VerificationOptions(),
+) -> Verification:
     """Verify a model on several records, with and without its wind term.
 
     Every record is simulated from all the model's measured inputs; a record
@@ -390,8 +470,10 @@ def verify(model: DelayedStateSpace, records: Sequence[Record], *, wind_model: D
         judged[pick] = tuple(axes[pick]) if axes is not None and pick in axes else driven_part(model, pick).outputs
 
     def run(which: DelayedStateSpace) -> tuple[RecordVerification, ...]:
-        return tuple(verify_record(which, record, on_axis=None if pick is None else judged[pick], excited=pick,
-                                   options=options) for record, pick in zip(records, picks))
+        return tuple(
+            verify_record(which, record, on_axis=None if pick is None else judged[pick], excited=pick, options=options)
+            for record, pick in zip(records, picks)
+        )
 
     without = run(model)
     final = run(wind_model) if wind_model is not None else without
@@ -401,6 +483,7 @@ def verify(model: DelayedStateSpace, records: Sequence[Record], *, wind_model: D
     if wind_model is None:
         return Verification(final, summary, rmse, tic, off_axis=off_axis)
     before = {s.name: s for s in _pooled(without)}
-    corrections = tuple(WindCorrection(s.name, s.unit, before[s.name].rmse, s.rmse)
-                        for s in summary if s.name in before)
+    corrections = tuple(
+        WindCorrection(s.name, s.unit, before[s.name].rmse, s.rmse) for s in summary if s.name in before
+    )
     return Verification(final, summary, rmse, tic, without, corrections, off_axis)

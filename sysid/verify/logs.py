@@ -5,14 +5,13 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from flightlogs.campaign import ingest_campaign
-from flightlogs.condition import ConditionedFlight, ConditioningOptions
+from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import DataError
-
-from ..statespace import DelayedStateSpace
-from .engine import VerificationOptions, verify
-from .records import doublet_records
-from .results import Verification
+from flightlogs.store.campaign import ingest_campaign
+from sysid.model.statespace import DelayedStateSpace
+from sysid.verify.engine import VerificationOptions, verify
+from sysid.verify.records import doublet_records
+from sysid.verify.results import Verification
 
 __all__ = ["verify_logs", "verify_flights"]
 
@@ -65,11 +64,20 @@ def verify_logs(
         an axis of the model (doublets on other axes are skipped).
     """
     if wind_model is not None and not wind_paths:
-        raise DataError("the model has wind terms but no anemometer file was given (--wind); "
-                        "without wind only the model without G_w can be verified")
+        raise DataError(
+            "the model has wind terms but no anemometer file was given (--wind); "
+            "without wind only the model without G_w can be verified"
+        )
     campaign = ingest_campaign(list(log_paths), list(wind_paths), options=conditioning, progress=progress)
-    return verify_flights(model, campaign.require_flights(), wind_model=wind_model, axes=axes, options=options,
-                          before_s=before_s, after_s=after_s)
+    return verify_flights(
+        model,
+        campaign.require_flights(),
+        wind_model=wind_model,
+        axes=axes,
+        options=options,
+        before_s=before_s,
+        after_s=after_s,
+    )
 
 
 def verify_flights(
@@ -115,7 +123,15 @@ def verify_flights(
     kept = [k for k, name in enumerate(cut.excited) if name in model.inputs]  # axes the model does not have
     if not kept:
         names = ", ".join(dict.fromkeys(flight.source.name for flight in flights))
-        raise DataError(f"no doublet found in {names} on an axis of the model ({', '.join(model.inputs)}): "
-                        "validation needs doublets not used in the fit" + (f" ({hint})" if hint else ""))
-    return verify(model, [cut.records[k] for k in kept], wind_model=wind_model,
-                  excited=[cut.excited[k] for k in kept], axes=axes, options=options)
+        raise DataError(
+            f"no doublet found in {names} on an axis of the model ({', '.join(model.inputs)}): "
+            "validation needs doublets not used in the fit" + (f" ({hint})" if hint else "")
+        )
+    return verify(
+        model,
+        [cut.records[k] for k in kept],
+        wind_model=wind_model,
+        excited=[cut.excited[k] for k in kept],
+        axes=axes,
+        options=options,
+    )

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from flightlogs.condition import ConditionedFlight
+from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.record import Record
 
 __all__ = ["DoubletRecords", "doublet_records", "MIXER_INPUTS"]
@@ -34,8 +34,13 @@ class DoubletRecords:
             raise ValueError(f"{len(self.records)} records but {len(self.excited)} excited inputs")
 
 
-def doublet_records(flights: Sequence[ConditionedFlight], *, before_s: float = 0.5, after_s: float = 1.0,
-                    kinds: tuple[str, ...] = ("doublet",)) -> DoubletRecords:
+def doublet_records(
+    flights: Sequence[ConditionedFlight],
+    *,
+    before_s: float = 0.5,
+    after_s: float = 1.0,
+    kinds: tuple[str, ...] = ("doublet",),
+) -> DoubletRecords:
     """Cut a record around every doublet of the flights.
 
     Parameters

@@ -10,8 +10,16 @@ from typing import Protocol, TypeVar
 
 import numpy as np
 
-__all__ = ["rms_error", "theil_inequality", "mode_names", "OutputVerification", "RecordVerification", "OutputSummary",
-           "WindCorrection", "Verification"]
+__all__ = [
+    "rms_error",
+    "theil_inequality",
+    "mode_names",
+    "OutputVerification",
+    "RecordVerification",
+    "OutputSummary",
+    "WindCorrection",
+    "Verification",
+]
 
 
 def rms_error(measured: np.ndarray, simulated: np.ndarray) -> float:
@@ -195,7 +203,7 @@ class RecordVerification:
         judged (left out of `rmse`, `tic` and the pooled summary); default none.
     unstable_modes : tuple of str, optional
         Labels of the unstable modes the judged outputs depend on
-        (``("pitch",)``; see :func:`sysid.modes.modes`), largest growth first;
+        (``("pitch",)``; see :func:`sysid.model.modes.modes`), largest growth first;
         a heave record names pitch when the trim couples it in (``w' = U0 q``).
     """
 
@@ -221,14 +229,18 @@ class RecordVerification:
         names = [o.name for o in self.outputs]
         unknown = [n for n in self.off_axis if n not in names]
         if unknown or (self.outputs and len(set(self.off_axis)) == len(names)):
-            raise ValueError(f"record {self.label!r}: off_axis {tuple(self.off_axis)} must name some, not all, of "
-                             f"its outputs {tuple(names)}")
+            raise ValueError(
+                f"record {self.label!r}: off_axis {tuple(self.off_axis)} must name some, not all, of "
+                f"its outputs {tuple(names)}"
+            )
         object.__setattr__(self, "off_axis", tuple(self.off_axis))
         object.__setattr__(self, "unstable_modes", tuple(self.unstable_modes))
         for output in self.outputs:
             if output.measured.shape != time_s.shape:
-                raise ValueError(f"record {self.label!r}: output {output.name} has {output.measured.size} samples, "
-                                 f"time_s {time_s.size}")
+                raise ValueError(
+                    f"record {self.label!r}: output {output.name} has {output.measured.size} samples, "
+                    f"time_s {time_s.size}"
+                )
         object.__setattr__(self, "time_s", time_s)
         object.__setattr__(self, "reference_shifts", MappingProxyType(dict(self.reference_shifts)))
 

@@ -8,11 +8,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from flightlogs.errors import ModelError
-
-from ..statespace import DelayedStateSpace
+from sysid.model.statespace import DelayedStateSpace
 
 if TYPE_CHECKING:
-    from ..fit import IdentifiedModel
+    from sysid.fit import IdentifiedModel
 
 __all__ = ["driven_part", "axis_outputs"]
 
@@ -74,9 +73,16 @@ def driven_part(model: DelayedStateSpace, excited: str) -> DelayedStateSpace:
     keep_inputs = np.any(b[reached] != 0, axis=0) | np.any(d[rows] != 0, axis=0)
     x, u, y = np.flatnonzero(reached), np.flatnonzero(keep_inputs), np.flatnonzero(rows)
     return DelayedStateSpace(
-        a[np.ix_(x, x)], b[np.ix_(x, u)], c[np.ix_(y, x)], d[np.ix_(y, u)],
-        tuple(model.states[i] for i in x), tuple(model.inputs[j] for j in u), tuple(model.outputs[i] for i in y),
-        np.asarray(model.input_delays_s, dtype=float)[u], model.trim)
+        a[np.ix_(x, x)],
+        b[np.ix_(x, u)],
+        c[np.ix_(y, x)],
+        d[np.ix_(y, u)],
+        tuple(model.states[i] for i in x),
+        tuple(model.inputs[j] for j in u),
+        tuple(model.outputs[i] for i in y),
+        np.asarray(model.input_delays_s, dtype=float)[u],
+        model.trim,
+    )
 
 
 def axis_outputs(model: IdentifiedModel) -> dict[str, tuple[str, ...]]:
@@ -112,7 +118,9 @@ def axis_outputs(model: IdentifiedModel) -> dict[str, tuple[str, ...]]:
     (('r',), ('w', 'az'))
     """
     structure = model.structure
-    constants = {c.name: c.value if c.trim is not None else float(model.constants.get(c.name, c.value))
-                 for c in structure.constants}
+    constants = {
+        c.name: c.value if c.trim is not None else float(model.constants.get(c.name, c.value))
+        for c in structure.constants
+    }
     nominal = dataclasses.replace(model, constants=constants).linear_model(include_wind=False)
     return {name: driven_part(nominal, name).outputs for name in dict.fromkeys(nominal.inputs)}

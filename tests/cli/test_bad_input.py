@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner, Result
 
-from sysid.sim.scenarios import write_demo_flight
+from simulator.campaign.demo_flight import write_demo_flight
 from sysid_cli.main import cli
 
 _CLASS_NAME = re.compile(r"\b\w+(Error|Exception)\b")
@@ -30,8 +30,10 @@ def demo(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     folder = tmp_path_factory.mktemp("bad-input")
     files = write_demo_flight(folder)
     dataset, model = folder / "dataset.h5", folder / "model.json"
-    for args in (["ingest", str(files.log), "-o", str(dataset), "-q"],
-                 ["fit", str(dataset), "--model", "hover", "-o", str(model), "-q"]):
+    for args in (
+        ["ingest", str(files.log), "-o", str(dataset), "-q"],
+        ["fit", str(dataset), "--model", "hover", "-o", str(model), "-q"],
+    ):
         result = CliRunner().invoke(cli, args)
         assert result.exit_code == 0, result.output
     return {"log": files.log, "wind": files.wind_csv, "dataset": dataset, "model": model}
@@ -49,10 +51,29 @@ def _commands(d: dict[str, Path]) -> dict[str, list[str]]:
         "validate --report": ["validate", model, ds, "-o", "v.json", "--report", "nodir/x.html"],
         "report -o": ["report", model, "-o", "nodir/x.html"],
         "modes --json": ["modes", model, "--json", "nodir/x.json"],
-        "ground-effect fit": ["ground-effect", "fit", log, "--rotor-radius", "0.0225", "-o", "ge.json",
-                              "--report", "nodir/x.html"],
-        "ground-effect spacing": ["ground-effect", "spacing", log, log, "--spacing", "0,10", "--rotor-radius",
-                                  "0.0225", "--report", "nodir/x.html"],
+        "ground-effect fit": [
+            "ground-effect",
+            "fit",
+            log,
+            "--rotor-radius",
+            "0.0225",
+            "-o",
+            "ge.json",
+            "--report",
+            "nodir/x.html",
+        ],
+        "ground-effect spacing": [
+            "ground-effect",
+            "spacing",
+            log,
+            log,
+            "--spacing",
+            "0,10",
+            "--rotor-radius",
+            "0.0225",
+            "--report",
+            "nodir/x.html",
+        ],
         "mrac compare": ["mrac", "compare", "--report", "r.html", "-o", "nodir/x.json"],
         "simulate -o": ["simulate", "sitl-nominal", "-o", "nodir/x"],
         "demo -o": ["demo", "-o", "nodir/x"],
@@ -61,7 +82,8 @@ def _commands(d: dict[str, Path]) -> dict[str, list[str]]:
 
 @pytest.mark.parametrize("name", list(_commands({k: Path(k) for k in ("log", "dataset", "model")})))
 def test_an_output_in_a_missing_folder_fails_first_and_writes_nothing(
-        demo: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str) -> None:
+    demo: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str
+) -> None:
     """Checked while parsing (exit 2), so no other output of the command (fit_fresh.json ...) appears."""
     monkeypatch.chdir(tmp_path)
     result = CliRunner().invoke(cli, _commands(demo)[name])
@@ -69,8 +91,9 @@ def test_an_output_in_a_missing_folder_fails_first_and_writes_nothing(
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_folder_output_under_a_file_or_on_a_file_is_a_usage_error(tmp_path: Path,
-                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_folder_output_under_a_file_or_on_a_file_is_a_usage_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.chdir(tmp_path)
     Path("keep.h5").write_text("keep")
     _clean(CliRunner().invoke(cli, ["demo", "-o", "keep.h5/sub"]), 2, "keep.h5/sub", "keep.h5 is a file")
@@ -84,11 +107,17 @@ def test_json_to_stdout_is_still_accepted(demo: dict[str, Path]) -> None:
     assert json.loads(result.stdout)["eigenvalues"]
 
 
-@pytest.mark.parametrize(("trials", "named"), [("99", "99: scenario sitl-nominal has trials 0-1 only"),
-                                               ("0,7-9", "7, 8, 9: scenario sitl-nominal has trials 0-1"),
-                                               ("3-1", "'3-1' is a reversed range")])
-def test_simulate_rejects_trials_the_scenario_lacks_and_keeps_the_index(tmp_path: Path, trials: str,
-                                                                        named: str) -> None:
+@pytest.mark.parametrize(
+    ("trials", "named"),
+    [
+        ("99", "99: scenario sitl-nominal has trials 0-1 only"),
+        ("0,7-9", "7, 8, 9: scenario sitl-nominal has trials 0-1"),
+        ("3-1", "'3-1' is a reversed range"),
+    ],
+)
+def test_simulate_rejects_trials_the_scenario_lacks_and_keeps_the_index(
+    tmp_path: Path, trials: str, named: str
+) -> None:
     out = tmp_path / "simx"
     out.mkdir()
     (out / "campaign.json").write_text('{"trials": ["kept"]}\n')
@@ -106,8 +135,9 @@ def test_ingest_bounds_the_rate(demo: dict[str, Path], tmp_path: Path) -> None:
 
 
 def test_ingest_names_the_valid_column_keys(demo: dict[str, Path]) -> None:
-    result = CliRunner().invoke(cli, ["ingest", str(demo["log"]), "--wind", str(demo["wind"]),
-                                      "--columns", "time=UTC,foo=bar"])
+    result = CliRunner().invoke(
+        cli, ["ingest", str(demo["log"]), "--wind", str(demo["wind"]), "--columns", "time=UTC,foo=bar"]
+    )
     _clean(result, 2, "--columns", "foo: not a column key", "speed=COL,direction=COL")
 
 
@@ -130,13 +160,17 @@ def test_ingest_writes_nothing_when_no_log_can_be_conditioned(demo: dict[str, Pa
     assert any("not conditioned: " in w for w in json.loads(result.stdout)["logs"][0]["warnings"])
 
 
-@pytest.mark.parametrize(("args", "named"), [
-    (["--omega-min", "50", "--omega-max", "1"], ["--omega-min", "50 rad/s must be below --omega-max (1 rad/s)"]),
-    (["--windows", "-2,4"], ["--windows", "-2: window lengths must be positive seconds"]),
-    (["--windows", "4,nan"], ["--windows", "nan: window lengths must be positive"]),
-])
-def test_freqresp_names_the_option_at_fault(demo: dict[str, Path], tmp_path: Path, args: list[str],
-                                            named: list[str]) -> None:
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (["--omega-min", "50", "--omega-max", "1"], ["--omega-min", "50 rad/s must be below --omega-max (1 rad/s)"]),
+        (["--windows", "-2,4"], ["--windows", "-2: window lengths must be positive seconds"]),
+        (["--windows", "4,nan"], ["--windows", "nan: window lengths must be positive"]),
+    ],
+)
+def test_freqresp_names_the_option_at_fault(
+    demo: dict[str, Path], tmp_path: Path, args: list[str], named: list[str]
+) -> None:
     out = tmp_path / "fr.h5"
     result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), "-o", str(out), *args])
     _clean(result, 2, *named)
@@ -151,8 +185,10 @@ def test_fit_kind_is_a_choice(demo: dict[str, Path]) -> None:
 
 def test_validate_takes_a_dataset_as_it_takes_the_log(demo: dict[str, Path]) -> None:
     """The dataset was ingested with the defaults, so it holds the flight `validate` conditions from the log."""
-    runs = [CliRunner().invoke(cli, ["validate", str(demo["model"]), str(source), "--json", "-", "-q"])
-            for source in (demo["dataset"], demo["log"])]
+    runs = [
+        CliRunner().invoke(cli, ["validate", str(demo["model"]), str(source), "--json", "-", "-q"])
+        for source in (demo["dataset"], demo["log"])
+    ]
     for result in runs:
         assert result.exit_code == 0, result.output
     from_dataset, from_log = (json.loads(r.stdout) for r in runs)
@@ -162,8 +198,18 @@ def test_validate_takes_a_dataset_as_it_takes_the_log(demo: dict[str, Path]) -> 
 
 
 def test_validate_of_a_dataset_rejects_the_log_options(demo: dict[str, Path], tmp_path: Path) -> None:
-    result = CliRunner().invoke(cli, ["validate", str(demo["model"]), str(demo["dataset"]),
-                                      "--wind", str(demo["wind"]), "-o", str(tmp_path / "v.json")])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "validate",
+            str(demo["model"]),
+            str(demo["dataset"]),
+            "--wind",
+            str(demo["wind"]),
+            "-o",
+            str(tmp_path / "v.json"),
+        ],
+    )
     _clean(result, 2, "--wind", "a dataset already holds its aligned wind")
     assert list(tmp_path.iterdir()) == []
 
@@ -172,33 +218,55 @@ def test_validate_names_the_segment_outside_the_log(demo: dict[str, Path], tmp_p
     segments = tmp_path / "seg_bad4.csv"
     segments.write_text("start_s,end_s,axis,kind\n5000,5002,lon,doublet\n")
     out = tmp_path / "v.json"
-    result = CliRunner().invoke(cli, ["validate", str(demo["model"]), str(demo["log"]), "--segments", str(segments),
-                                      "-o", str(out)])
+    result = CliRunner().invoke(
+        cli, ["validate", str(demo["model"]), str(demo["log"]), "--segments", str(segments), "-o", str(out)]
+    )
     _clean(result, 1, "seg_bad4.csv line 2", "lon doublet at 5000-5002 s", "flight.bin")
     assert "give their times with --segments" not in result.output
     assert not out.exists()
 
 
-@pytest.mark.parametrize(("spacing", "named"), [("10,10", "10 mm given twice"),
-                                                ("-5,10", "-5 mm: spacings must be finite and not negative"),
-                                                ("10", "2 files but 1 spacings")])
+@pytest.mark.parametrize(
+    ("spacing", "named"),
+    [
+        ("10,10", "10 mm given twice"),
+        ("-5,10", "-5 mm: spacings must be finite and not negative"),
+        ("10", "2 files but 1 spacings"),
+    ],
+)
 def test_ground_effect_spacing_is_checked_in_mm(tmp_path: Path, spacing: str, named: str) -> None:
     rig = tmp_path / "rig.csv"
     rig.write_text("height_m,thrust_n\n0.1,0.4\n")
     report = tmp_path / "s.html"
-    result = CliRunner().invoke(cli, ["ground-effect", "spacing", str(rig), str(rig), f"--spacing={spacing}",
-                                      "--rotor-radius", "0.0225", "--report", str(report)])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "ground-effect",
+            "spacing",
+            str(rig),
+            str(rig),
+            f"--spacing={spacing}",
+            "--rotor-radius",
+            "0.0225",
+            "--report",
+            str(report),
+        ],
+    )
     _clean(result, 2, "--spacing", named)
     assert not report.exists()
 
 
-@pytest.mark.parametrize(("command", "named"), [
-    (["freqresp", "DATASET", "--pairs", ""], ["--pairs", "empty: give OUTPUT/INPUT pairs"]),
-    (["freqresp", "DATASET", "--pairs", " , "], ["--pairs", "empty: give OUTPUT/INPUT pairs"]),
-    (["ground-effect", "fit", "RIG", "--rotor-radius", "0.0225", "--models", ""], ["--models", "empty: choose"]),
-])
-def test_an_empty_list_option_is_a_usage_error_not_the_default(demo: dict[str, Path], tmp_path: Path,
-                                                               command: list[str], named: list[str]) -> None:
+@pytest.mark.parametrize(
+    ("command", "named"),
+    [
+        (["freqresp", "DATASET", "--pairs", ""], ["--pairs", "empty: give OUTPUT/INPUT pairs"]),
+        (["freqresp", "DATASET", "--pairs", " , "], ["--pairs", "empty: give OUTPUT/INPUT pairs"]),
+        (["ground-effect", "fit", "RIG", "--rotor-radius", "0.0225", "--models", ""], ["--models", "empty: choose"]),
+    ],
+)
+def test_an_empty_list_option_is_a_usage_error_not_the_default(
+    demo: dict[str, Path], tmp_path: Path, command: list[str], named: list[str]
+) -> None:
     rig = tmp_path / "rig.csv"
     rig.write_text("height_m,thrust_n\n0.1,0.4\n")
     args = [str(demo["dataset"]) if a == "DATASET" else str(rig) if a == "RIG" else a for a in command]

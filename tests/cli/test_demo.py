@@ -10,12 +10,12 @@ import pytest
 from click.testing import CliRunner
 from markupsafe import escape
 
-from flightlogs.store import read_dataset
+from flightlogs.store.dataset import read_dataset
 from reports.model_report import model_verdict
+from simulator.campaign.demo_flight import write_demo_flight
 from sysid.fit import read_model
-from sysid.sim.scenarios import write_demo_flight
 from sysid.verify import axis_outputs
-from sysid.verify_io import read_verification
+from sysid.verify.io import read_verification
 from sysid_cli.main import cli
 
 
@@ -49,7 +49,9 @@ def test_demo_writes_the_flight_and_the_aligned_dataset(demo_run: tuple[Path, st
     assert [s["axis"] for s in summary["segments"] if s["kind"] == "sweep"] == ["lon", "lat", "yaw", "thr"]
     dataset = read_dataset(demo_dir / "dataset.h5")
     (flight,) = dataset.conditioned
-    assert flight.wind is not None and flight.wind.clock_offset_s == pytest.approx(alignment["clock_offset_s"], abs=1e-4)
+    assert flight.wind is not None and flight.wind.clock_offset_s == pytest.approx(
+        alignment["clock_offset_s"], abs=1e-4
+    )
     assert [s.kind for s in flight.segments] == [s["kind"] for s in summary["segments"]]
     (record,) = flight.records
     assert record.time_s.size == summary["records"][0]["samples"]
@@ -85,8 +87,19 @@ def test_demo_ends_with_the_report_and_sysid_report_rebuilds_it(demo_run: tuple[
     assert '<p class="verdict ' in text and str(escape(verdict.sentence)) in text  # as the template escapes it
     assert "ArduCopter" in text and 'id="verification"' in text
     rebuilt = tmp_path / "rebuilt.html"
-    result = CliRunner().invoke(cli, ["report", str(demo_dir / "model.json"), str(demo_dir / "validation.json"),
-                                      "--ingest-summary", str(demo_dir / "ingest.json"), "-o", str(rebuilt), "-q"])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "report",
+            str(demo_dir / "model.json"),
+            str(demo_dir / "validation.json"),
+            "--ingest-summary",
+            str(demo_dir / "ingest.json"),
+            "-o",
+            str(rebuilt),
+            "-q",
+        ],
+    )
     assert result.exit_code == 0, result.output
     assert _FOOTER.sub("", rebuilt.read_text()) == _FOOTER.sub("", text)
 
@@ -101,7 +114,8 @@ def test_demo_ends_with_the_report_and_sysid_report_rebuilds_it(demo_run: tuple[
 def test_wind_that_cannot_be_aligned_is_exit_1(demo_dir: Path, tmp_path: Path, extra: list[str], fragment: str) -> None:
     out = tmp_path / "set.h5"
     result = CliRunner().invoke(
-        cli, ["ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"), "-o", str(out), *extra]
+        cli,
+        ["ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"), "-o", str(out), *extra],
     )
     assert result.exit_code == 1
     assert "Traceback" not in result.output and fragment in result.stderr
@@ -112,9 +126,12 @@ def test_a_wind_folder_pairs_each_log_by_utc(demo_dir: Path, tmp_path: Path) -> 
     folder = tmp_path / "anemometers"
     folder.mkdir()
     (folder / "a.csv").write_text((demo_dir / "anemometer.csv").read_text())
-    (folder / "b.csv").write_text("utc,speed_m_s,direction_deg\n2020-01-01T00:00:00Z,1.0,90\n2020-01-01T00:00:01Z,1.0,90\n")
+    (folder / "b.csv").write_text(
+        "utc,speed_m_s,direction_deg\n2020-01-01T00:00:00Z,1.0,90\n2020-01-01T00:00:01Z,1.0,90\n"
+    )
     result = CliRunner().invoke(
-        cli, ["ingest", str(demo_dir / "flight.bin"), "--wind", str(folder), "--wind-distance", "4.6", "--json", "-", "-q"]
+        cli,
+        ["ingest", str(demo_dir / "flight.bin"), "--wind", str(folder), "--wind-distance", "4.6", "--json", "-", "-q"],
     )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
@@ -126,10 +143,22 @@ def test_anemometer_position_gives_the_transport_delay_from_gps(demo_dir: Path) 
     """``--anemometer-at`` (deg): distance and bearing to the vehicle's mean GPS position, delay within a sample."""
     truth = json.loads((demo_dir / "truth.json").read_text())["anemometer"]
     lat, lon = truth["position_deg"]
-    result = CliRunner().invoke(cli, [
-        "ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"),
-        "--anemometer-at", f"{lat:.9f},{lon:.9f}", "--wind-offset", str(truth["clock_offset_s"]), "--json", "-", "-q",
-    ])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "ingest",
+            str(demo_dir / "flight.bin"),
+            "--wind",
+            str(demo_dir / "anemometer.csv"),
+            "--anemometer-at",
+            f"{lat:.9f},{lon:.9f}",
+            "--wind-offset",
+            str(truth["clock_offset_s"]),
+            "--json",
+            "-",
+            "-q",
+        ],
+    )
     assert result.exit_code == 0, result.output
     alignment = json.loads(result.stdout)["wind_alignment"]
     assert alignment["transport_delay_source"] == "gps"
@@ -137,42 +166,76 @@ def test_anemometer_position_gives_the_transport_delay_from_gps(demo_dir: Path) 
     assert abs(alignment["transport_delay_s"] - truth["transport_delay_s"]) < 0.01
 
 
-@pytest.mark.parametrize(("value", "fragment"), [
-    ("35.0", "not LAT,LON"),
-    ("35.0;-106.9", "not LAT,LON"),
-    ("north,west", "not LAT,LON"),
-    ("-106.9,35.0", "latitude must lie within"),
-    ("nan,1", "latitude must lie within"),
-])
+@pytest.mark.parametrize(
+    ("value", "fragment"),
+    [
+        ("35.0", "not LAT,LON"),
+        ("35.0;-106.9", "not LAT,LON"),
+        ("north,west", "not LAT,LON"),
+        ("-106.9,35.0", "latitude must lie within"),
+        ("nan,1", "latitude must lie within"),
+    ],
+)
 def test_a_bad_anemometer_position_is_a_usage_error(demo_dir: Path, value: str, fragment: str) -> None:
-    result = CliRunner().invoke(cli, [
-        "ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"), f"--anemometer-at={value}",
-    ])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "ingest",
+            str(demo_dir / "flight.bin"),
+            "--wind",
+            str(demo_dir / "anemometer.csv"),
+            f"--anemometer-at={value}",
+        ],
+    )
     assert result.exit_code == 2
     assert "--anemometer-at" in result.stderr and fragment in result.stderr
 
 
 def test_transport_delay_by_correlation_from_the_command_line(demo_dir: Path) -> None:
     truth = json.loads((demo_dir / "truth.json").read_text())["anemometer"]
-    result = CliRunner().invoke(cli, [
-        "ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"),
-        "--wind-offset", str(truth["clock_offset_s"]), "--estimate-transport-delay", "--json", "-", "-q",
-    ])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "ingest",
+            str(demo_dir / "flight.bin"),
+            "--wind",
+            str(demo_dir / "anemometer.csv"),
+            "--wind-offset",
+            str(truth["clock_offset_s"]),
+            "--estimate-transport-delay",
+            "--json",
+            "-",
+            "-q",
+        ],
+    )
     assert result.exit_code == 0, result.output
     alignment = json.loads(result.stdout)["wind_alignment"]
     assert alignment["transport_delay_source"] == "correlation"
     assert abs(alignment["transport_delay_s"] - truth["transport_delay_s"]) < 0.01
-    both = CliRunner().invoke(cli, ["ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"),
-                                    "--estimate-wind-offset", "--estimate-transport-delay"])
+    both = CliRunner().invoke(
+        cli,
+        [
+            "ingest",
+            str(demo_dir / "flight.bin"),
+            "--wind",
+            str(demo_dir / "anemometer.csv"),
+            "--estimate-wind-offset",
+            "--estimate-transport-delay",
+        ],
+    )
     assert both.exit_code == 2 and "pick one" in both.output
 
 
 def test_a_segments_file_overrides_detection(demo_dir: Path, tmp_path: Path) -> None:
     segments = tmp_path / "maneuvers.csv"
     segments.write_text("start_s,end_s,axis,kind\n26.0,60.0,lon,sweep\n66.0,68.0,lon,doublet\n")
-    result = CliRunner().invoke(cli, ["ingest", str(demo_dir / "flight.bin"), "--segments", str(segments), "--json", "-", "-q"])
+    result = CliRunner().invoke(
+        cli, ["ingest", str(demo_dir / "flight.bin"), "--segments", str(segments), "--json", "-", "-q"]
+    )
     assert result.exit_code == 0, result.output
-    found = [(s["axis"], s["kind"], s["start_s"], s["end_s"], s["source"]) for s in json.loads(result.stdout)["segments"]]
+    found = [
+        (s["axis"], s["kind"], s["start_s"], s["end_s"], s["source"]) for s in json.loads(result.stdout)["segments"]
+    ]
     assert found == [("lon", "sweep", 26.0, 60.0, "user"), ("lon", "doublet", 66.0, 68.0, "user")]
     segments.write_text("start_s,end_s,axis\n50,45,lon\n")
     bad = CliRunner().invoke(cli, ["ingest", str(demo_dir / "flight.bin"), "--segments", str(segments)])

@@ -2,20 +2,18 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
 from scipy import io as sio
 
+from simulator.campaign.fly import run_scenario
+from simulator.campaign.scenario import load_builtin
 from sysid.fit import read_model
-from sysid.sim.campaign import run_scenario
-from sysid.sim.scenario import load_builtin
 from sysid_cli.main import cli
-
 
 
 @pytest.fixture(scope="module")
@@ -28,8 +26,25 @@ def flights(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_fit_writes_a_model_and_the_summary(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
     out, mat = tmp_path / "model.json", tmp_path / "model.mat"
     logs = [str(p) for p in sorted(flights.glob("*.bin"))]
-    result = runner.invoke(cli, ["fit", *logs, "--wind", str(flights), "--wind-distance", "4.6", "--model", "hover",
-                                 "-o", str(out), "--mat", str(mat), "--json", "-"])
+    result = runner.invoke(
+        cli,
+        [
+            "fit",
+            *logs,
+            "--wind",
+            str(flights),
+            "--wind-distance",
+            "4.6",
+            "--model",
+            "hover",
+            "-o",
+            str(out),
+            "--mat",
+            str(mat),
+            "--json",
+            "-",
+        ],
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     model = read_model(out)
@@ -56,8 +71,9 @@ def test_report_option(runner: CliRunner, flights: Path, tmp_path: Path) -> None
 def test_fit_reads_an_ingested_dataset(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
     dataset = tmp_path / "set.h5"
     logs = [str(p) for p in sorted(flights.glob("*lon*.bin"))]
-    ingested = runner.invoke(cli, ["ingest", *logs, "--wind", str(flights), "--wind-distance", "4.6", "-o",
-                                   str(dataset), "-q"])
+    ingested = runner.invoke(
+        cli, ["ingest", *logs, "--wind", str(flights), "--wind-distance", "4.6", "-o", str(dataset), "-q"]
+    )
     assert ingested.exit_code == 0, ingested.output
     result = runner.invoke(cli, ["fit", str(dataset), "--json", "-", "-q"])
     assert result.exit_code == 0, result.output
@@ -67,13 +83,16 @@ def test_fit_reads_an_ingested_dataset(runner: CliRunner, flights: Path, tmp_pat
     assert summary["parameters"]["L_lat"]["status"] == "fixed"  # no lateral sweep in the dataset
 
 
-@pytest.mark.parametrize(("extra", "code", "message"), [
-    (["--kind", "multisine"], 1, "no multisine"),
-    (["--model", "hovre"], 1, "neither a built-in structure"),
-    (["--set", "X_u"], 2, "NAME=VALUE"),
-    (["--set", "X_v=1"], 1, "no parameter 'X_v'"),
-    (["--starts", "0"], 2, "0"),
-])
+@pytest.mark.parametrize(
+    ("extra", "code", "message"),
+    [
+        (["--kind", "multisine"], 1, "no multisine"),
+        (["--model", "hovre"], 1, "neither a built-in structure"),
+        (["--set", "X_u"], 2, "NAME=VALUE"),
+        (["--set", "X_v=1"], 1, "no parameter 'X_v'"),
+        (["--starts", "0"], 2, "0"),
+    ],
+)
 def test_fit_errors(runner: CliRunner, flights: Path, extra: list[str], code: int, message: str) -> None:
     log = str(sorted(flights.glob("*lon*.bin"))[0])
     result = runner.invoke(cli, ["fit", log, "-q", *extra])

@@ -3,19 +3,19 @@
 from __future__ import annotations
 
 import json
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from datetime import datetime, timezone
-
+from simulator.autopilot.excitation import Maneuver
+from simulator.campaign.demo_flight import write_demo_flight
+from simulator.flights.linear import simulate_hover
+from simulator.output.px4 import write_px4_log
+from simulator.vehicle.identified import CALM_HOVER
 from sysid.freqresp import DEFAULT_PAIRS, read_responses
-from sysid.sim.excitation import Maneuver
-from sysid.sim.linear_flight import CALM_HOVER, simulate_hover
-from sysid.sim.px4_writer import write_px4_log
-from sysid.sim.scenarios import write_demo_flight
 from sysid_cli.main import cli
 
 
@@ -31,8 +31,9 @@ def demo(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 def test_default_pairs_from_a_dataset_with_outputs_reopened(demo: dict[str, Path], tmp_path: Path) -> None:
     out, plot = tmp_path / "fr.h5", tmp_path / "fr.svg"
-    result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), "-o", str(out), "--plot", str(plot),
-                                      "--json", "-"])
+    result = CliRunner().invoke(
+        cli, ["freqresp", str(demo["dataset"]), "-o", str(out), "--plot", str(plot), "--json", "-"]
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     expected = [f"{output}/delta_{axis}" for axis in ("lat", "lon", "yaw", "thr") for output in DEFAULT_PAIRS[axis]]
@@ -59,14 +60,29 @@ def test_default_pairs_from_a_dataset_with_outputs_reopened(demo: dict[str, Path
     # the simulator's ArduPilot log carries SIDD: the excitation is every axis's reference, said so
     assert all(entry["reference"] == "excitation" for entry in summary["responses"])
     assert all(r.reference == "excitation" and not r.whole_record for r in responses)  # one piece per axis
-    assert summary["notes"][1] == "lon: the logged excitation (SIDD) is the reference of the delta_lon responses, " \
-                                  "H = G_ry / G_rx."
+    assert (
+        summary["notes"][1] == "lon: the logged excitation (SIDD) is the reference of the delta_lon responses, "
+        "H = G_ry / G_rx."
+    )
     assert summary["options"]["reference"] is None and summary["options"]["whole_record"] is True
 
 
 def test_the_reference_can_be_switched_off(demo: dict[str, Path]) -> None:
-    result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), "--pairs", "q/delta_lon", "--reference", "none",
-                                      "--no-whole-record", "--json", "-", "-q"])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "freqresp",
+            str(demo["dataset"]),
+            "--pairs",
+            "q/delta_lon",
+            "--reference",
+            "none",
+            "--no-whole-record",
+            "--json",
+            "-",
+            "-q",
+        ],
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert summary["responses"][0]["reference"] is None and summary["options"]["whole_record"] is False
@@ -76,20 +92,41 @@ def test_the_reference_can_be_switched_off(demo: dict[str, Path]) -> None:
 def test_a_px4_log_has_no_excitation_and_the_mixer_input_is_used(tmp_path: Path) -> None:
     """PX4 logs no injected excitation: the responses come from the mixer input, and the notes say so."""
     flight = simulate_hover(50.0, (Maneuver("lon", "sweep", 8.0, 8.0, 34.0),), parameters=CALM_HOVER, seed=2)
-    log = write_px4_log(flight, tmp_path / "sweep.ulg", utc_start=datetime(2024, 5, 1, 10, tzinfo=timezone.utc))
+    log = write_px4_log(flight, tmp_path / "sweep.ulg", utc_start=datetime(2024, 5, 1, 10, tzinfo=UTC))
     result = CliRunner().invoke(cli, ["freqresp", str(log), "--pairs", "q/delta_lon", "--json", "-", "-q"])
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert summary["responses"][0]["reference"] is None and summary["responses"][0]["kept"]
-    assert summary["notes"] == ["lon: none of the sweep pieces carry a logged excitation (PX4 logs none): responses "
-                                "computed from the mixer input delta_lon, which in closed loop also carries the "
-                                "feedback of noise and turbulence."]
+    assert summary["notes"] == [
+        "lon: none of the sweep pieces carry a logged excitation (PX4 logs none): responses "
+        "computed from the mixer input delta_lon, which in closed loop also carries the "
+        "feedback of noise and turbulence."
+    ]
 
 
 def test_logs_are_ingested_on_the_fly_and_wind_inputs_conditioned(demo: dict[str, Path]) -> None:
-    result = CliRunner().invoke(cli, ["freqresp", str(demo["log"]), "--wind", str(demo["wind"]), "--wind-distance",
-                                      "4.6", "--wind-offset", "1.5", "--pairs", "ax/delta_lon,ax/wind_lon",
-                                      "--min-coherence", "0.6", "--windows", "4,8,16", "--json", "-", "-q"])
+    result = CliRunner().invoke(
+        cli,
+        [
+            "freqresp",
+            str(demo["log"]),
+            "--wind",
+            str(demo["wind"]),
+            "--wind-distance",
+            "4.6",
+            "--wind-offset",
+            "1.5",
+            "--pairs",
+            "ax/delta_lon,ax/wind_lon",
+            "--min-coherence",
+            "0.6",
+            "--windows",
+            "4,8,16",
+            "--json",
+            "-",
+            "-q",
+        ],
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     control, wind = summary["responses"]
@@ -99,16 +136,20 @@ def test_logs_are_ingested_on_the_fly_and_wind_inputs_conditioned(demo: dict[str
     assert summary["options"]["min_coherence"] == 0.6 and summary["output"] is None
 
 
-@pytest.mark.parametrize(("args", "fragment"), [
-    (["--pairs", "q/delta_lon,zz/delta_lon"], "has no signal zz"),
-    (["--kind", "multisine"], "no multisine on any axis"),
-    (["--pairs", "q/delta_lon", "--kind", "3211"], "no 3211 on axis lon"),
-    (["--windows", "90"], "longer than every record"),
-    (["--omega-max", "400"], "above the Nyquist frequency"),
-    (["--pairs", "q/delta_lon", "--reference", "sidd"], "has no signal sidd"),
-])
-def test_bad_data_is_exit_1_with_one_sentence_and_no_file(demo: dict[str, Path], tmp_path: Path, args: list[str],
-                                                           fragment: str) -> None:
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--pairs", "q/delta_lon,zz/delta_lon"], "has no signal zz"),
+        (["--kind", "multisine"], "no multisine on any axis"),
+        (["--pairs", "q/delta_lon", "--kind", "3211"], "no 3211 on axis lon"),
+        (["--windows", "90"], "longer than every record"),
+        (["--omega-max", "400"], "above the Nyquist frequency"),
+        (["--pairs", "q/delta_lon", "--reference", "sidd"], "has no signal sidd"),
+    ],
+)
+def test_bad_data_is_exit_1_with_one_sentence_and_no_file(
+    demo: dict[str, Path], tmp_path: Path, args: list[str], fragment: str
+) -> None:
     out, plot = tmp_path / "fr.h5", tmp_path / "fr.svg"
     result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), "-o", str(out), "--plot", str(plot), *args])
     assert result.exit_code == 1, result.output
@@ -117,12 +158,15 @@ def test_bad_data_is_exit_1_with_one_sentence_and_no_file(demo: dict[str, Path],
     assert not out.exists() and not plot.exists()
 
 
-@pytest.mark.parametrize(("args", "fragment"), [
-    (["--pairs", "q"], "OUTPUT/INPUT"),
-    (["--windows", "2,x"], "comma-separated list of seconds"),
-    (["--omega-min", "50", "--omega-max", "10"], "must be below --omega-max"),
-    (["--wind-distance", "4.6"], "--wind-distance goes with logs"),
-])
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--pairs", "q"], "OUTPUT/INPUT"),
+        (["--windows", "2,x"], "comma-separated list of seconds"),
+        (["--omega-min", "50", "--omega-max", "10"], "must be below --omega-max"),
+        (["--wind-distance", "4.6"], "--wind-distance goes with logs"),
+    ],
+)
 def test_usage_errors_are_exit_2(demo: dict[str, Path], args: list[str], fragment: str) -> None:
     result = CliRunner().invoke(cli, ["freqresp", str(demo["dataset"]), *args])
     assert result.exit_code == 2, result.output

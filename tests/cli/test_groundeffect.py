@@ -20,8 +20,16 @@ EQ_2_5 = (laws.FITTED_4ROTOR_SLOPE, laws.FITTED_4ROTOR_INTERCEPT, laws.FITTED_4R
 HEIGHTS_CM = np.arange(2.5, 20.51, 1.0)
 
 
-def rig_csv(path: Path, ratio: np.ndarray, *, readings: int, sigma: float, seed: int,
-            header: str = "height_cm,thrust_g", heights_cm: np.ndarray = HEIGHTS_CM) -> Path:
+def rig_csv(
+    path: Path,
+    ratio: np.ndarray,
+    *,
+    readings: int,
+    sigma: float,
+    seed: int,
+    header: str = "height_cm,thrust_g",
+    heights_cm: np.ndarray = HEIGHTS_CM,
+) -> Path:
     """A rig file in a scale's units (cm, grams of force), `readings` per height, noise `sigma` in F/F0."""
     rng = np.random.default_rng(seed)
     heights = np.repeat(heights_cm, readings)
@@ -34,8 +42,22 @@ def test_fit_rig_csv_recovers_eq_2_5_and_writes_model_and_report(runner: CliRunn
     x = HEIGHTS_CM / 100 / R
     data = rig_csv(tmp_path / "rig.csv", laws.piecewise_linear(x, *EQ_2_5), readings=60, sigma=0.0103, seed=5)
     out, report = tmp_path / "ge.json", tmp_path / "ge.html"
-    result = runner.invoke(cli, ["ground-effect", "fit", str(data), "--rotor-radius", str(R), "-o", str(out),
-                                 "--report", str(report), "--json", "-"])
+    result = runner.invoke(
+        cli,
+        [
+            "ground-effect",
+            "fit",
+            str(data),
+            "--rotor-radius",
+            str(R),
+            "-o",
+            str(out),
+            "--report",
+            str(report),
+            "--json",
+            "-",
+        ],
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert summary["best"] == "piecewise_linear"
@@ -56,11 +78,29 @@ def test_fit_rig_csv_recovers_eq_2_5_and_writes_model_and_report(runner: CliRunn
 
 def test_fit_human_output_and_f0_given(runner: CliRunner, tmp_path: Path) -> None:
     x = HEIGHTS_CM[:8] / 100 / R  # all in ground effect: no rows above Z/R 8
-    data = rig_csv(tmp_path / "low.csv", laws.corrected(x, 3.315), readings=3, sigma=0.002, seed=1,
-                   header="Z (cm),F [g]", heights_cm=HEIGHTS_CM[:8]).read_text().replace(",", ";")
+    data = (
+        rig_csv(
+            tmp_path / "low.csv",
+            laws.corrected(x, 3.315),
+            readings=3,
+            sigma=0.002,
+            seed=1,
+            header="Z (cm),F [g]",
+            heights_cm=HEIGHTS_CM[:8],
+        )
+        .read_text()
+        .replace(",", ";")
+    )
     (tmp_path / "low.csv").write_text(data)
-    args = ["ground-effect", "fit", str(tmp_path / "low.csv"), "--rotor-radius", str(R),
-            "--columns", "height=Z (cm),thrust=F [g]"]
+    args = [
+        "ground-effect",
+        "fit",
+        str(tmp_path / "low.csv"),
+        "--rotor-radius",
+        str(R),
+        "--columns",
+        "height=Z (cm),thrust=F [g]",
+    ]
     result = runner.invoke(cli, args)
     assert result.exit_code == 1
     assert "low.csv: no reading above Z/R = 8" in result.output and "--f0" in result.output
@@ -96,27 +136,45 @@ def test_fit_bad_rig_file_names_the_line(runner: CliRunner, tmp_path: Path) -> N
 def test_spacing_finds_the_transition_and_writes_the_report(runner: CliRunner, tmp_path: Path) -> None:
     x = HEIGHTS_CM / 100 / R
     files = []
-    for i, w in enumerate([1.0, 0.9, 0.8, 0.2, 0.1, 0.0]):  # see tests/sysid/test_groundeffect.py: spacing_series
+    for i, w in enumerate(
+        [1.0, 0.9, 0.8, 0.2, 0.1, 0.0]
+    ):  # see tests/sysid/groundeffect/test_fitting.py: spacing_series
         ratio = w * laws.piecewise_linear(x, *EQ_2_5) + (1 - w) * laws.corrected(x, 3.0)
         files.append(str(rig_csv(tmp_path / f"rig_{10 * i}mm.csv", ratio, readings=3, sigma=0.0103, seed=40 + i)))
     report = tmp_path / "spacing.html"
-    result = runner.invoke(cli, ["ground-effect", "spacing", *files, "--spacing", "0,10,20,30,40,50",
-                                 "--rotor-radius", str(R), "--report", str(report), "--json", "-"])
+    result = runner.invoke(
+        cli,
+        [
+            "ground-effect",
+            "spacing",
+            *files,
+            "--spacing",
+            "0,10,20,30,40,50",
+            "--rotor-radius",
+            str(R),
+            "--report",
+            str(report),
+            "--json",
+            "-",
+        ],
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert summary["transition_mm"] == pytest.approx(30.0)
     assert summary["chosen"] == ["piecewise_linear"] * 3 + ["corrected"] * 3
     assert [s["source"] for s in summary["sets"]] == [Path(f).name for f in files]
     assert "30 mm" in report.read_text()
-    human = runner.invoke(cli, ["ground-effect", "spacing", *files, "--spacing", "0,10,20,30,40,50",
-                                "--rotor-radius", str(R)])
+    human = runner.invoke(
+        cli, ["ground-effect", "spacing", *files, "--spacing", "0,10,20,30,40,50", "--rotor-radius", str(R)]
+    )
     assert "transition piecewise_linear -> corrected: at 30 mm" in human.stdout
 
 
 def test_spacing_needs_one_spacing_per_file(runner: CliRunner, tmp_path: Path) -> None:
     data = rig_csv(tmp_path / "rig.csv", np.ones(HEIGHTS_CM.size), readings=1, sigma=0.0, seed=0)
-    result = runner.invoke(cli, ["ground-effect", "spacing", str(data), str(data), "--spacing", "0",
-                                 "--rotor-radius", "0.0225"])
+    result = runner.invoke(
+        cli, ["ground-effect", "spacing", str(data), str(data), "--spacing", "0", "--rotor-radius", "0.0225"]
+    )
     assert result.exit_code == 2 and "2 files but 1 spacings" in result.output
     result = runner.invoke(cli, ["ground-effect", "spacing", str(data), "--spacing", "0,x", "--rotor-radius", "1"])
     assert result.exit_code == 2 and "not a comma-separated list" in result.output

@@ -9,20 +9,43 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from flightlogs.store import read_dataset
+from flightlogs.store.dataset import read_dataset
 from sysid_cli.main import cli
 
 # (file under real/, autopilot, log format, signals that must be present)
 REAL_LOGS = [
     ("kd0aij-impulse-response/log1.ulg", "px4", "ulog", {"p", "q", "r", "ax", "ay", "az"}),
-    ("px4-ulog-rs/quadrotor_local.ulg", "px4", "ulog",
-     {"p", "q", "r", "phi", "theta", "psi", "vd", "ax", "delta_lat", "delta_thr", "motor_1", "motor_4", "battery_v", "height_agl"}),
+    (
+        "px4-ulog-rs/quadrotor_local.ulg",
+        "px4",
+        "ulog",
+        {
+            "p",
+            "q",
+            "r",
+            "phi",
+            "theta",
+            "psi",
+            "vd",
+            "ax",
+            "delta_lat",
+            "delta_thr",
+            "motor_1",
+            "motor_4",
+            "battery_v",
+            "height_agl",
+        },
+    ),
     ("px4-ulog-rs/corrupt_unregistered_msg_id.ulg", "px4", "ulog", {"p", "q", "r", "phi", "motor_1", "battery_v"}),
     ("px4-ulog-rs/corrupt_actuator_armed_wrong_size.ulg", "px4", "ulog", {"p", "q", "r"}),
     ("pyulog/sample.ulg", "px4", "ulog", {"p", "q", "r", "phi", "ax", "delta_lat", "delta_thr", "motor_1"}),
     ("pyulog/sample_appended_multiple.ulg", "px4", "ulog", {"p", "q", "r", "phi", "ax"}),
-    ("dronekit-la-testdata/log171.bin", "ardupilot", "dataflash",
-     {"p", "q", "r", "phi", "theta", "psi", "ax", "motor_1", "motor_4", "battery_v", "vn", "ve", "vd"}),
+    (
+        "dronekit-la-testdata/log171.bin",
+        "ardupilot",
+        "dataflash",
+        {"p", "q", "r", "phi", "theta", "psi", "ax", "motor_1", "motor_4", "battery_v", "vn", "ve", "vd"},
+    ),
     ("ardupilot-log-diagnosis/sample.bin", "ardupilot", "dataflash", {"p", "q", "r", "phi", "ax", "motor_1", "vn"}),
     ("phoenix/2018-09-17 16-44-06.tlog", "ardupilot", "tlog", {"p", "q", "r", "phi", "theta", "psi", "motor_1"}),
 ]
@@ -30,7 +53,13 @@ REAL_LOGS = [
 
 @pytest.mark.parametrize(("relative", "autopilot", "log_format", "present"), REAL_LOGS, ids=[r[0] for r in REAL_LOGS])
 def test_every_real_log_ingests(
-    runner: CliRunner, real_data: Path, tmp_path: Path, relative: str, autopilot: str, log_format: str, present: set[str]
+    runner: CliRunner,
+    real_data: Path,
+    tmp_path: Path,
+    relative: str,
+    autopilot: str,
+    log_format: str,
+    present: set[str],
 ) -> None:
     out = tmp_path / "set.h5"
     result = runner.invoke(cli, ["ingest", str(real_data / relative), "-o", str(out), "--json", "-", "-q"])
@@ -57,7 +86,9 @@ def test_human_table_lists_signals_and_missing(runner: CliRunner, real_data: Pat
 
 def test_json_to_file(runner: CliRunner, real_data: Path, tmp_path: Path) -> None:
     target = tmp_path / "summary.json"
-    result = runner.invoke(cli, ["ingest", str(real_data / "dronekit-la-testdata/log171.bin"), "--json", str(target), "-q"])
+    result = runner.invoke(
+        cli, ["ingest", str(real_data / "dronekit-la-testdata/log171.bin"), "--json", str(target), "-q"]
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(target.read_text())
     assert summary["signals"]["battery_v"]["unit"] == "V"

@@ -8,13 +8,24 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from simulator.vehicle.identified import CALM_HOVER
 from sysid.fit import fit_frequency_responses, model_from_fit, synthetic_responses, write_model
 from sysid.model import load_structure, structure_model
-from sysid.sim.linear_flight import CALM_HOVER
 from sysid_cli.main import cli
 
-TABLE_3_3_CALM = ["X_u=-0.3172", "M_u=0.7690", "X_lon=-0.0985", "M_lon=0.5251", "Y_v=-0.2787", "L_v=-0.7406",
-                  "Y_lat=0.1185", "L_lat=0.6226", "N_yaw=0.0744", "Z_thr=-0.8712", "T_a=0.0458"]
+TABLE_3_3_CALM = [
+    "X_u=-0.3172",
+    "M_u=0.7690",
+    "X_lon=-0.0985",
+    "M_lon=0.5251",
+    "Y_v=-0.2787",
+    "L_v=-0.7406",
+    "Y_lat=0.1185",
+    "L_lat=0.6226",
+    "N_yaw=0.0744",
+    "Z_thr=-0.8712",
+    "T_a=0.0458",
+]
 
 
 def test_modes_of_published_derivatives_are_the_si_values(runner: CliRunner) -> None:
@@ -35,8 +46,9 @@ def test_modes_of_published_derivatives_are_the_si_values(runner: CliRunner) -> 
 def test_modes_of_a_model_file(runner: CliRunner, tmp_path: Path) -> None:
     structure = load_structure("hover")
     truth, _ = structure_model(structure, dict(CALM_HOVER))
-    fit = fit_frequency_responses(structure, synthetic_responses(truth, ["q/delta_lon", "ax/delta_lon"],
-                                                                 fit_range=(0.8, 50.0)))
+    fit = fit_frequency_responses(
+        structure, synthetic_responses(truth, ["q/delta_lon", "ax/delta_lon"], fit_range=(0.8, 50.0))
+    )
     path = write_model(tmp_path / "model.json", model_from_fit(fit))
     result = runner.invoke(cli, ["modes", str(path), "--json", "-", "-q"])
     assert result.exit_code == 0, result.output
@@ -44,11 +56,14 @@ def test_modes_of_a_model_file(runner: CliRunner, tmp_path: Path) -> None:
     assert reals == pytest.approx([-2.073, 0.878], abs=5e-4)  # noise-free fit: exact to the table's rounding
 
 
-@pytest.mark.parametrize(("args", "code", "message"), [
-    (["modes"], 2, "either MODEL_FILE"),
-    (["modes", "--model", "hover", "--set", "Q=1"], 1, "no parameter 'Q'"),
-    (["modes", "--model", "hover", "--set", "X_u=abc"], 2, "NAME=VALUE"),
-])
+@pytest.mark.parametrize(
+    ("args", "code", "message"),
+    [
+        (["modes"], 2, "either MODEL_FILE"),
+        (["modes", "--model", "hover", "--set", "Q=1"], 1, "no parameter 'Q'"),
+        (["modes", "--model", "hover", "--set", "X_u=abc"], 2, "NAME=VALUE"),
+    ],
+)
 def test_modes_errors(runner: CliRunner, args: list[str], code: int, message: str) -> None:
     result = runner.invoke(cli, args)
     assert result.exit_code == code, result.output

@@ -17,8 +17,24 @@ SHORT = ["--trials", "2", "--pid-phase", "4", "--mrac-phase", "4", "-q"]
 
 def test_compare_writes_summary_results_and_report(runner: CliRunner, tmp_path: Path) -> None:
     report, results = tmp_path / "mrac.html", tmp_path / "results.json"
-    result = runner.invoke(cli, ["mrac", "compare", "--height-ratio", "4,3", "--height-ratio", "22", *SHORT,
-                                 "--report", str(report), "-o", str(results), "--json", "-"])
+    result = runner.invoke(
+        cli,
+        [
+            "mrac",
+            "compare",
+            "--height-ratio",
+            "4,3",
+            "--height-ratio",
+            "22",
+            *SHORT,
+            "--report",
+            str(report),
+            "-o",
+            str(results),
+            "--json",
+            "-",
+        ],
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert summary["height_ratios"] == [4.0, 3.0, 22.0] and summary["trials"] == 2
@@ -43,14 +59,27 @@ def test_compare_defaults_to_the_dissertation_cases_and_prints_rise_times(runner
 
 def test_a_fitted_ground_effect_model_drives_the_vehicle(runner: CliRunner, tmp_path: Path) -> None:
     """The loop from data to controller: eq. 2.5 sampled, fitted, saved, and flown; same result as eq. 2.5 itself."""
+    from simulator.world.environment import thrust_ratio
     from sysid.groundeffect import ThrustRatioData, fit_ground_effect, write_ground_effect_model
-    from sysid.sim.environment import thrust_ratio
 
     x = np.linspace(1.1, 8.0, 40)
     fit = fit_ground_effect(ThrustRatioData(x, thrust_ratio(x, "fitted_4rotor"), 0.0225))
     model = write_ground_effect_model(fit, tmp_path / "ge.json")
-    args = ["mrac", "compare", "--height-ratio", "3", "--trials", "1", "--pid-phase", "6", "--mrac-phase", "6", "-q",
-            "--json", "-"]
+    args = [
+        "mrac",
+        "compare",
+        "--height-ratio",
+        "3",
+        "--trials",
+        "1",
+        "--pid-phase",
+        "6",
+        "--mrac-phase",
+        "6",
+        "-q",
+        "--json",
+        "-",
+    ]
     fitted = runner.invoke(cli, [*args, "--ground-effect", str(model)])
     plain = runner.invoke(cli, args)
     assert fitted.exit_code == 0 and plain.exit_code == 0, fitted.output + plain.output
@@ -62,12 +91,15 @@ def test_a_fitted_ground_effect_model_drives_the_vehicle(runner: CliRunner, tmp_
         assert a == pytest.approx(b, rel=0.05)  # the fit reproduces eq. 2.5 to its RMSE
 
 
-@pytest.mark.parametrize(("args", "code", "fragment"), [
-    (["--height-ratio", "four"], 2, "is not a number"),
-    (["--height-ratio", "-1"], 2, "must be > 0"),
-    (["--trials", "0"], 2, "--trials"),
-    (["--height-ratio", "1"], 1, "below the rotors' height on the ground"),
-])
+@pytest.mark.parametrize(
+    ("args", "code", "fragment"),
+    [
+        (["--height-ratio", "four"], 2, "is not a number"),
+        (["--height-ratio", "-1"], 2, "must be > 0"),
+        (["--trials", "0"], 2, "--trials"),
+        (["--height-ratio", "1"], 1, "below the rotors' height on the ground"),
+    ],
+)
 def test_bad_options_are_usage_or_data_errors(runner: CliRunner, args: list[str], code: int, fragment: str) -> None:
     result = runner.invoke(cli, ["mrac", "compare", *args, "-q"])
     assert result.exit_code == code

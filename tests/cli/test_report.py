@@ -1,6 +1,6 @@
 """``sysid report`` rebuilds the model report from the saved files, also after ``sysid fit`` and ``sysid validate``.
 
-(The verification file itself, :mod:`sysid.verify_io`, is tested in ``tests/sysid/test_verify_io.py``.)
+(The verification file itself, :mod:`sysid.verify.io`, is tested in ``tests/sysid/verify/test_io.py``.)
 """
 
 from __future__ import annotations
@@ -10,55 +10,72 @@ import re
 from pathlib import Path
 from types import ModuleType
 
-import numpy as np
 import pytest
 from click.testing import CliRunner
 
 from flightlogs.errors import DataError
 from reports.model_report import model_report_html
+from simulator.campaign.fly import run_scenario
+from simulator.campaign.scenario import read_scenario
 from sysid.fit import IdentifiedModel, read_model, write_model
-from sysid.sim.campaign import run_scenario
-from sysid.sim.scenario import read_scenario
 from sysid.verify import Verification
-from sysid.verify_io import read_verification, write_verification
+from sysid.verify.io import read_verification, write_verification
 from sysid_cli.main import cli
 from sysid_cli.report import ingest_card
 
 _FOOTER = re.compile(r"<footer>.*?</footer>", re.S)
-INGEST = {"path": "/data/flight.bin", "log_format": "dataflash", "autopilot": "ardupilot",
-          "vehicle": "ArduCopter V4.5.7 <octo>", "duration_s": 204.0, "utc_start": "2024-05-01T10:00:00+00:00",
-          "wind_alignment": {"clock_offset_s": 1.5003, "clock_offset_source": "estimated", "transport_delay_s": 1.7374,
-                             "transport_delay_source": "geometry", "turbulence_ratio": 0.2046}}
+INGEST = {
+    "path": "/data/flight.bin",
+    "log_format": "dataflash",
+    "autopilot": "ardupilot",
+    "vehicle": "ArduCopter V4.5.7 <octo>",
+    "duration_s": 204.0,
+    "utc_start": "2024-05-01T10:00:00+00:00",
+    "wind_alignment": {
+        "clock_offset_s": 1.5003,
+        "clock_offset_source": "estimated",
+        "transport_delay_s": 1.7374,
+        "transport_delay_source": "geometry",
+        "turbulence_ratio": 0.2046,
+    },
+}
 
 
 @pytest.fixture(scope="module")
-def saved(tmp_path_factory: pytest.TempPathFactory, report_browser: ModuleType,
-          report_models: ModuleType) -> tuple[Path, Path, IdentifiedModel, Verification]:
+def saved(
+    tmp_path_factory: pytest.TempPathFactory, report_browser: ModuleType, report_models: ModuleType
+) -> tuple[Path, Path, IdentifiedModel, Verification]:
     folder = tmp_path_factory.mktemp("saved")
     model = report_models.small_model(files=("flight.bin", "anemometer.csv"))
     verification = report_browser.sample_verification()
     write_model(folder / "model.json", model)
-    write_verification(folder / "validation.json", verification, model="model.json",
-                       options={"initial_state": "estimated", "after_s": 1.0})
+    write_verification(
+        folder / "validation.json",
+        verification,
+        model="model.json",
+        options={"initial_state": "estimated", "after_s": 1.0},
+    )
     return folder / "model.json", folder / "validation.json", model, verification
 
 
 def test_report_rebuilds_the_same_page_from_the_saved_files(
-        saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path) -> None:
+    saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path
+) -> None:
     model_path, validation_path, model, verification = saved
     out = tmp_path / "report.html"
-    result = CliRunner().invoke(cli, ["report", str(model_path), str(validation_path), "-o", str(out),
-                                      "--json", "-"])
+    result = CliRunner().invoke(cli, ["report", str(model_path), str(validation_path), "-o", str(out), "--json", "-"])
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert summary["report"] == str(out) and summary["verdict"] == "good"
-    direct = model_report_html(model, verification=verification, verification_options={
-        "initial_state": "estimated", "after_s": 1.0})
+    direct = model_report_html(
+        model, verification=verification, verification_options={"initial_state": "estimated", "after_s": 1.0}
+    )
     assert _FOOTER.sub("", out.read_text()) == _FOOTER.sub("", direct)
 
 
 def test_without_a_verification_the_default_output_sits_beside_the_model(
-        saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path) -> None:
+    saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path
+) -> None:
     model_path, _, _, _ = saved
     copy = tmp_path / "m.json"
     copy.write_text(model_path.read_text())
@@ -80,19 +97,23 @@ def test_ingest_card_reads_what_ingest_writes() -> None:
     card = ingest_card(INGEST)
     assert card["vehicle"] == "ArduCopter V4.5.7 <octo>"
     assert card["flight"] == "flight.bin: ardupilot dataflash log, 204 s from 2024-05-01T10:00:00+00:00"
-    assert card["wind alignment"] == ("anemometer clock offset +1.50 s (estimated), transport delay 1.74 s "
-                                      "(geometry), turbulence 20 %")
+    assert card["wind alignment"] == (
+        "anemometer clock offset +1.50 s (estimated), transport delay 1.74 s (geometry), turbulence 20 %"
+    )
     with pytest.raises(DataError, match="sysid ingest --json"):
         ingest_card({"records": []})
 
 
-def _bad_files(folder: Path, saved: tuple[Path, Path, IdentifiedModel, Verification]) -> dict[str, tuple[list[str], str]]:
+def _bad_files(
+    folder: Path, saved: tuple[Path, Path, IdentifiedModel, Verification]
+) -> dict[str, tuple[list[str], str]]:
     model_path, validation_path, _, _ = saved
     (folder / "broken.json").write_text('{"schema": "flight-sysid/identified-model", ')
     newer = json.loads(model_path.read_text()) | {"schema_version": 99}
     (folder / "newer.json").write_text(json.dumps(newer))
-    (folder / "summary.json").write_text(json.dumps({"model": "m.json", "records": [], "summary": {},
-                                                     "overall": {"rmse": 1.0, "tic": 0.1}}))
+    (folder / "summary.json").write_text(
+        json.dumps({"model": "m.json", "records": [], "summary": {}, "overall": {"rmse": 1.0, "tic": 0.1}})
+    )
     damaged = json.loads(validation_path.read_text())
     del damaged["records"][0]["time_s"]
     (folder / "damaged.json").write_text(json.dumps(damaged))
@@ -103,15 +124,27 @@ def _bad_files(folder: Path, saved: tuple[Path, Path, IdentifiedModel, Verificat
         "a validate summary": ([str(model_path), str(folder / "summary.json")], "sysid validate --json"),
         "damaged verification": ([str(model_path), str(folder / "damaged.json")], "incomplete or damaged"),
         "model as verification": ([str(model_path), str(model_path)], "not a flight-sysid verification file"),
-        "not an ingest summary": ([str(model_path), "--ingest-summary", str(folder / "not-ingest.json")],
-                                  "sysid ingest --json"),
+        "not an ingest summary": (
+            [str(model_path), "--ingest-summary", str(folder / "not-ingest.json")],
+            "sysid ingest --json",
+        ),
     }
 
 
-@pytest.mark.parametrize("case", ["model not JSON", "model too new", "a validate summary", "damaged verification",
-                                  "model as verification", "not an ingest summary"])
-def test_bad_input_is_exit_1_and_writes_nothing(case: str, saved: tuple[Path, Path, IdentifiedModel, Verification],
-                                                tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    "case",
+    [
+        "model not JSON",
+        "model too new",
+        "a validate summary",
+        "damaged verification",
+        "model as verification",
+        "not an ingest summary",
+    ],
+)
+def test_bad_input_is_exit_1_and_writes_nothing(
+    case: str, saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path
+) -> None:
     inputs = tmp_path / "in"
     inputs.mkdir()
     arguments, fragment = _bad_files(inputs, saved)[case]
@@ -128,8 +161,9 @@ def test_a_missing_model_is_a_usage_error(tmp_path: Path) -> None:
     assert result.exit_code == 2 and "does not exist" in result.stderr
 
 
-def test_fit_report_hook_writes_the_model_report(saved: tuple[Path, Path, IdentifiedModel, Verification],
-                                                 tmp_path: Path) -> None:
+def test_fit_report_hook_writes_the_model_report(
+    saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path
+) -> None:
     """``sysid fit --report`` calls ``write_model_report``: the page ``sysid report`` renders."""
     from reports.model_report import write_model_report
 
@@ -175,7 +209,7 @@ duration_s = 2.0
 
 
 def _sections(page: str) -> list[str]:
-    return re.findall(r'<h[23][^>]*>(.*?)</h[23]>', page)
+    return re.findall(r"<h[23][^>]*>(.*?)</h[23]>", page)
 
 
 @pytest.mark.slow
@@ -187,8 +221,9 @@ def test_fit_validate_and_report_from_the_command_line(tmp_path: Path) -> None:
     fitted = CliRunner().invoke(cli, ["fit", str(sweep), "--model", "hover", "-o", str(model), "-q"])
     assert fitted.exit_code == 0, fitted.output
     first = tmp_path / "validate.html"
-    result = CliRunner().invoke(cli, ["validate", str(model), str(doublet), "-o", str(validation),
-                                      "--report", str(first), "--json", "-", "-q"])
+    result = CliRunner().invoke(
+        cli, ["validate", str(model), str(doublet), "-o", str(validation), "--report", str(first), "--json", "-", "-q"]
+    )
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert summary["output"] == str(validation) and summary["report"] == str(first)

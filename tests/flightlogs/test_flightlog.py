@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -51,7 +51,7 @@ def test_flightlog_reports_missing_and_utc() -> None:
     assert "p" not in log.missing and "phi" in log.missing
     assert "motor_1..n" not in log.missing
     assert set(log.missing) == set(LOGGED_SIGNALS) - {"p", "q", "r"}
-    assert log.utc_start == datetime.fromtimestamp(1_700_000_000.0, tz=timezone.utc)
+    assert log.utc_start == datetime.fromtimestamp(1_700_000_000.0, tz=UTC)
     assert log.duration_s == pytest.approx(1.0)
 
 

@@ -10,9 +10,7 @@ from scipy.spatial.transform import Rotation
 
 from flightlogs.frames import air_velocity_body, earth_to_body, quaternion_to_euler, wind_to_body_axes
 
-angles = st.tuples(
-    st.floats(-3.1, 3.1), st.floats(-1.5, 1.5), st.floats(-3.1, 3.1)
-)
+angles = st.tuples(st.floats(-3.1, 3.1), st.floats(-1.5, 1.5), st.floats(-3.1, 3.1))
 
 
 @settings(max_examples=60, deadline=None)
@@ -36,7 +34,9 @@ def test_earth_to_body_is_the_inverse_of_scipys_body_to_earth(euler: tuple, vect
 
 def test_airspeed_of_a_level_vehicle_in_a_crosswind() -> None:
     # nose east, flying east at 2 m/s, wind blowing towards the north at 3 m/s
-    uvw = air_velocity_body(np.array([[0.0, 2.0, 0.0]]), np.array([[3.0, 0.0]]), np.zeros(1), np.zeros(1), np.array([np.pi / 2]))
+    uvw = air_velocity_body(
+        np.array([[0.0, 2.0, 0.0]]), np.array([[3.0, 0.0]]), np.zeros(1), np.zeros(1), np.array([np.pi / 2])
+    )
     np.testing.assert_allclose(uvw, [[2.0, 3.0, 0.0]], atol=1e-12)  # air from the left: v = +3 (moves right relative)
 
 

@@ -16,13 +16,21 @@ import numpy as np
 import pandas as pd
 
 from flightlogs.record import Record
-from sysid.statespace import DelayedStateSpace
+from sysid.model.statespace import DelayedStateSpace
 from sysid.verify import Verification, verify
 from sysid.verify._discrete import discretize, simulate
 
 #: Flags that work on the shared machine and CI: no sandbox (root), no GPU, nothing phoning home.
-CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync")
+CHROMIUM_FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+)
 
 
 class BrowserUnavailable(RuntimeError):
@@ -98,8 +106,12 @@ def render_in_browser(html_path: Path, screenshot_path: Path, *, width: int = 11
     screenshot_path.parent.mkdir(parents=True, exist_ok=True)
     with sync_playwright() as driver, tempfile.TemporaryDirectory(prefix="chromium-profile-") as profile:
         context = driver.chromium.launch_persistent_context(
-            profile, executable_path=str(executable), headless=True, args=list(CHROMIUM_FLAGS),
-            viewport={"width": width, "height": height})
+            profile,
+            executable_path=str(executable),
+            headless=True,
+            args=list(CHROMIUM_FLAGS),
+            viewport={"width": width, "height": height},
+        )
         try:
             page = context.new_page()
             page.on("console", lambda message: errors.append(message.text) if message.type == "error" else None)
@@ -109,13 +121,20 @@ def render_in_browser(html_path: Path, screenshot_path: Path, *, width: int = 11
             box = "e => [e.getBoundingClientRect().width, e.getBoundingClientRect().height]"
             sizes = page.eval_on_selector_all("svg.figure", f"els => els.map({box})")
             marks = page.eval_on_selector_all(
-                "svg.figure", "els => els.map(e => e.querySelectorAll('path, line, text, use').length)")
+                "svg.figure", "els => els.map(e => e.querySelectorAll('path, line, text, use').length)"
+            )
             png = page.screenshot(path=str(screenshot_path), full_page=True)
         finally:
             context.close()
     external = tuple(url for url in requests if url != page_url and not url.startswith(("data:", "about:")))
-    return BrowserResult(tuple(errors), len(sizes), tuple((float(w), float(h)) for w, h in sizes),
-                         tuple(int(n) for n in marks), _nonblank(png), external)
+    return BrowserResult(
+        tuple(errors),
+        len(sizes),
+        tuple((float(w), float(h)) for w, h in sizes),
+        tuple(int(n) for n in marks),
+        _nonblank(png),
+        external,
+    )
 
 
 def sample_verification(*, seed: int = 0) -> Verification:
@@ -128,10 +147,26 @@ def sample_verification(*, seed: int = 0) -> Verification:
     b = np.array([[0.0, 0.0, 0.3], [0.0, 0.0, 0.0], [20.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
     c = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [-0.4, 0.0, 0.3, 0.0], [0.0, 0.0, 0.0, 1.0]])
     d = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.5], [0.0, 0.0, 0.0]])
-    with_wind = DelayedStateSpace(a, b, c, d, ("q", "theta", "d_lon", "p"), ("delta_lon", "delta_lat", "wind_lon"),
-                                  ("q", "theta", "ax", "p"), np.array([0.02, 0.02, 0.015]))
-    without = DelayedStateSpace(a, b[:, :2], c, d[:, :2], with_wind.states, with_wind.inputs[:2], with_wind.outputs,
-                                with_wind.input_delays_s[:2])
+    with_wind = DelayedStateSpace(
+        a,
+        b,
+        c,
+        d,
+        ("q", "theta", "d_lon", "p"),
+        ("delta_lon", "delta_lat", "wind_lon"),
+        ("q", "theta", "ax", "p"),
+        np.array([0.02, 0.02, 0.015]),
+    )
+    without = DelayedStateSpace(
+        a,
+        b[:, :2],
+        c,
+        d[:, :2],
+        with_wind.states,
+        with_wind.inputs[:2],
+        with_wind.outputs,
+        with_wind.input_delays_s[:2],
+    )
     rng = np.random.default_rng(seed)
     t = np.arange(400) * 0.01
     records = []
@@ -141,11 +176,32 @@ def sample_verification(*, seed: int = 0) -> Verification:
         inputs = np.column_stack([doublet, 0.05 * np.sin(2.0 * t), wind - wind.mean()])
         y = simulate(discretize(with_wind, 0.01), inputs, np.zeros(4))
         y += rng.normal(scale=[0.005, 0.001, 0.03, 0.005], size=y.shape)
-        table = pd.DataFrame({"delta_lon": inputs[:, 0], "delta_lat": inputs[:, 1], "wind_lon": inputs[:, 2],
-                              "q": y[:, 0], "theta": y[:, 1], "ax": y[:, 2], "p": y[:, 3]},
-                             index=pd.Index(20.0 * k + 5.0 + t, name="time_s"))
-        units = {"delta_lon": "%", "delta_lat": "%", "wind_lon": "m/s", "q": "rad/s", "theta": "rad",
-                 "ax": "m/s^2", "p": "rad/s"}
+        table = pd.DataFrame(
+            {
+                "delta_lon": inputs[:, 0],
+                "delta_lat": inputs[:, 1],
+                "wind_lon": inputs[:, 2],
+                "q": y[:, 0],
+                "theta": y[:, 1],
+                "ax": y[:, 2],
+                "p": y[:, 3],
+            },
+            index=pd.Index(20.0 * k + 5.0 + t, name="time_s"),
+        )
+        units = {
+            "delta_lon": "%",
+            "delta_lat": "%",
+            "wind_lon": "m/s",
+            "q": "rad/s",
+            "theta": "rad",
+            "ax": "m/s^2",
+            "p": "rad/s",
+        }
         records.append(Record(table, units, {}, Path("doublets.ulg"), f"doublets.ulg lon doublet {k + 1}"))
-    return verify(without, records, wind_model=with_wind, excited=["delta_lon", "delta_lon"],
-                  axes={"delta_lon": ("q", "theta", "ax")})
+    return verify(
+        without,
+        records,
+        wind_model=with_wind,
+        excited=["delta_lon", "delta_lon"],
+        axes={"delta_lon": ("q", "theta", "ax")},
+    )

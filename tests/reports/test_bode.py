@@ -20,8 +20,21 @@ OMEGA = np.geomspace(0.5, 50.0, 60)
 def _lag(output: str = "q", *, fit_range: tuple[float, float] | None = None, delay_s: float = 0.0) -> FrequencyResponse:
     h = np.exp(-1j * OMEGA * delay_s) / (1j * OMEGA * 0.2 + 1)
     n = OMEGA.size
-    return FrequencyResponse("delta_lon", output, OMEGA, h, np.full(n, 0.9), np.full(n, 0.02), np.ones(n), np.ones(n),
-                             np.ones(n, complex), (2.0, 8.0), input_unit="%", output_unit="rad/s", fit_range=fit_range)
+    return FrequencyResponse(
+        "delta_lon",
+        output,
+        OMEGA,
+        h,
+        np.full(n, 0.9),
+        np.full(n, 0.02),
+        np.ones(n),
+        np.ones(n),
+        np.ones(n, complex),
+        (2.0, 8.0),
+        input_unit="%",
+        output_unit="rad/s",
+        fit_range=fit_range,
+    )
 
 
 def _y(line: Any) -> np.ndarray:
@@ -46,8 +59,11 @@ def test_three_panels_per_response_with_data_in_db_and_degrees() -> None:
 def test_blocks_fill_two_columns_and_unused_panels_are_hidden() -> None:
     figure = bode_figure([_lag("q"), _lag("ax"), _lag("theta")])
     assert len(figure.axes) == 12 and len(_visible(figure)) == 9
-    assert [ax.get_title() for ax in _visible(figure) if ax.get_title()] == ["q/delta_lon", "ax/delta_lon",
-                                                                             "theta/delta_lon"]
+    assert [ax.get_title() for ax in _visible(figure) if ax.get_title()] == [
+        "q/delta_lon",
+        "ax/delta_lon",
+        "theta/delta_lon",
+    ]
     assert len(bode_figure([_lag("q"), _lag("ax")], n_cols=1).axes) == 6
 
 
@@ -107,8 +123,9 @@ def _tick_texts(ax: Any) -> list[str]:
 
 def test_frequency_ticks_are_plain_numbers_labelled_once_per_column() -> None:
     """Five blocks in two columns: only the last block of each column carries tick labels and the axis title."""
-    figure = bode_figure([_lag(name) for name in ("q", "ax", "theta", "u", "w")],
-                         models={"q/delta_lon": 1 / (1j * OMEGA * 0.2 + 1)})
+    figure = bode_figure(
+        [_lag(name) for name in ("q", "ax", "theta", "u", "w")], models={"q/delta_lon": 1 / (1j * OMEGA * 0.2 + 1)}
+    )
     figure.canvas.draw()
     shown = _visible(figure)
     labelled = [ax for ax in shown if _tick_texts(ax)]

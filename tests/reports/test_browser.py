@@ -29,14 +29,20 @@ def chromium(report_browser: ModuleType) -> Path:
         pytest.skip(str(err))
 
 
-def test_model_report_renders_in_chromium(chromium: Path, tmp_path: Path, report_browser: ModuleType,
-                                          report_models: ModuleType) -> None:
+def test_model_report_renders_in_chromium(
+    chromium: Path, tmp_path: Path, report_browser: ModuleType, report_models: ModuleType
+) -> None:
     """What ``sysid validate --report`` and ``sysid report`` write: the model with its verification."""
     browser, fixtures = report_browser, report_models
     model = fixtures.small_model(files=("flight.bin", "anemometer.csv"))
     verification = browser.sample_verification()
-    page = write_model_report(tmp_path / "model.html", model, verification=verification,
-                              logs_summary={"vehicle": "linear octocopter"}, generated_utc=fixtures.STAMP)
+    page = write_model_report(
+        tmp_path / "model.html",
+        model,
+        verification=verification,
+        logs_summary={"vehicle": "linear octocopter"},
+        generated_utc=fixtures.STAMP,
+    )
     shot = ARTIFACTS / "model_report.png"
     seen = browser.render_in_browser(page, shot)
     assert seen.console_errors == ()
@@ -54,8 +60,10 @@ def test_model_report_renders_in_chromium(chromium: Path, tmp_path: Path, report
 def test_a_blank_page_is_seen_as_blank(chromium: Path, tmp_path: Path, report_browser: ModuleType) -> None:
     """The helper itself: an empty page has no figures and no ink; a broken script and a fetch are reported."""
     page = tmp_path / "blank.html"
-    page.write_text('<!DOCTYPE html><html><body><script>undefinedFunction()</script>'
-                    '<img src="http://127.0.0.1:9/pixel.png" alt=""></body></html>')  # loopback discard port
+    page.write_text(
+        "<!DOCTYPE html><html><body><script>undefinedFunction()</script>"
+        '<img src="http://127.0.0.1:9/pixel.png" alt=""></body></html>'
+    )  # loopback discard port
     seen = report_browser.render_in_browser(page, tmp_path / "blank.png")
     assert seen.n_figures == 0 and not seen.screenshot_nonblank
     assert any("undefinedFunction" in error for error in seen.console_errors)

@@ -65,8 +65,9 @@ def test_figures_draw_data_and_one_curve_per_model() -> None:
 @pytest.mark.parametrize("rotors", [2, 4])
 def test_spacing_report_names_the_transition(rotors: int) -> None:
     weights = [1.0, 0.9, 0.8, 0.2, 0.1, 0.0]
-    study = spacing_study([_data(10 + i, w, f"rig_{10 * i}mm.csv") for i, w in enumerate(weights)],
-                          np.arange(6) * 0.010, rotors=rotors)
+    study = spacing_study(
+        [_data(10 + i, w, f"rig_{10 * i}mm.csv") for i, w in enumerate(weights)], np.arange(6) * 0.010, rotors=rotors
+    )
     page = render_spacing_report(study)
     assert page.count("<svg") == 2 and _self_contained(page)
     assert "rig_50mm.csv" in page

@@ -9,17 +9,24 @@ import numpy as np
 import pytest
 from matplotlib.text import Text
 
-from reports.model_figures import (correlation_figure, pair_response, plain_text, pole_map_figure,
-                                   response_figures)
+from reports.model_figures import correlation_figure, pair_response, plain_text, pole_map_figure, response_figures
 from reports.svg import figure_svg
 from sysid.fit import IdentifiedModel
-from sysid.modes import Mode, modes
-from sysid.statespace import DelayedStateSpace
+from sysid.model.modes import Mode, modes
+from sysid.model.statespace import DelayedStateSpace
 
 
 def _first_order(delay_s: float = 0.0) -> DelayedStateSpace:
-    return DelayedStateSpace(np.array([[-2.0]]), np.array([[2.0]]), np.array([[1.0]]), np.zeros((1, 1)), ("p",),
-                             ("delta_lat",), ("p",), np.array([delay_s]))
+    return DelayedStateSpace(
+        np.array([[-2.0]]),
+        np.array([[2.0]]),
+        np.array([[1.0]]),
+        np.zeros((1, 1)),
+        ("p",),
+        ("delta_lat",),
+        ("p",),
+        np.array([delay_s]),
+    )
 
 
 def test_pair_response_is_the_analytic_lag_with_its_delay() -> None:
@@ -32,8 +39,16 @@ def test_pair_response_is_the_analytic_lag_with_its_delay() -> None:
 
 def test_a_signal_entering_twice_is_summed() -> None:
     """A wind signal with two delays (u and w) acts as one input: its response is the sum of both paths."""
-    model = DelayedStateSpace(-np.eye(2), np.eye(2), np.ones((1, 2)), np.zeros((1, 2)), ("u", "w"),
-                              ("wind_lon", "wind_lon"), ("ax",), np.array([0.0, 0.1]))
+    model = DelayedStateSpace(
+        -np.eye(2),
+        np.eye(2),
+        np.ones((1, 2)),
+        np.zeros((1, 2)),
+        ("u", "w"),
+        ("wind_lon", "wind_lon"),
+        ("ax",),
+        np.array([0.0, 0.1]),
+    )
     omega = np.array([1.0, 3.0])
     expected = 1.0 / (1j * omega + 1.0) * (1.0 + np.exp(-0.1j * omega))
     np.testing.assert_allclose(pair_response(model, "ax", "wind_lon", omega), expected, rtol=1e-12)
@@ -98,8 +113,12 @@ def test_pole_map_draws_conjugates_and_zooms_past_fast_actuators() -> None:
     found = [_mode(-22.9, 0.0, "actuator"), _mode(0.9, 1.7, "pitch"), _mode(-2.1, 0.0, "pitch")]
     figure = pole_map_figure(found)
     assert len(figure.axes) == 2  # all poles, and near the origin
-    points = [(float(x), float(y)) for line in figure.axes[0].get_lines() if line.get_marker() not in ("None", "")
-              for x, y in zip(np.asarray(line.get_xdata()), np.asarray(line.get_ydata()))]
+    points = [
+        (float(x), float(y))
+        for line in figure.axes[0].get_lines()
+        if line.get_marker() not in ("None", "")
+        for x, y in zip(np.asarray(line.get_xdata()), np.asarray(line.get_ydata()))
+    ]
     assert sorted(points) == sorted([(-22.9, 0.0), (0.9, 1.7), (0.9, -1.7), (-2.1, 0.0)])
     low, high = figure.axes[1].get_xlim()
     assert low < -2.1 and 0.9 < high < 5.0
@@ -111,8 +130,11 @@ def test_pole_map_draws_conjugates_and_zooms_past_fast_actuators() -> None:
 def test_pole_map_of_an_identified_model_has_every_mode(small_model: IdentifiedModel) -> None:
     found = modes(small_model.linear_model())
     figure = pole_map_figure(found)
-    drawn = sum(np.asarray(line.get_xdata()).size for line in figure.axes[0].get_lines()
-                if line.get_marker() not in ("None", ""))
+    drawn = sum(
+        np.asarray(line.get_xdata()).size
+        for line in figure.axes[0].get_lines()
+        if line.get_marker() not in ("None", "")
+    )
     assert drawn == sum(2 if m.imag > 0 else 1 for m in found)
 
 
@@ -122,4 +144,3 @@ def small_model(report_models: ModuleType) -> IdentifiedModel:
     model: IdentifiedModel = report_models.small_model()
     assert [r.pair for r in model.responses] == list(report_models.PAIRS)
     return model
-

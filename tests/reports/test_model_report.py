@@ -18,11 +18,20 @@ from types import ModuleType
 import numpy as np
 import pytest
 
-from reports.model_report import (CR_MAX_PERCENT, INSENSITIVITY_MAX_PERCENT, J_AVE_ACCEPTABLE, J_AVE_GOOD,
-                                  J_RESPONSE_MAX, TIC_ACCEPTABLE, TIC_GOOD, model_report_html, model_verdict)
+from reports.model_report import (
+    CR_MAX_PERCENT,
+    INSENSITIVITY_MAX_PERCENT,
+    J_AVE_ACCEPTABLE,
+    J_AVE_GOOD,
+    J_RESPONSE_MAX,
+    TIC_ACCEPTABLE,
+    TIC_GOOD,
+    model_report_html,
+    model_verdict,
+)
+from simulator.vehicle.identified import CALM_HOVER
 from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate, Provenance, ReductionStep, synthetic_responses
 from sysid.model import parse_structure
-from sysid.sim.linear_flight import CALM_HOVER
 from sysid.verify import OutputSummary, Verification
 
 HOSTILE = '<script>alert("x")</script><img src=x onerror=alert(1)>'
@@ -32,9 +41,15 @@ DROPPED = ("N_r", "Z_w", "tau_thr")
 _NORMALISED = "normalised (-1..1)"
 
 
-def small_model(*, average: float = 40.0, costs: Mapping[str, float] | None = None,
-                accuracy: Mapping[str, tuple[float, float]] | None = None, files: tuple[str, ...] = ("flight.bin",),
-                notes: tuple[str, ...] = (), responses: bool = True) -> IdentifiedModel:
+def small_model(
+    *,
+    average: float = 40.0,
+    costs: Mapping[str, float] | None = None,
+    accuracy: Mapping[str, tuple[float, float]] | None = None,
+    files: tuple[str, ...] = ("flight.bin",),
+    notes: tuple[str, ...] = (),
+    responses: bool = True,
+) -> IdentifiedModel:
     """The hover structure at Table 3.3's values (per normalised input) with chosen costs and accuracies."""
     text = (resources.files("sysid.model") / "builtin" / "hover.toml").read_text()
     structure = parse_structure(text, source="hover")
@@ -47,23 +62,40 @@ def small_model(*, average: float = 40.0, costs: Mapping[str, float] | None = No
         estimated = p.name not in DROPPED
         cr, ins = accuracy.get(p.name, (5.0, 2.0)) if estimated else (math.nan, math.nan)
         unit = re.sub(r"\{delta_\w+\}", _NORMALISED, p.unit)
-        parameters.append(ParameterEstimate(p.name, values[p.name], cr, ins, "estimated" if estimated else "dropped",
-                                            unit))
+        parameters.append(
+            ParameterEstimate(p.name, values[p.name], cr, ins, "estimated" if estimated else "dropped", unit)
+        )
     names = tuple(p.name for p in parameters if p.status == "estimated")
     correlation = np.eye(len(names))
     correlation[0, 1] = correlation[1, 0] = -0.95  # X_u, M_u: the one pair beyond |r| = 0.9
     correlation[2, 3] = correlation[3, 2] = 0.5
     constants = {"g": 9.81, "U0": 0.0, "V0": 0.0, "W0": 0.0, "phi0": 0.0, "theta0": 0.0}
-    model = IdentifiedModel("hover", text, tuple(parameters), names, correlation, CostSummary(average),
-                            constants=constants)
-    fitted = synthetic_responses(model.linear_model(), PAIRS, noise_db=0.5, noise_deg=3.0, fit_range=(1.0, 40.0),
-                                 seed=3) if responses else ()
+    model = IdentifiedModel(
+        "hover", text, tuple(parameters), names, correlation, CostSummary(average), constants=constants
+    )
+    fitted = (
+        synthetic_responses(model.linear_model(), PAIRS, noise_db=0.5, noise_deg=3.0, fit_range=(1.0, 40.0), seed=3)
+        if responses
+        else ()
+    )
     costs = dict(costs) if costs is not None else {pair: average for pair in PAIRS}
     reduction = (ReductionStep(1, "N_r", "dropped", 0.0, -0.02, 80.0, 45.0, "I% = 45 > 10", average, average),)
-    provenance = Provenance(files, {f: "ab" * 32 for f in files}, {"min_coherence": 0.5, "fit": {"starts": 1}},
-                            {"flight-sysid": "0.1.0"}, "2024-05-01T12:00:00+00:00")
-    return dataclasses.replace(model, cost=CostSummary(average, costs), responses=fitted, reduction=reduction,
-                               provenance=provenance, notes=notes, input_units={"delta_lon": _NORMALISED})
+    provenance = Provenance(
+        files,
+        {f: "ab" * 32 for f in files},
+        {"min_coherence": 0.5, "fit": {"starts": 1}},
+        {"flight-sysid": "0.1.0"},
+        "2024-05-01T12:00:00+00:00",
+    )
+    return dataclasses.replace(
+        model,
+        cost=CostSummary(average, costs),
+        responses=fitted,
+        reduction=reduction,
+        provenance=provenance,
+        notes=notes,
+        input_units={"delta_lon": _NORMALISED},
+    )
 
 
 def verification_with(tics: Mapping[str, float]) -> Verification:
@@ -76,13 +108,19 @@ def verification_with(tics: Mapping[str, float]) -> Verification:
 def hostile_page(report_browser: ModuleType) -> tuple[str, IdentifiedModel, Verification]:
     """A full report where every string from a log or a file is hostile."""
     model = small_model(files=(f"flight{HOSTILE}.bin", "anemometer.csv"), notes=(f"note {HOSTILE}",))
-    model = dataclasses.replace(model, provenance=dataclasses.replace(
-        model.provenance, options={"min_coherence": 0.5, "kind": HOSTILE}))
+    model = dataclasses.replace(
+        model, provenance=dataclasses.replace(model.provenance, options={"min_coherence": 0.5, "kind": HOSTILE})
+    )
     sample = report_browser.sample_verification()
     records = tuple(dataclasses.replace(r, label=f"{r.label} {HOSTILE}") for r in sample.records)
     verification = dataclasses.replace(sample, records=records)
-    page = model_report_html(model, verification=verification, logs_summary={"vehicle": HOSTILE},
-                             verification_options={"initial_state": HOSTILE}, generated_utc=STAMP)
+    page = model_report_html(
+        model,
+        verification=verification,
+        logs_summary={"vehicle": HOSTILE},
+        verification_options={"initial_state": HOSTILE},
+        generated_utc=STAMP,
+    )
     return page, model, verification
 
 
@@ -92,8 +130,16 @@ def _section_ids(page: str) -> list[str]:
 
 def test_every_section_is_there_in_order(hostile_page: tuple[str, IdentifiedModel, Verification]) -> None:
     page, _, _ = hostile_page
-    assert _section_ids(page) == ["responses", "parameters", "costs", "correlation", "modes", "verification",
-                                  "reduction", "provenance"]
+    assert _section_ids(page) == [
+        "responses",
+        "parameters",
+        "costs",
+        "correlation",
+        "modes",
+        "verification",
+        "reduction",
+        "provenance",
+    ]
     assert 'id="summary"' in page and "With and without the wind term" in page
     for heading in ("Bias and reference shift per record", "Options of the identification", "Software"):
         assert heading in page
@@ -116,18 +162,24 @@ def test_strings_from_logs_and_files_are_escaped(hostile_page: tuple[str, Identi
 
 
 def test_one_figure_per_input_plus_correlation_poles_and_verification(
-        hostile_page: tuple[str, IdentifiedModel, Verification]) -> None:
+    hostile_page: tuple[str, IdentifiedModel, Verification],
+) -> None:
     page, model, verification = hostile_page
     inputs = {r.input for r in model.responses}
     n_verification = len(verification.records) + (1 if verification.wind_correction else 0)
-    assert page.count('<svg ') == len(inputs) + 1 + 1 + n_verification
+    assert page.count("<svg ") == len(inputs) + 1 + 1 + n_verification
     assert page.count('class="figure"') == page.count("<svg ")
 
 
 def test_the_report_is_deterministic(hostile_page: tuple[str, IdentifiedModel, Verification]) -> None:
     page, model, verification = hostile_page
-    again = model_report_html(model, verification=verification, logs_summary={"vehicle": HOSTILE},
-                              verification_options={"initial_state": HOSTILE}, generated_utc=STAMP)
+    again = model_report_html(
+        model,
+        verification=verification,
+        logs_summary={"vehicle": HOSTILE},
+        verification_options={"initial_state": HOSTILE},
+        generated_utc=STAMP,
+    )
     assert again == page
 
 
@@ -138,9 +190,14 @@ def _row(page: str, first_cell: str) -> str:
 
 
 def test_parameters_beyond_the_guidelines_are_flagged() -> None:
-    model = small_model(responses=False, accuracy={"X_u": (CR_MAX_PERCENT + 0.1, 3.0),
-                                                   "M_u": (4.0, INSENSITIVITY_MAX_PERCENT + 0.1),
-                                                   "Y_v": (CR_MAX_PERCENT, INSENSITIVITY_MAX_PERCENT)})
+    model = small_model(
+        responses=False,
+        accuracy={
+            "X_u": (CR_MAX_PERCENT + 0.1, 3.0),
+            "M_u": (4.0, INSENSITIVITY_MAX_PERCENT + 0.1),
+            "Y_v": (CR_MAX_PERCENT, INSENSITIVITY_MAX_PERCENT),
+        },
+    )
     page = model_report_html(model, generated_utc=STAMP)
     assert re.search(r'<td class="flag">20\.1</td><td>3</td>', _row(page, "X_u"))
     assert re.search(r'<td>4</td><td class="flag">10\.1</td>', _row(page, "M_u"))
@@ -149,8 +206,12 @@ def test_parameters_beyond_the_guidelines_are_flagged() -> None:
 
 
 def test_response_costs_beyond_200_are_flagged() -> None:
-    costs = {"q/delta_lon": J_RESPONSE_MAX + 1.0, "u/delta_lon": J_RESPONSE_MAX, "p/delta_lat": 10.0,
-             "az/delta_thr": 5.0}
+    costs = {
+        "q/delta_lon": J_RESPONSE_MAX + 1.0,
+        "u/delta_lon": J_RESPONSE_MAX,
+        "p/delta_lat": 10.0,
+        "az/delta_thr": 5.0,
+    }
     page = model_report_html(small_model(average=90.0, costs=costs), generated_utc=STAMP)
     assert '<td class="flag">201</td>' in _row(page, "q/delta_lon")
     assert 'class="flag"' not in _row(page, "u/delta_lon")
@@ -158,30 +219,41 @@ def test_response_costs_beyond_200_are_flagged() -> None:
 
 def test_correlated_pairs_beyond_0_9_are_listed() -> None:
     page = model_report_html(small_model(responses=False), generated_utc=STAMP)
-    assert re.search(r"<td class=\"mono\">X_u</td><td class=\"mono left\">M_u</td><td class=\"warn\">-0\.950</td>",
-                     page)
+    assert re.search(
+        r"<td class=\"mono\">X_u</td><td class=\"mono left\">M_u</td><td class=\"warn\">-0\.950</td>", page
+    )
     assert page.count('<td class="warn">') == 1  # the 0.5 pair is not listed
 
 
-@pytest.mark.parametrize(("average", "grade"), [
-    (J_AVE_GOOD, "good"), (J_AVE_GOOD + 0.01, "acceptable"), (J_AVE_ACCEPTABLE, "acceptable"),
-    (J_AVE_ACCEPTABLE + 0.01, "poor"), (math.nan, "poor"),
-])
+@pytest.mark.parametrize(
+    ("average", "grade"),
+    [
+        (J_AVE_GOOD, "good"),
+        (J_AVE_GOOD + 0.01, "acceptable"),
+        (J_AVE_ACCEPTABLE, "acceptable"),
+        (J_AVE_ACCEPTABLE + 0.01, "poor"),
+        (math.nan, "poor"),
+    ],
+)
 def test_verdict_on_the_average_cost(average: float, grade: str) -> None:
     verdict = model_verdict(small_model(average=average, costs={"q/delta_lon": 10.0}, responses=False))
     assert verdict.grade == grade
     assert verdict.checks[0].grade == grade
 
 
-@pytest.mark.parametrize(("costs", "accuracy", "grade"), [
-    ({"q/delta_lon": J_RESPONSE_MAX}, {}, "good"),
-    ({"q/delta_lon": J_RESPONSE_MAX + 0.1}, {}, "acceptable"),  # a few single responses may pass 200
-    ({"q/delta_lon": 10.0}, {"X_u": (CR_MAX_PERCENT + 0.5, 1.0)}, "acceptable"),
-    ({"q/delta_lon": 10.0}, {"X_u": (1.0, INSENSITIVITY_MAX_PERCENT + 0.5)}, "acceptable"),
-    ({"q/delta_lon": 10.0}, {"X_u": (CR_MAX_PERCENT, INSENSITIVITY_MAX_PERCENT)}, "good"),
-])
-def test_verdict_on_responses_and_parameters(costs: dict[str, float], accuracy: dict[str, tuple[float, float]],
-                                             grade: str) -> None:
+@pytest.mark.parametrize(
+    ("costs", "accuracy", "grade"),
+    [
+        ({"q/delta_lon": J_RESPONSE_MAX}, {}, "good"),
+        ({"q/delta_lon": J_RESPONSE_MAX + 0.1}, {}, "acceptable"),  # a few single responses may pass 200
+        ({"q/delta_lon": 10.0}, {"X_u": (CR_MAX_PERCENT + 0.5, 1.0)}, "acceptable"),
+        ({"q/delta_lon": 10.0}, {"X_u": (1.0, INSENSITIVITY_MAX_PERCENT + 0.5)}, "acceptable"),
+        ({"q/delta_lon": 10.0}, {"X_u": (CR_MAX_PERCENT, INSENSITIVITY_MAX_PERCENT)}, "good"),
+    ],
+)
+def test_verdict_on_responses_and_parameters(
+    costs: dict[str, float], accuracy: dict[str, tuple[float, float]], grade: str
+) -> None:
     verdict = model_verdict(small_model(average=50.0, costs=costs, accuracy=accuracy, responses=False))
     assert verdict.grade == grade
     if grade != "good":
@@ -189,10 +261,15 @@ def test_verdict_on_responses_and_parameters(costs: dict[str, float], accuracy: 
         assert "X_u" in verdict.sentence or "q/delta_lon" in verdict.sentence
 
 
-@pytest.mark.parametrize(("worst", "grade"), [
-    (TIC_GOOD, "good"), (TIC_GOOD + 0.01, "acceptable"), (TIC_ACCEPTABLE, "acceptable"),
-    (TIC_ACCEPTABLE + 0.01, "poor"),
-])
+@pytest.mark.parametrize(
+    ("worst", "grade"),
+    [
+        (TIC_GOOD, "good"),
+        (TIC_GOOD + 0.01, "acceptable"),
+        (TIC_ACCEPTABLE, "acceptable"),
+        (TIC_ACCEPTABLE + 0.01, "poor"),
+    ],
+)
 def test_verdict_on_the_prediction_of_doublets(worst: float, grade: str) -> None:
     model = small_model(average=50.0, costs={"q/delta_lon": 10.0}, responses=False)
     verdict = model_verdict(model, verification_with({"q": 0.05, "theta": worst}))

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from reports.mrac_report import height_figure, render_mrac_report, theta_figure, write_mrac_report
-from sysid.mrac import CompareConfig, MracComparison, compare_controllers
+from simulator.mrac import CompareConfig, MracComparison, compare_controllers
 
 
 @pytest.fixture(scope="module")

@@ -14,6 +14,7 @@ from reports.model_report import model_report_html
 from reports.verify_figures import display_scale, record_figure, verification_figures, wind_correction_figure
 from sysid.verify import Verification, WindCorrection
 
+
 @pytest.fixture(scope="module")
 def verification(report_browser: ModuleType) -> Verification:
     result: Verification = report_browser.sample_verification()
@@ -53,9 +54,13 @@ def test_a_dollar_in_a_record_label_is_drawn_as_it_is(verification: Verification
 
 
 def test_wind_correction_figure_annotates_the_change() -> None:
-    svg = wind_correction_figure([WindCorrection("ax", "m/s^2", 0.4129, 0.3480),
-                                  WindCorrection("p", "rad/s", 0.1, 0.1),
-                                  WindCorrection("az", "m/s^2", 0.187, 0.295)])
+    svg = wind_correction_figure(
+        [
+            WindCorrection("ax", "m/s^2", 0.4129, 0.3480),
+            WindCorrection("p", "rad/s", 0.1, 0.1),
+            WindCorrection("az", "m/s^2", 0.187, 0.295),
+        ]
+    )
     assert "−16 %" in svg and "+58 %" in svg  # Table 3.6, strong wind: 0.4129 -> 0.3480; a worse az
     assert "−-" not in svg and "−+" not in svg
     assert ">p<" not in svg  # an output the wind term does not change is left out
@@ -74,9 +79,13 @@ def _wind_axes(corrections: list[WindCorrection]):  # type: ignore[no-untyped-de
 
 def test_the_legend_never_covers_a_bar_even_beyond_the_old_axis_limit() -> None:
     """An output made 58 % worse (ratio 1.58 > 1.2) still fits, and the legend sits outside every bar."""
-    ax, renderer = _wind_axes([WindCorrection("ax", "m/s^2", 0.0675, 0.0585),
-                               WindCorrection("az", "m/s^2", 0.187, 0.295),
-                               WindCorrection("w", "m/s", 0.135, 0.141)])
+    ax, renderer = _wind_axes(
+        [
+            WindCorrection("ax", "m/s^2", 0.0675, 0.0585),
+            WindCorrection("az", "m/s^2", 0.187, 0.295),
+            WindCorrection("w", "m/s", 0.135, 0.141),
+        ]
+    )
     assert ax.get_ylim()[1] > 0.295 / 0.187
     legend: Bbox = ax.get_legend().get_window_extent(renderer)
     for bar in ax.patches:
@@ -94,11 +103,13 @@ def test_figures_are_the_wind_bars_then_one_per_record(verification: Verificatio
     assert len(verification_figures(plain)) == len(verification.records)
 
 
-def test_the_report_tables_judge_on_axis_outputs_and_list_the_others(verification: Verification,
-                                                                     report_models: ModuleType) -> None:
-    page = model_report_html(report_models.small_model(responses=False), verification=verification,
-                             generated_utc=report_models.STAMP)
-    section = page[page.index('id="verification"'):page.index('id="reduction"')]
+def test_the_report_tables_judge_on_axis_outputs_and_list_the_others(
+    verification: Verification, report_models: ModuleType
+) -> None:
+    page = model_report_html(
+        report_models.small_model(responses=False), verification=verification, generated_utc=report_models.STAMP
+    )
+    section = page[page.index('id="verification"') : page.index('id="reduction"')]
     judged, informative = section.split("Off-axis outputs", 1)
     for summary in verification.summary:
         assert re.search(rf"<tr><td>{summary.name}</td>.*?<td class=\"mono left\">delta_lon</td></tr>", judged)

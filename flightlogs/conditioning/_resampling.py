@@ -1,0 +1,134 @@
+"""Numerics behind :mod:`flightlogs.conditioning.resample`: time checks, gaps, anti-alias filter, interpolants, spans.
+
+Times are s; a piece is an index range ``[i0, i1)`` of samples between gaps;
+spans are ordered lists of disjoint closed ``(start_s, end_s)`` intervals.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.interpolate import CubicSpline, PchipInterpolator
+from scipy.signal import fftconvolve, firwin, kaiserord
+
+from flightlogs.errors import DataError
+
+__all__: list[str] = []
+
+TIME_TOL_S = 1e-7  # below the 1 µs resolution of log timestamps
+_STOPBAND_DB = 60.0  # anti-alias attenuation from 0.6 × the target rate
+_PASS_EDGE = 0.4  # anti-alias pass-band edge, × target rate
+_STOP_EDGE = 0.6  # anti-alias stop-band edge, × target rate
+
+
+def check_times(time_s: np.ndarray, name: str) -> np.ndarray:
+    """Return `time_s` as float64 after checking it is 1-D, finite and strictly increasing."""
+    t = np.asarray(time_s, dtype=np.float64)
+    if t.ndim != 1 or t.size == 0:
+        raise DataError(f"{name}: times must be a non-empty 1-D array, got shape {t.shape}")
+    if not np.isfinite(t).all():
+        raise DataError(f"{name}: times hold non-finite values")
+    steps = np.diff(t)
+    if (steps <= 0).any():
+        at = int(np.argmax(steps <= 0))
+        raise DataError(f"{name}: time does not increase at sample {at + 1} ({t[at]:.6f} → {t[at + 1]:.6f} s)")
+    return t
+
+
+def check_time_base(time_base: np.ndarray) -> tuple[np.ndarray, float]:
+    """Validate a uniform time base; return it with its sample interval, s."""
+    tb = check_times(time_base, "time_base")
+    if tb.size < 2:
+        raise DataError("time_base must hold at least 2 samples")
+    steps = np.diff(tb)
+    dt = float(np.median(steps))
+    if np.max(np.abs(steps - dt)) > 1e-3 * dt + TIME_TOL_S:
+        raise DataError(f"time_base is not uniform (steps from {steps.min():.6g} to {steps.max():.6g} s)")
+    return tb, float((tb[-1] - tb[0]) / (tb.size - 1))
+
+
+def nominal_interval(t: np.ndarray) -> float:
+    """Median sample interval, s (inf for a single sample)."""
+    return float(np.median(np.diff(t))) if t.size > 1 else np.inf
+
+
+def piece_bounds(t: np.ndarray, dt: float, max_gap_samples: float) -> list[tuple[int, int]]:
+    """Index ranges [i0, i1) of the pieces between gaps longer than `max_gap_samples` × `dt`."""
+    if not (np.isfinite(max_gap_samples) and max_gap_samples >= 1):
+        raise DataError(f"{max_gap_samples=} must be a finite number ≥ 1")
+    cuts = np.flatnonzero(np.diff(t) > max_gap_samples * dt + TIME_TOL_S) + 1
+    edges = np.r_[0, cuts, t.size]
+    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
+
+
+def lowpass(t: np.ndarray, v: np.ndarray, dt_src: float, target_rate_hz: float) -> tuple[np.ndarray, np.ndarray]:
+    """Anti-alias one contiguous piece: uniform grid at the source rate, then a zero-phase FIR."""
+    n_fine = max(int(round((t[-1] - t[0]) / dt_src)) + 1, 2)
+    grid = np.linspace(t[0], t[-1], n_fine)
+    if grid.size == t.size and np.allclose(grid, t, rtol=0.0, atol=TIME_TOL_S):
+        grid, values = t, v
+    else:
+        values = interpolate(t, v, grid, "spline")
+    fs = (n_fine - 1) / (grid[-1] - grid[0])
+    taps = _kaiser_lowpass(fs, target_rate_hz)
+    half = taps.size // 2
+    padded = np.pad(values, half, mode="reflect", reflect_type="odd")
+    return grid, fftconvolve(padded, taps, mode="valid")
+
+
+def _kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
+    """Odd-length, unit-DC-gain Kaiser FIR: pass to 0.4, stop from 0.6 × the target rate."""
+    nyquist = fs_hz / 2.0
+    width = (_STOP_EDGE - _PASS_EDGE) * target_rate_hz / nyquist
+    numtaps, beta = kaiserord(_STOPBAND_DB, min(width, 1.0))
+    numtaps |= 1
+    cutoff = 0.5 * (_PASS_EDGE + _STOP_EDGE) * target_rate_hz
+    return firwin(numtaps, min(cutoff, 0.999 * nyquist), window=("kaiser", beta), fs=fs_hz)
+
+
+def interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: str) -> np.ndarray:
+    """Evaluate the chosen interpolant through (t, v) at times `at` inside [t[0], t[-1]]."""
+    if method == "linear" or t.size < 3:
+        return np.interp(at, t, v)
+    if method == "spline":
+        return CubicSpline(t, v, bc_type="not-a-knot")(at)
+    if method == "pchip":
+        with np.errstate(over="ignore"):  # SciPy divides by slopes that underflow for subnormal data
+            return PchipInterpolator(t, v)(at)
+    raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
+
+
+def complement(pieces: list[tuple[float, float]], lo: float, hi: float) -> list[tuple[float, float]]:
+    """Parts of [lo, hi] not covered by the ordered, disjoint `pieces`."""
+    holes, cursor = [], lo
+    for a, b in pieces:
+        if a > cursor + TIME_TOL_S and cursor < hi:
+            holes.append((cursor, min(a, hi)))
+        cursor = max(cursor, b)
+    if cursor < hi - TIME_TOL_S:
+        holes.append((cursor, hi))
+    return holes
+
+
+def intersect(left: list[tuple[float, float]], right: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """Intersection of two ordered lists of disjoint closed intervals."""
+    out, i, j = [], 0, 0
+    while i < len(left) and j < len(right):
+        a, b = max(left[i][0], right[j][0]), min(left[i][1], right[j][1])
+        if b >= a - TIME_TOL_S:
+            out.append((a, max(a, b)))
+        if left[i][1] < right[j][1]:
+            i += 1
+        else:
+            j += 1
+    return out
+
+
+def snap(intervals: list[tuple[float, float]], grid: np.ndarray) -> list[tuple[float, float]]:
+    """Shrink each interval to the grid samples inside it; drop those holding none."""
+    out = []
+    for a, b in intervals:
+        i0 = int(np.searchsorted(grid, a - TIME_TOL_S, side="left"))
+        i1 = int(np.searchsorted(grid, b + TIME_TOL_S, side="right")) - 1
+        if i1 >= i0:
+            out.append((float(grid[i0]), float(grid[i1])))
+    return out

@@ -1,0 +1,536 @@
+"""Condition a flight for identification: align, resample, rotate, segment, remove trim.
+
+The steps, in order (chapter 3 of the dissertation, section 3.3.3):
+
+1. one uniform time base, by default at the rate of the fastest core signal;
+2. the anemometer wind put on the log's clock (UTC pairing, clock offset,
+   transport delay of Taylor's frozen turbulence, over a distance given or
+   found from the anemometer's and the vehicle's GPS positions) and
+   resampled onto it;
+3. the body air-relative velocity ``u v w`` of eq. 3.1 and the wind in body
+   axes ``wind_lon wind_lat``;
+4. the flight cut where a core signal has a gap, never interpolated across;
+5. maneuvers found (ArduPilot System ID runs, else detected from the mixer
+   inputs with the controller's state feedback removed, see
+   :mod:`flightlogs.maneuvers.excitation_recovery`, or given by the user) and hover stretches;
+6. trim (mean over hover, else over the record) removed and kept.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import pandas as pd
+
+from flightlogs.conditioning.align import WindAlignment, estimate_residual_offset, wind_log_time
+from flightlogs.conditioning.lag import TransportDelay, bearing_and_distance, transport_delay
+from flightlogs.conditioning.resample import contiguous_spans, resample_signals, uniform_time_base
+from flightlogs.errors import DataError
+from flightlogs.flightlog import FlightLog, Signal
+from flightlogs.frames import air_velocity_body, wind_to_body_axes
+from flightlogs.maneuvers.excitation_recovery import estimate_excitation
+from flightlogs.maneuvers.segments import Segment, detect_segments, segments_from_sid
+from flightlogs.record import Record
+
+__all__ = ["ConditioningOptions", "ConditionedFlight", "condition_flight", "CORE_SIGNALS"]
+
+#: Signals whose gaps cut a record; the time base follows the fastest of them.
+CORE_SIGNALS = (
+    "p",
+    "q",
+    "r",
+    "phi",
+    "theta",
+    "psi",
+    "ax",
+    "ay",
+    "az",
+    "delta_lat",
+    "delta_lon",
+    "delta_yaw",
+    "delta_thr",
+)
+_MIXER = {"lat": "delta_lat", "lon": "delta_lon", "yaw": "delta_yaw", "thr": "delta_thr"}
+#: Where the vehicle is: used for the anemometer geometry, not carried into the records.
+_POSITION = ("latitude", "longitude")
+_EARTH_RADIUS_M = 6_371_008.8
+_MAX_GPS_DISTANCE_M = 1000.0  # farther, the anemometer's position is more likely mistyped than meant
+_MIN_CORRELATION_S = 20.0  # shortest stretch a residual clock offset is estimated over
+
+
+@dataclass(frozen=True, slots=True)
+class ConditioningOptions:
+    """Choices for :func:`condition_flight`; every default follows the dissertation.
+
+    Parameters
+    ----------
+    rate_hz : float or None
+        Rate of the common time base, Hz; None for the fastest core signal's.
+    wind_offset_s : float or None
+        Anemometer clock minus the log's reference clock (UTC, or the log's
+        own clock without GPS time), s; None to rely on GPS time alone.
+    estimate_wind_offset : bool
+        Also apply the residual clock offset found by cross-correlation.
+    estimate_transport_delay : bool
+        Find the transport delay by cross-correlation instead (the clock
+        offset is then trusted); a delay and a clock offset shift the wind the
+        same way, so only one of the two can be estimated.
+    wind_distance_m : float or None
+        Anemometer-to-vehicle distance, m (the dissertation: 4.6 m).
+    wind_bearing_rad : float or None
+        Direction from the anemometer to the vehicle, rad from north; None for
+        straight upstream.
+    anemometer_position_rad : tuple of (float, float) or None
+        WGS-84 latitude and longitude of the anemometer, rad. Without
+        `wind_distance_m` and `transport_delay_s`, the distance and bearing
+        come from it to the vehicle's mean GNSS position (signals
+        ``latitude``, ``longitude``) while the anemometer record overlaps the
+        flight.
+    transport_delay_s : float or None
+        Transport delay to use instead of distance / mean speed, s.
+    max_gap_samples : float
+        A core signal silent for more than this many of its sample intervals
+        splits the record.
+    min_record_s : float
+        Pieces shorter than this are dropped, s.
+    segments : tuple of Segment or None
+        Maneuvers given by the user; None to find them.
+    """
+
+    rate_hz: float | None = None
+    wind_offset_s: float | None = None
+    estimate_wind_offset: bool = False
+    estimate_transport_delay: bool = False
+    wind_distance_m: float | None = None
+    wind_bearing_rad: float | None = None
+    anemometer_position_rad: tuple[float, float] | None = None
+    transport_delay_s: float | None = None
+    max_gap_samples: float = 5
+    min_record_s: float = 2.0
+    segments: tuple[Segment, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.estimate_wind_offset and self.estimate_transport_delay:
+            raise ValueError(
+                "estimate either the clock offset or the transport delay, not both: they shift the wind alike"
+            )
+        if self.anemometer_position_rad is not None:
+            lat, lon = (float(v) for v in self.anemometer_position_rad)
+            if not (abs(lat) <= np.pi / 2 and abs(lon) <= np.pi):
+                raise ValueError(
+                    f"anemometer_position_rad={self.anemometer_position_rad} must be a latitude "
+                    "within ±π/2 and a longitude within ±π, rad"
+                )
+            object.__setattr__(self, "anemometer_position_rad", (lat, lon))
+
+
+@dataclass(frozen=True, slots=True)
+class ConditionedFlight:
+    """A flight ready for frequency responses.
+
+    Parameters
+    ----------
+    source : Path
+        The log.
+    records : tuple of Record
+        Contiguous pieces on one uniform time base, trim removed.
+    segments : tuple of Segment
+        Maneuvers and hover stretches, on the log clock.
+    rate_hz : float
+        Rate of the records, Hz.
+    wind : WindAlignment or None
+        How the anemometer was aligned, if one was given.
+    warnings : tuple of str
+        Gaps, doubtful wind, dropped signals.
+    """
+
+    source: Path
+    records: tuple[Record, ...]
+    segments: tuple[Segment, ...]
+    rate_hz: float
+    wind: WindAlignment | None = None
+    warnings: tuple[str, ...] = ()
+
+
+def condition_flight(
+    log: FlightLog,
+    wind: Any | None = None,
+    options: ConditioningOptions = ConditioningOptions(),
+) -> ConditionedFlight:
+    """Align, resample, rotate, segment and de-trim one flight.
+
+    Parameters
+    ----------
+    log : FlightLog
+        The flight, as read.
+    wind : WindMeasurement, optional
+        Anemometer record overlapping the flight (see :func:`flightlogs.conditioning.align.pair_winds`).
+    options : ConditioningOptions, optional
+        Rates, offsets, distances, user segments.
+
+    Returns
+    -------
+    ConditionedFlight
+
+    Raises
+    ------
+    DataError
+        If the log has none of the core signals, no stretch long enough, or
+        the wind cannot be aligned.
+    """
+    if options.estimate_transport_delay and wind is not None:
+        return _with_estimated_delay(log, wind, options)
+    notes: list[str] = []
+    core = {name: _unwrapped(log.signals[name]) for name in CORE_SIGNALS if name in log.signals}
+    if not core:
+        raise DataError(f"{log.path}: none of the core signals ({', '.join(CORE_SIGNALS)}) is in the log")
+    others = {n: s for n, s in log.signals.items() if n not in core and n not in _POSITION}
+    alignment, wind_signals = (None, {}) if wind is None else _wind_signals(log, wind, options, notes)
+    cut_by = core | wind_signals
+    time_base = uniform_time_base(cut_by, rate_hz=options.rate_hz)
+    rate_hz = 1.0 / float(np.median(np.diff(time_base)))
+    spans = contiguous_spans(
+        cut_by, time_base, max_gap_samples=options.max_gap_samples, min_duration_s=options.min_record_s
+    )
+    notes.extend(spans.messages())
+    if not spans.spans:
+        raise DataError(
+            f"{log.path}: no stretch of at least {options.min_record_s:g} s where every core signal has data"
+        )
+    values = resample_signals(cut_by | others, time_base, max_gap_samples=options.max_gap_samples)
+    for name, signal in others.items():
+        values[name] = _hold_edges(values[name], time_base, 1.5 / signal.rate_hz if signal.rate_hz > 0 else 0.0)
+    if "excitation" in values:  # logged only while a System ID run injects it: zero elsewhere
+        values["excitation"] = np.nan_to_num(values["excitation"], nan=0.0)
+    units = {name: sig.unit for name, sig in (cut_by | others).items()}
+    if alignment is not None:
+        alignment = _residual(alignment, time_base, values, rate_hz)
+        if options.estimate_wind_offset and alignment.residual is not None:
+            return _with_estimated_offset(log, wind, options, alignment)
+        if options.estimate_wind_offset:
+            notes.append(
+                f"{log.path}: the clock offset was not estimated: that needs {_MIN_CORRELATION_S:g} s "
+                "where the wind and the autopilot's wind estimate or attitude are logged together; "
+                f"the offset used is {alignment.clock_offset_s:+.3f} s ({alignment.clock_offset_source})"
+            )
+    _derived(values, units, wind_given=bool(wind_signals), notes=notes)
+    segments = _segments(log, time_base, values, options)
+    records = tuple(
+        _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}", notes)
+        for k, span in enumerate(spans.spans)
+    )
+    return ConditionedFlight(log.path, records, segments, rate_hz, alignment, tuple(notes))
+
+
+def _hold_edges(column: np.ndarray, time_base: np.ndarray, max_hold_s: float) -> np.ndarray:
+    """Hold the first and last value of a slower signal over the few core samples it stops short of.
+
+    A 25 Hz estimate that ends 30 ms before the 100 Hz core signals would
+    otherwise leave NaNs at the record's edge and be left out of it.
+    """
+    finite = np.flatnonzero(np.isfinite(column))
+    if finite.size == 0:
+        return column
+    first, last = finite[0], finite[-1]
+    held = column.copy()
+    if time_base[first] - time_base[0] <= max_hold_s:
+        held[:first] = column[first]
+    if time_base[-1] - time_base[last] <= max_hold_s:
+        held[last + 1 :] = column[last]
+    return held
+
+
+def _unwrapped(signal: Signal) -> Signal:
+    """Heading made continuous before it is interpolated (no jumps at ±π)."""
+    if signal.name != "psi":
+        return signal
+    return replace(signal, values=np.unwrap(signal.values), source=f"{signal.source}, unwrapped")
+
+
+def _wind_signals(
+    log: FlightLog, wind: Any, options: ConditioningOptions, notes: list[str]
+) -> tuple[WindAlignment, dict[str, Signal]]:
+    if log.utc_offset_s is None and options.wind_offset_s is None:
+        raise DataError(
+            f"{log.path}: the log has no GPS time, so the anemometer cannot be aligned by UTC; "
+            "give --wind-offset (anemometer time minus log time, s)"
+        )
+    clock_offset = options.wind_offset_s or 0.0
+    source: Literal["gps", "user"] = "user" if options.wind_offset_s is not None else "gps"
+    reference: Literal["utc", "log"] = "utc" if log.utc_offset_s is not None else "log"
+    start, end = log.time_range_s
+    raw_time = wind_log_time(log, wind, clock_offset_s=clock_offset, transport_delay_s=0.0)
+    during = (raw_time >= start) & (raw_time <= end)
+    if during.sum() < 2:
+        raise DataError(f"{wind.path}: the anemometer record does not overlap {log.path.name} in time")
+    wind_ne = np.column_stack([wind.wind_n, wind.wind_e])
+    delay = _transport_delay(log, wind_ne[during], raw_time[during], options, notes)
+    if not delay.frozen_turbulence_holds:
+        notes.append(
+            f"{wind.path}: sigma_M/M = {delay.turbulence_ratio:.2f} is not below 0.5, so Taylor's frozen "
+            "turbulence does not hold: the anemometer wind is a poor stand-in for the wind at the vehicle"
+        )
+    time_s = raw_time + delay.delay_s
+    overlap = float(min(end, time_s[-1]) - max(start, time_s[0]))
+    alignment = WindAlignment(Path(wind.path), reference, clock_offset, source, delay, overlap)
+    series = {
+        name: Signal(name, time_s, column, "m/s", f"{Path(wind.path).name}:{label} (delayed {delay.delay_s:.3f} s)")
+        for name, column, label in (("wind_n", wind.wind_n, "north"), ("wind_e", wind.wind_e, "east"))
+    }
+    return alignment, series
+
+
+def _transport_delay(
+    log: FlightLog, wind_ne: np.ndarray, wind_time_s: np.ndarray, options: ConditioningOptions, notes: list[str]
+) -> TransportDelay:
+    """Distance / mean speed along the line, the line from the options or from GNSS positions."""
+    if options.anemometer_position_rad is None or options.transport_delay_s is not None:
+        return transport_delay(
+            wind_ne,
+            distance_m=options.wind_distance_m,
+            bearing_rad=options.wind_bearing_rad,
+            delay_s=options.transport_delay_s,
+        )
+    if options.wind_distance_m is not None:
+        notes.append(
+            "the anemometer-to-vehicle distance was given (--wind-distance): the anemometer's position is not used"
+        )
+        return transport_delay(wind_ne, distance_m=options.wind_distance_m, bearing_rad=options.wind_bearing_rad)
+    if options.wind_bearing_rad is not None:
+        notes.append(
+            "the bearing from the anemometer to the vehicle comes from their positions; --wind-bearing is not used"
+        )
+    bearing, distance = _gps_geometry(log, options.anemometer_position_rad, wind_time_s, notes)
+    return replace(transport_delay(wind_ne, distance_m=distance, bearing_rad=bearing), source="gps")
+
+
+def _gps_geometry(
+    log: FlightLog, anemometer_rad: tuple[float, float], wind_time_s: np.ndarray, notes: list[str]
+) -> tuple[float, float]:
+    """Bearing (rad) and distance (m) from the anemometer to the vehicle's mean position while the wind overlaps."""
+    if not set(_POSITION) <= log.signals.keys():
+        raise DataError(
+            f"{log.path}: the log holds no GNSS position (latitude, longitude), so the anemometer-to-vehicle "
+            "distance cannot be found from the anemometer's position; give --wind-distance"
+        )
+    lat_signal, lon_signal = log.signals["latitude"], log.signals["longitude"]
+    time_s = lat_signal.time_s
+    inside = (time_s >= wind_time_s[0]) & (time_s <= wind_time_s[-1])
+    if not inside.any():
+        inside = np.ones(time_s.size, dtype=bool)
+    lat = lat_signal.values[inside]
+    lon = np.interp(time_s[inside], lon_signal.time_s, lon_signal.values)
+    mean_lat = float(lat.mean())
+    mean_lon = float(np.arctan2(np.sin(lon).mean(), np.cos(lon).mean()))  # across ±180° too
+    bearing, distance = bearing_and_distance(*anemometer_rad, mean_lat, mean_lon)
+    if distance > _MAX_GPS_DISTANCE_M:
+        raise DataError(
+            f"{log.path}: the anemometer ({np.degrees(anemometer_rad[0]):.6f}, {np.degrees(anemometer_rad[1]):.6f}) "
+            f"is {distance / 1000:.1f} km from the vehicle's mean GPS position ({np.degrees(mean_lat):.6f}, "
+            f"{np.degrees(mean_lon):.6f}), too far for its wind to stand for the vehicle's; check the "
+            "anemometer's position (latitude first, degrees) or give --wind-distance"
+        )
+    north = (lat - mean_lat) * _EARTH_RADIUS_M
+    east = np.angle(np.exp(1j * (lon - mean_lon))) * _EARTH_RADIUS_M * np.cos(mean_lat)
+    spread = float(np.hypot(north, east).max())
+    if spread > 0.5 * distance:
+        notes.append(
+            f"{log.path.name}: the vehicle moved up to {spread:.1f} m from its mean position, which is "
+            f"{distance:.1f} m from the anemometer: one transport delay is a rough stand-in for a varying one"
+        )
+    return bearing, distance
+
+
+def _residual(
+    alignment: WindAlignment, time_base: np.ndarray, values: dict[str, np.ndarray], rate_hz: float
+) -> WindAlignment:
+    """Residual clock offset over the longest stretch where the wind and what it is compared with are logged."""
+    for needed in (("est_wind_n", "est_wind_e"), ("phi", "theta", "psi")):
+        if not set(needed) <= values.keys():
+            continue
+        columns = ("wind_n", "wind_e", *needed)
+        start, stop = _longest_finite_run(np.all([np.isfinite(values[n]) for n in columns], axis=0))
+        if stop - start < _MIN_CORRELATION_S * rate_hz:
+            continue
+        table = {n: values[n][start:stop] for n in columns}
+        estimate, against = estimate_residual_offset(
+            time_base[start:stop], np.column_stack([table["wind_n"], table["wind_e"]]), table, rate_hz
+        )
+        if estimate is not None:
+            return replace(alignment, residual=estimate, residual_against=against)
+    return alignment
+
+
+def _true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Bounds [start, stop) of every run of True in `mask`, in order."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(np.int8), [0]])))
+    return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def _longest_finite_run(mask: np.ndarray) -> tuple[int, int]:
+    """Bounds [start, stop) of the longest run of True in `mask` ((0, 0) if none)."""
+    return max(_true_runs(mask), key=lambda run: run[1] - run[0], default=(0, 0))
+
+
+_MAX_OFFSET_ITERATIONS = 6
+
+
+def _with_estimated_offset(
+    log: FlightLog, wind: Any, options: ConditioningOptions, first: WindAlignment
+) -> ConditionedFlight:
+    """Condition again with the clock offset corrected by the residual found (vehicle lags by +lag).
+
+    A large first residual is measured on a broad correlation peak, so the
+    correction is repeated until what is left is under a tenth of a sample.
+    """
+    assert first.residual is not None
+    corrected = first.clock_offset_s - first.residual.lag_s
+    for _ in range(_MAX_OFFSET_ITERATIONS):
+        again = condition_flight(log, wind, replace(options, wind_offset_s=corrected, estimate_wind_offset=False))
+        assert again.wind is not None
+        left = again.wind.residual
+        if left is None or abs(left.lag_s) < 0.1 / again.rate_hz:
+            break
+        corrected -= left.lag_s
+    assert again.wind is not None
+    alignment = replace(
+        again.wind, clock_offset_source="estimated", residual=first.residual, residual_against=first.residual_against
+    )
+    return replace(again, wind=alignment)
+
+
+def _with_estimated_delay(log: FlightLog, wind: Any, options: ConditioningOptions) -> ConditionedFlight:
+    """Condition without a delay, take the vehicle's lag behind the wind as the delay, condition again."""
+    first = condition_flight(log, wind, replace(options, transport_delay_s=0.0, estimate_transport_delay=False))
+    assert first.wind is not None
+    if first.wind.residual is None:
+        raise DataError(
+            f"{log.path}: the transport delay cannot be estimated: the log has neither an autopilot wind "
+            "estimate nor attitude to correlate the wind with; give --wind-distance or --transport-delay"
+        )
+    delay = first.wind.residual.lag_s
+    if delay < 0:
+        raise DataError(
+            f"{log.path}: the vehicle sees the wind {-delay:.2f} s before the anemometer: it is not upstream "
+            "(or its clock is off); give --wind-distance or --transport-delay"
+        )
+    again = condition_flight(log, wind, replace(options, transport_delay_s=delay, estimate_transport_delay=False))
+    assert again.wind is not None
+    transport = replace(again.wind.transport, source="correlation")
+    return replace(
+        again,
+        wind=replace(
+            again.wind, transport=transport, residual=first.wind.residual, residual_against=first.wind.residual_against
+        ),
+    )
+
+
+def _derived(values: dict[str, np.ndarray], units: dict[str, str], *, wind_given: bool, notes: list[str]) -> None:
+    """Add u v w (eq. 3.1) and, with wind, wind_lon wind_lat."""
+    have = values.keys()
+    wind_ne = np.column_stack([values["wind_n"], values["wind_e"]]) if wind_given else None
+    if {"vn", "ve", "vd", "phi", "theta", "psi"} <= have:
+        n = values["vn"].size
+        uvw = air_velocity_body(
+            np.column_stack([values["vn"], values["ve"], values["vd"]]),
+            wind_ne if wind_ne is not None else np.zeros((n, 2)),
+            values["phi"],
+            values["theta"],
+            values["psi"],
+        )
+        for k, name in enumerate("uvw"):
+            values[name] = uvw[:, k]
+            units[name] = "m/s"
+        if wind_ne is None:
+            notes.append("no wind given: u v w are ground-relative velocities in body axes")
+    if wind_ne is not None and "psi" in have:
+        body = wind_to_body_axes(wind_ne, values["psi"])
+        values["wind_lon"], values["wind_lat"] = body[:, 0], body[:, 1]
+        units["wind_lon"] = units["wind_lat"] = "m/s"
+
+
+def _segments(
+    log: FlightLog, time_base: np.ndarray, values: dict[str, np.ndarray], options: ConditioningOptions
+) -> tuple[Segment, ...]:
+    if options.segments is not None:
+        return tuple(sorted(options.segments, key=lambda s: s.start_s))
+    logged = segments_from_sid(log.system_id_runs) if log.system_id_runs else ()
+    inputs = {axis: values[name] for axis, name in _MIXER.items() if name in values}
+    if not inputs:
+        return tuple(logged)
+    pieces = _between(time_base, logged)
+    quiet = np.zeros(time_base.size, dtype=bool)
+    for start, stop in pieces:
+        quiet[start:stop] = True
+    detected: list[Segment] = []
+    for _ in range(2):  # fit the feedback where nothing is excited, detect, refit without what was found
+        excitation = estimate_excitation(inputs, values, quiet & ~_near(time_base, detected, 2.0), time_s=time_base)
+        detected = [
+            segment
+            for start, stop in pieces
+            for segment in detect_segments(time_base[start:stop], {a: x[start:stop] for a, x in excitation.items()})
+        ]
+    kept = [s for s in detected if not any(_overlaps(s, run) for run in logged)]
+    return tuple(sorted([*logged, *kept], key=lambda s: s.start_s))
+
+
+def _near(time_base: np.ndarray, segments: Sequence[Segment], margin_s: float) -> np.ndarray:
+    """Samples within `margin_s` of a maneuver (hover stretches excepted)."""
+    mask = np.zeros(time_base.size, dtype=bool)
+    for segment in segments:
+        if segment.kind != "hover":
+            mask |= (time_base >= segment.start_s - margin_s) & (time_base <= segment.end_s + margin_s)
+    return mask
+
+
+_MIN_DETECTION_S = 5.0
+
+
+def _between(time_base: np.ndarray, logged: Sequence[Segment]) -> list[tuple[int, int]]:
+    """Index ranges [start, stop) of the stretches outside the logged System ID runs (with 0.5 s margins).
+
+    Detection runs on each separately, so a logged sweep neither merges with
+    its neighbours nor sets their noise floor.
+    """
+    free = np.ones(time_base.size, dtype=bool)
+    for run in logged:
+        free &= (time_base < run.start_s - 0.5) | (time_base > run.end_s + 0.5)
+    rate = 1.0 / float(np.median(np.diff(time_base)))
+    return [(a, b) for a, b in _true_runs(free) if (b - a) / rate >= _MIN_DETECTION_S]
+
+
+def _overlaps(a: Segment, b: Segment) -> bool:
+    return a.start_s < b.end_s and b.start_s < a.end_s
+
+
+def _record(
+    log: FlightLog,
+    time_base: np.ndarray,
+    values: dict[str, np.ndarray],
+    units: dict[str, str],
+    span: tuple[float, float],
+    segments: Sequence[Segment],
+    label: str,
+    notes: list[str],
+) -> Record:
+    inside = (time_base >= span[0] - 1e-9) & (time_base <= span[1] + 1e-9)
+    columns = {}
+    for name, column in values.items():
+        piece = column[inside]
+        if np.all(np.isfinite(piece)):
+            columns[name] = piece
+        else:
+            notes.append(f"{name}: not logged through {label} ({span[0]:.2f}-{span[1]:.2f} s); left out of it")
+    table = pd.DataFrame(columns, index=pd.Index(time_base[inside], name="time_s"))
+    quiet = np.zeros(table.shape[0], dtype=bool)
+    t = table.index.to_numpy()
+    for segment in segments:
+        if segment.kind == "hover":
+            quiet |= (t >= segment.start_s) & (t <= segment.end_s)
+    reference = table[quiet] if quiet.sum() >= 10 else table
+    trim = {str(name): float(value) for name, value in reference.mean().items()}
+    return Record(table - pd.Series(trim), units, trim, log.path, label)

@@ -1,0 +1,383 @@
+"""Maneuver detection in mixer inputs, behind :func:`flightlogs.maneuvers.segments.detect_segments`.
+
+Per axis: a robust trend is removed and short moving envelopes are
+normalised by noise floors (:func:`_activity`); bursts above a threshold are
+merged, shared between axes (:func:`_assign`), given edges against a local
+baseline (:func:`_edges`) and classified from their half-waves
+(:func:`_classify`). Inputs are checked by the caller; indices are samples of
+the uniform time base.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.fft import irfft, next_fast_len, rfft
+from scipy.ndimage import binary_dilation, median_filter, uniform_filter1d
+from scipy.stats import spearmanr
+
+__all__: list[str] = []
+
+_SHORT_S = 0.2  # window of the short moving mean and RMS, s
+_GUARD_S, _BASELINE_S = 1.0, 10.0  # edge baseline: fitted from 11 s to 1 s before the burst
+_QUADRATIC_S = 3.0  # edge baseline: straight below this much quiet trace, quadratic above
+_LOOK_IN_S = 3.0  # edge baseline: trusted this far into a burst, s
+_CALM = 3.0  # edges: calm within 3 noise σ ...
+_RELATIVE_FLOOR = 0.015  # ... or within 1.5 % of the burst's peak, however clean the trace
+_EDGE_PASSES = 6  # edges: searched again from the last edge found until they settle
+
+
+def find_maneuvers(
+    t: np.ndarray,
+    dt: float,
+    traces: dict[str, np.ndarray],
+    threshold: float,
+    trend_window_s: float,
+    merge_gap_s: float,
+    min_active_s: float,
+) -> tuple[list[tuple], list[tuple[int, int]]]:
+    """Maneuvers found in `traces` and the sample ranges kept busy by any activity.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n_samples,)
+        Uniform sample times, s.
+    dt : float
+        Their interval, s.
+    traces : dict of str to ndarray, shape (n_samples,)
+        Finite mixer input by axis.
+    threshold, trend_window_s, merge_gap_s, min_active_s : float
+        As in :func:`flightlogs.maneuvers.segments.detect_segments`.
+
+    Returns
+    -------
+    maneuvers : list of tuple
+        ``(axis, kind, first, last, f_min_hz, f_max_hz)`` per maneuver of a
+        known kind, ``first`` and ``last`` sample indices, in the order the
+        bursts start.
+    busy : list of (int, int)
+        Inclusive index ranges of every maneuver and every reaction to one.
+    """
+    acts = {axis: _activity(x, dt, threshold, trend_window_s) for axis, x in traces.items()}
+    bursts = [b for axis, act in acts.items() for b in _bursts(axis, act, dt, threshold, merge_gap_s, min_active_s)]
+    maneuvers, busy = [], []
+    margin = int(round(_GUARD_S / dt))
+    for owner, reactions in _assign(bursts):
+        axis, i0, i1, _ = owner
+        others = [b for b in bursts if b is not owner and b not in reactions]
+        before = max((b[2] + margin for b in others if b[2] < i0), default=0)
+        after = min((b[1] - margin for b in others if b[1] > i1), default=t.size - 1)
+        lo, hi = _edges(acts[axis], i0, i1, dt, (min(before, i0), max(after, i1)), threshold)
+        busy += [(lo, hi)] + [(b[1], b[2]) for b in reactions]
+        found = _classify(acts[axis], t, lo, hi, threshold)
+        if found is not None:
+            first, last = found[3] if len(found) > 3 else (lo, hi)
+            maneuvers.append((axis, found[0], first, last, found[1], found[2]))
+    return maneuvers, busy
+
+
+@dataclass(frozen=True, slots=True)
+class _Activity:
+    """One axis: raw and detrended trace (n_samples,), normalised envelopes, noise σ of both."""
+
+    raw: np.ndarray
+    detrended: np.ndarray
+    mean_z: np.ndarray  # |0.2 s moving mean| / sigma_mean
+    rms_z: np.ndarray  # 0.2 s moving RMS / sigma
+    sigma: float
+    sigma_mean: float
+
+    def flipped(self) -> _Activity:
+        """The same axis with time reversed (to find an end as a start)."""
+        return _Activity(
+            self.raw[::-1], self.detrended[::-1], self.mean_z[::-1], self.rms_z[::-1], self.sigma, self.sigma_mean
+        )
+
+
+def _activity(x: np.ndarray, dt: float, threshold: float, trend_window_s: float) -> _Activity:
+    """Detrend one axis and normalise its short envelopes by noise floors of quiet stretches."""
+    xd = x - _trend(x, max(3, int(round(trend_window_s / dt)) | 1))
+    width = max(1, int(round(_SHORT_S / dt)))
+    mean = np.abs(uniform_filter1d(xd, width, mode="nearest"))
+    rms = np.sqrt(np.maximum(uniform_filter1d(xd * xd, width, mode="nearest"), 0.0))  # rounding can dip below 0
+    tiny = 1e-12 * max(1.0, float(np.max(np.abs(xd))))
+    quiet = np.ones(xd.size, dtype=bool)
+    for quantile in (0.25, 0.5, 0.5, 0.5):  # the first pass may see more maneuver than quiet
+        sigma = max(_robust_std(xd[quiet], quantile), tiny)
+        sigma_mean = max(_robust_std(mean[quiet], quantile, centred=True), tiny)
+        calm = ~binary_dilation(np.maximum(mean / sigma_mean, rms / sigma) > threshold, iterations=int(1 / dt))
+        if calm.sum() < 10:
+            break
+        quiet = calm
+    return _Activity(x, xd, mean / sigma_mean, rms / sigma, sigma, sigma_mean)
+
+
+def _trend(x: np.ndarray, width: int) -> np.ndarray:
+    """Robust moving quadratic (bisquare weights, from a moving median): trim and drift, not maneuvers.
+
+    A maneuver's lobes lose their weight, so the trend runs through the quiet
+    samples and the zero crossings and follows a curving drift without lag.
+    """
+    trend = median_filter(x, size=width, mode="reflect")
+    half = width // 2
+    n_fft = next_fast_len(x.size + 2 * half, real=True)
+    kernels = rfft((-np.arange(-half, half + 1) / half) ** np.arange(5)[:, None], n_fft)  # moving moments 0-4
+
+    def moving(signal: np.ndarray, k: int) -> list[np.ndarray]:  # its first k moving moments, as fftconvolve "same"
+        return list(irfft(rfft(signal, n_fft) * kernels[:k], n_fft)[:, half : half + x.size])
+
+    idx = np.arange(x.size)
+    for _ in range(3):
+        resid = x - trend
+        r = resid / (4.685 * max(_robust_std(resid, 0.25), 1e-12 * (1.0 + float(np.max(np.abs(x))))))
+        w = np.where(np.abs(r) < 1, (1 - r * r) ** 2, 0.0)
+        m0, m1, m2, m3, m4 = moving(w, 5)
+        b0, b1, b2 = moving(w * x, 3)
+        # normal equations [[m0 m1 m2] [m1 m2 m3] [m2 m3 m4]] c = b; the trend is c0 (Cramer's rule)
+        minor = m2 * m4 - m3 * m3
+        det = m0 * minor - m1 * (m1 * m4 - m3 * m2) + m2 * (m1 * m3 - m2 * m2)
+        good = (m0 > 0.2 * half) & (np.abs(det) > 1e-6 * m0**3)
+        if good.sum() < 2:
+            break
+        c0 = (b0 * minor - m1 * (b1 * m4 - m3 * b2) + m2 * (b1 * m3 - m2 * b2))[good] / det[good]
+        trend = np.interp(idx, idx[good], c0)
+    return trend
+
+
+def _robust_std(x: np.ndarray, quantile: float = 0.5, *, centred: bool = False) -> float:
+    """σ of the quietest part of `x` from a quantile of |x - median| (0.5: 1.4826 × MAD).
+
+    A lower quantile stays right when maneuvers fill more than half the
+    record; `centred` takes x as already |deviations|. Falls back to the
+    standard deviation for quantised traces.
+    """
+    dev = x if centred else np.abs(x - np.median(x))
+    spread = float(np.quantile(dev, quantile)) / {0.5: 0.6745, 0.25: 0.3186}[quantile]
+    return spread if spread > 0 else float(np.std(x))
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """Inclusive index ranges of the True runs of `mask`."""
+    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def _bursts(axis: str, act: _Activity, dt: float, threshold: float, merge_s: float, active_s: float) -> list[tuple]:
+    """(axis, first, last, score) of each burst: active runs merged over short pauses."""
+    active = np.maximum(act.mean_z, act.rms_z) > threshold
+    merged: list[list[int]] = []
+    for a, b in _runs(active):
+        if merged and (a - merged[-1][1]) * dt < merge_s:
+            merged[-1][1] = b
+        else:
+            merged.append([a, b])
+    score = np.maximum(act.mean_z, act.rms_z)
+    return [
+        (axis, a, b, float(np.percentile(score[a : b + 1], 95)))
+        for a, b in merged
+        if active[a : b + 1].sum() * dt >= active_s
+    ]
+
+
+def _assign(bursts: list[tuple]) -> list[tuple[tuple, list[tuple]]]:
+    """Greedy: the strongest burst owns a maneuver; weaker bursts overlapping it are its reactions."""
+    pending, owned = sorted(bursts, key=lambda b: -b[3]), []
+    while pending:
+        owner, rest = pending[0], pending[1:]
+        reactions = [b for b in rest if b[1] <= owner[2] and b[2] >= owner[1]]
+        pending = [b for b in rest if b not in reactions]
+        owned.append((owner, reactions))
+    return sorted(owned, key=lambda pair: pair[0][1])
+
+
+def _edges(act: _Activity, i0: int, i1: int, dt: float, limits: tuple[int, int], threshold: float) -> tuple[int, int]:
+    """First and last sample of the maneuver around burst [i0, i1], within `limits`.
+
+    The end is found as the start of the time-reversed trace. Each edge is
+    searched again from where it was found until it settles, so the baseline
+    ends up next to the edge even when noise misplaced the burst boundary.
+    """
+    peak, n, back = float(np.max(np.abs(act.detrended[i0 : i1 + 1]))), act.raw.size, act.flipped()
+    lo, hi = i0, n - 1 - i1
+    for _ in range(_EDGE_PASSES):
+        lo, before = _onset(act, lo, dt, (limits[0], i1), peak, threshold), lo
+        if lo == before:
+            break
+    for _ in range(_EDGE_PASSES):
+        hi, before = _onset(back, hi, dt, (n - 1 - limits[1], n - 1 - i0), peak, threshold), hi
+        if hi == before:
+            break
+    return lo, max(n - 1 - hi, lo + 1)
+
+
+def _onset(act: _Activity, core: int, dt: float, limits: tuple[int, int], peak: float, threshold: float) -> int:
+    """Last calm sample before the trace leaves its local baseline near `core`.
+
+    The baseline is a robust polynomial through up to `_BASELINE_S` of trace
+    ending `_GUARD_S` before `core`, extended `_LOOK_IN_S` past it: a fade-in
+    too weak to detect lies in the guard, not in the fit, and a curving drift
+    is followed.
+    """
+    guard, x = int(round(_GUARD_S / dt)), act.raw
+    lo = max(core - guard - int(round(_BASELINE_S / dt)), limits[0], 0)
+    hi = int(min(core + _LOOK_IN_S / dt, limits[1], x.size - 1))
+    fit_end = max(lo, core - guard)
+    t = (np.arange(lo, hi + 1) - core) * dt
+    n_fit = fit_end - lo + 1
+    if n_fit >= max(3, int(round(0.5 / dt))):
+        degree = 2 if n_fit * dt >= _QUADRATIC_S else 1
+        d = x[lo : hi + 1] - _robust_poly(t[:n_fit], x[lo : fit_end + 1], degree, t)
+    else:
+        d = act.detrended[lo : hi + 1]
+    width = max(1, int(round(_SHORT_S / dt)))
+    mean = np.abs(uniform_filter1d(d, width, mode="nearest"))
+    rms = np.sqrt(uniform_filter1d(d * d, width, mode="nearest"))
+    floor = _RELATIVE_FLOOR * peak
+    loud = (mean > max(threshold * act.sigma_mean, 2 * floor)) | (rms > max(threshold * act.sigma, 2 * floor))
+    calm = (mean < max(_CALM * act.sigma_mean, floor)) & (rms < max(_CALM * act.sigma, floor))
+    leaving = np.flatnonzero(loud[fit_end - lo :])
+    first = fit_end - lo + int(leaving[0]) if leaving.size else core - lo
+    quiet = np.flatnonzero(calm[:first])
+    return lo + int(quiet[-1]) if quiet.size else lo
+
+
+def _robust_poly(t: np.ndarray, x: np.ndarray, degree: int, at: np.ndarray) -> np.ndarray:
+    """Polynomial fit of x(t), re-weighted twice with bisquare weights, evaluated at `at`."""
+    w = np.ones_like(x)
+    for _ in range(3):
+        coef = np.polyfit(t, x, degree, w=np.sqrt(w))
+        resid = x - np.polyval(coef, t)
+        r = resid / (4.685 * max(_robust_std(resid), 1e-300))
+        w = np.where(np.abs(r) < 1, (1 - r * r) ** 2, 0.0)
+        if np.count_nonzero(w) <= degree + 1:
+            break
+    return np.polyval(coef, at)
+
+
+def _lobes(x: np.ndarray, t: np.ndarray, h: float) -> list[tuple[int, float, float, float]]:
+    """(sign, begin_s, end_s, area) of the half-waves of `x`, cut at zero crossings with hysteresis h.
+
+    A half-wave begins at the zero crossing before `x` passes ±h with the
+    other sign; the first begins at t[0], the last ends at t[-1].
+    """
+    state = np.where(x > h, 1, np.where(x < -h, -1, 0))
+    loud = np.flatnonzero(state)
+    if loud.size == 0:
+        return []
+    firsts = loud[np.r_[0, np.flatnonzero(np.diff(state[loud]) != 0) + 1]]
+    idx = np.arange(x.size)
+    last_nonpos = np.maximum.accumulate(np.where(x <= 0, idx, 0))
+    last_nonneg = np.maximum.accumulate(np.where(x >= 0, idx, 0))
+    bounds = [float(t[0])]
+    for a in firsts[1:]:
+        j = int(last_nonpos[a] if state[a] > 0 else last_nonneg[a])
+        bounds.append(float(t[j] + x[j] / (x[j] - x[j + 1]) * (t[j + 1] - t[j])))
+    bounds.append(float(t[-1]))
+    cum = np.r_[0.0, np.cumsum(0.5 * (x[1:] + x[:-1]) * np.diff(t))]
+    areas = np.diff(np.interp(bounds, t, cum))
+    return [(int(state[a]), b, e, float(s)) for a, b, e, s in zip(firsts, bounds[:-1], bounds[1:], areas)]
+
+
+def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float) -> tuple | None:
+    """(kind, f_min_hz, f_max_hz[, (first, last)]) of the maneuver on samples [lo, hi], or None.
+
+    Doublets and 3211s come with refined bounds: the first and last sample
+    of their two (four) lobes that stand out of the noise (and above 3 % of
+    their peak), since their edges are steps.
+    """
+    x, h = act.detrended[lo : hi + 1], threshold * act.sigma
+    lobes = _lobes(x, t[lo : hi + 1], h)
+    if len(lobes) >= 8:
+        return _oscillation(lobes)
+    if not lobes:
+        return None
+    areas = np.array([abs(lobe[3]) for lobe in lobes])
+    durations = np.array([lobe[2] - lobe[1] for lobe in lobes])
+    big = np.flatnonzero(areas >= 0.25 * areas.max())
+    if big.size == 2 and big[1] == big[0] + 1:
+        area_ratio, time_ratio = areas[big[1]] / areas[big[0]], durations[big[1]] / durations[big[0]]
+        if 1 / 3 <= area_ratio <= 3 and 1 / 3 <= time_ratio <= 3:
+            return "doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h)
+    if big.size == 3 and np.all(np.diff(big) == 1):
+        # closed loop: the rate loop cancels each edge of the doublet, leaving +, -, + (middle largest);
+        # the third lobe is the recovery after the doublet has ended
+        signs = [lobes[i][0] for i in big]
+        if signs[0] == signs[2] == -signs[1] and areas[big[1]] == areas[big].max():
+            return "doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h)
+    if big.size == 4 and np.all(np.diff(big) == 1):
+        # the outer pulses run from the first loud sample and to the last: their steps, not the
+        # zero crossings the noise or the loop's settling move away from them
+        first, last = _loud_span(x, t, lo, lobes[big[0]], lobes[big[3]], h)
+        steps = durations[big].copy()
+        steps[0], steps[3] = lobes[big[0]][2] - t[first], t[last] + (t[1] - t[0]) - lobes[big[3]][1]
+        unit = steps.sum() / 7.0
+        if unit > 0 and np.all(np.abs(steps / unit - [3, 2, 1, 1]) <= [1.0, 0.7, 0.4, 0.4]):
+            return "3211", None, None, (first, last)
+    pair = _dominant_pair(lobes, areas)
+    if pair is not None:
+        return "doublet", None, None, _loud_span(x, t, lo, lobes[pair], lobes[pair + 1], h)
+    return None
+
+
+def _loud_span(x: np.ndarray, t: np.ndarray, lo: int, first: tuple, second: tuple, h: float) -> tuple[int, int]:
+    """Absolute indices of the first and last sample from lobe `first` to `second` that are loud.
+
+    Loud: above `h` in magnitude and above twice the relative floor of the
+    peak, as for the edges (a trace almost free of noise may still drift by
+    a fraction of a percent before its first step).
+    """
+    local = t[lo : lo + x.size]
+    span = (local >= first[1]) & (local <= second[2])
+    if not span.any():
+        return _span(t, lo, first[1], second[2])
+    level = max(h, 2 * _RELATIVE_FLOOR * float(np.max(np.abs(x[span]))))
+    inside = np.flatnonzero(span & (np.abs(x) > level))
+    if inside.size == 0:
+        return _span(t, lo, first[1], second[2])
+    return lo + int(inside[0]), lo + int(inside[-1])
+
+
+def _dominant_pair(lobes: list, areas: np.ndarray) -> int | None:
+    """Index of the adjacent opposite pair of lobes that holds most of the burst, if it looks like a doublet.
+
+    In closed loop with an unstable airframe the controller's reaction adds
+    lobes before and after; the doublet itself is the adjacent pair of
+    opposite sign with the largest area, of similar size (ratio 1/3 to 3),
+    holding at least 45 % of the burst's area.
+    """
+    best, best_area = None, 0.0
+    for i in range(len(lobes) - 1):
+        if lobes[i][0] == -lobes[i + 1][0] and 1 / 3 <= areas[i + 1] / areas[i] <= 3:
+            if areas[i] + areas[i + 1] > best_area:
+                best, best_area = i, areas[i] + areas[i + 1]
+    return best if best is not None and best_area >= 0.45 * areas.sum() else None
+
+
+def _span(t: np.ndarray, lo: int, begin_s: float, end_s: float) -> tuple[int, int]:
+    """Sample indices (absolute) of the times `begin_s`..`end_s` inside the burst starting at `lo`."""
+    del lo  # t is the full time base; kept for symmetry with the caller's indices
+    return int(np.searchsorted(t, begin_s)), min(int(np.searchsorted(t, end_s)), t.size - 1)
+
+
+def _oscillation(lobes: list) -> tuple:
+    """Sweep (frequency trend, or one frequency) or multisine, from the half-wave durations."""
+    durations = np.array([lobe[2] - lobe[1] for lobe in lobes[:-1]])  # the last may be cut short
+    freq = 0.5 / durations
+    mid = np.array([0.5 * (lobe[1] + lobe[2]) for lobe in lobes[:-1]])
+    smooth = np.array([np.median(freq[max(0, i - 1) : i + 2]) for i in range(freq.size)])
+    f_min, f_max = float(min(freq[0], smooth.min())), float(smooth.max())
+    if (abs(spearmanr(mid, freq).statistic) > 0.6 and f_max > 2 * f_min) or f_max < 1.5 * f_min:
+        return "sweep", f_min, f_max
+    return "multisine", f_min, f_max
+
+
+def hover_spans(
+    t: np.ndarray, busy: list[tuple[int, int]], min_hover_s: float, margin_s: float
+) -> list[tuple[float, float]]:
+    """``(start_s, end_s)`` of the stretches at least `min_hover_s` long and `margin_s` from any `busy` range."""
+    quiet = np.ones(t.size, dtype=bool)
+    pad = int(round(margin_s / (t[1] - t[0])))
+    for lo, hi in busy:
+        quiet[max(0, lo - pad) : hi + pad + 1] = False
+    return [(float(t[a]), float(t[b])) for a, b in _runs(quiet) if t[b] - t[a] >= min_hover_s]

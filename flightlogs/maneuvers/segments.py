@@ -1,0 +1,497 @@
+"""Find the maneuvers in a flight: sweeps, doublets, 3211s, multisines and hover.
+
+Spectra must be taken on the right pieces of a flight. The pieces come from
+three places, in order of trust: ``"sids"``, the runs ArduPilot's System ID
+mode logs when it starts a sweep (SIDS messages, in
+:attr:`FlightLog.system_id_runs <flightlogs.flightlog.FlightLog>`;
+:func:`segments_from_sid`); ``"user"``, a TOML or CSV file the engineer
+writes (:func:`read_segments_file`);
+``"detected"``, found from the mixer inputs alone (:func:`detect_segments`).
+Axes are the mixer inputs: ``lat`` (delta_lat, roll), ``lon`` (delta_lon,
+pitch), ``yaw`` (delta_yaw) and ``thr`` (delta_thr).
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+from typing import Any, Literal, get_args
+
+import numpy as np
+
+from flightlogs.errors import DataError
+from flightlogs.flightlog import SystemIdRun
+from flightlogs.maneuvers.detection import find_maneuvers, hover_spans
+
+__all__ = [
+    "Axis",
+    "Kind",
+    "SegmentSource",
+    "AXES",
+    "SID_AXES",
+    "Segment",
+    "detect_segments",
+    "segments_from_sid",
+    "read_segments_file",
+]
+
+Axis = Literal["lat", "lon", "yaw", "thr"]
+Kind = Literal["sweep", "doublet", "3211", "multisine", "hover"]
+SegmentSource = Literal["sids", "detected", "user"]
+
+#: Mixer axes in canonical order (delta_lat, delta_lon, delta_yaw, delta_thr).
+AXES: tuple[str, ...] = get_args(Axis)
+
+#: ArduCopter ``SID_AXIS`` values: (mixer axis excited, ArduPilot's name).
+#: Source: ``@Values`` of ``SID_AXIS`` in ``ArduCopter/mode_systemid.cpp``.
+#: 1-3 angle input, 4-6 the same with feed-forward off ("recovery"), 7-9 rate,
+#: 10-13 mixer; 14-19 act on the position loops and map to the attitude axis
+#: that flies them.
+SID_AXES: dict[int, tuple[str, str]] = {
+    1: ("lat", "Input Roll Angle"),
+    2: ("lon", "Input Pitch Angle"),
+    3: ("yaw", "Input Yaw Angle"),
+    4: ("lat", "Recovery Roll Angle"),
+    5: ("lon", "Recovery Pitch Angle"),
+    6: ("yaw", "Recovery Yaw Angle"),
+    7: ("lat", "Rate Roll"),
+    8: ("lon", "Rate Pitch"),
+    9: ("yaw", "Rate Yaw"),
+    10: ("lat", "Mixer Roll"),
+    11: ("lon", "Mixer Pitch"),
+    12: ("yaw", "Mixer Yaw"),
+    13: ("thr", "Mixer Thrust"),
+    14: ("lat", "Measured Lateral Position"),
+    15: ("lon", "Measured Longitudinal Position"),
+    16: ("lat", "Measured Lateral Velocity"),
+    17: ("lon", "Measured Longitudinal Velocity"),
+    18: ("lat", "Input Lateral Velocity"),
+    19: ("lon", "Input Longitudinal Velocity"),
+}
+
+_SID_FIELDS = {
+    "Ax": "axis",
+    "Mag": "magnitude",
+    "FSt": "f_start_hz",
+    "FSp": "f_stop_hz",
+    "TFin": "fade_in_s",
+    "TC": "const_s",
+    "TR": "record_s",
+    "TFout": "fade_out_s",
+}
+_USER_KEYS = ("start_s", "end_s", "axis", "kind", "f_min_hz", "f_max_hz")
+
+
+@dataclass(frozen=True, slots=True)
+class Segment:
+    """One maneuver, or one stretch of hover, in a flight.
+
+    Parameters
+    ----------
+    axis : {"lat", "lon", "yaw", "thr"} or None
+        Mixer axis excited; None exactly when `kind` is ``"hover"``.
+    kind : {"sweep", "doublet", "3211", "multisine", "hover"}
+        What was flown.
+    start_s, end_s : float
+        Bounds on the log clock, s; a fade-in is inside.
+    source : {"sids", "detected", "user"}
+        Where the segment came from.
+    f_min_hz, f_max_hz : float or None, optional
+        Frequency range of a sweep (or multisine), Hz.
+    detail : str, optional
+        Free text, e.g. the ArduPilot axis that was excited.
+    """
+
+    axis: Axis | None
+    kind: Kind
+    start_s: float
+    end_s: float
+    source: SegmentSource
+    f_min_hz: float | None = None
+    f_max_hz: float | None = None
+    detail: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in get_args(Kind):
+            raise DataError(f"unknown kind {self.kind!r} (expected {', '.join(get_args(Kind))})")
+        if self.kind == "hover" and self.axis is not None:
+            raise DataError(f"a hover segment has no axis, got axis={self.axis!r}")
+        if self.kind != "hover" and self.axis not in AXES:
+            raise DataError(f"unknown axis {self.axis!r} for a {self.kind} (expected {', '.join(AXES)})")
+        if self.source not in get_args(SegmentSource):
+            raise DataError(f"unknown source {self.source!r}")
+        start, end = float(self.start_s), float(self.end_s)
+        if not (np.isfinite(start) and np.isfinite(end)) or end <= start:
+            raise DataError(f"end_s={end:g} must be after start_s={start:g}")
+        object.__setattr__(self, "start_s", start)
+        object.__setattr__(self, "end_s", end)
+        for name in ("f_min_hz", "f_max_hz"):
+            value = getattr(self, name)
+            if value is not None and not (np.isfinite(value) and value > 0):
+                raise DataError(f"{name}={value} must be a positive frequency in Hz")
+            object.__setattr__(self, name, None if value is None else float(value))
+        if self.f_min_hz is not None and self.f_max_hz is not None and self.f_max_hz < self.f_min_hz:
+            raise DataError(f"f_max_hz={self.f_max_hz:g} is below f_min_hz={self.f_min_hz:g}")
+
+    @property
+    def duration_s(self) -> float:
+        """Length of the segment, s."""
+        return self.end_s - self.start_s
+
+
+def detect_segments(
+    time_s: np.ndarray,
+    inputs: Mapping[str, np.ndarray],
+    *,
+    min_hover_s: float = 3.0,
+    threshold: float = 4.0,
+    trend_window_s: float = 10.0,
+    merge_gap_s: float = 2.0,
+    min_active_s: float = 0.3,
+    hover_margin_s: float = 0.5,
+) -> tuple[Segment, ...]:
+    """Find sweeps, doublets, 3211s, multisines and hover in mixer inputs.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (n_samples,)
+        Uniform sample times, s.
+    inputs : Mapping[str, ndarray of shape (n_samples,)]
+        Mixer input by axis (``"lat"``, ``"lon"``, ``"yaw"``, ``"thr"``; any
+        subset), as logged, finite.
+    min_hover_s : float, optional
+        Shortest stretch, quiet on every axis, reported as hover, s. Default 3.
+    threshold : float, optional
+        Activity threshold in noise-floor units. Default 4.
+    trend_window_s : float, optional
+        Window of the robust trend that removes trim and slow pilot inputs,
+        s; about one period of the lowest sweep frequency. Default 10.
+    merge_gap_s : float, optional
+        Active stretches on one axis closer than this are one maneuver, s.
+        Default 2.
+    min_active_s : float, optional
+        Bursts active for less than this in total are ignored, s. Default 0.3.
+    hover_margin_s : float, optional
+        Hover keeps this far from any activity, s. Default 0.5.
+
+    Returns
+    -------
+    tuple of Segment
+        In time order, ``source="detected"``. Activity of no known kind
+        (pilot repositioning, take-off) is not returned but interrupts hover.
+
+    Raises
+    ------
+    DataError
+        If `time_s` is not uniform, an axis is unknown, or an input has the
+        wrong length or non-finite values.
+
+    Notes
+    -----
+    Per axis, a robust (bisquare) moving quadratic removes trim and drift;
+    a 0.2 s moving mean (which sees the slow start of a faded-in sweep) and
+    moving RMS (which sees its fast end) are normalised by noise floors of
+    the quiet stretches. A burst is a run above `threshold`; overlapping
+    bursts on several axes are one maneuver, owned by the axis with the
+    largest normalised activity, the others being the closed loop's
+    reaction. Each edge is where the owner's trace leaves a baseline fitted
+    to the 10 s of trace before it (after it, for the end), within 3 σ or
+    1.5 % of the peak; for clean inputs they fall within about 0.1-0.3 s of
+    the excitation (a fade-in is found once it rises out of the noise). The
+    trace is cut into half-waves at zero crossings (hysteresis `threshold`
+    σ): two large ones of similar area make a doublet, four of durations
+    3:2:1:1 (the outer two timed from the first and to the last loud
+    sample) a 3211, both bounded by those samples since their edges are
+    steps; eight or more with a frequency trend (Spearman |ρ| > 0.6, range
+    over 2:1) or at one frequency a sweep, otherwise a multisine. In closed
+    loop, pass the excitation of :func:`flightlogs.maneuvers.excitation_recovery.estimate_excitation`,
+    which fits doublets and 3-2-1-1s jointly with the feedback (a 3-2-1-1 bent
+    by a poorly fitted feedback can show an adjacent pair of pulses that
+    passes for a doublet).
+    """
+    t, dt = _uniform(time_s)
+    traces = _check_inputs(inputs, t.size)
+    maneuvers, busy = find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s)
+    segments = [
+        Segment(axis, kind, t[lo], t[hi], "detected", f_min, f_max) for axis, kind, lo, hi, f_min, f_max in maneuvers
+    ]
+    segments += [Segment(None, "hover", a, b, "detected") for a, b in hover_spans(t, busy, min_hover_s, hover_margin_s)]
+    return tuple(sorted(segments, key=lambda s: s.start_s))
+
+
+def segments_from_sid(
+    runs: Sequence[SystemIdRun] | Mapping[str, Any],
+    *,
+    sidd_time_s: np.ndarray | None = None,
+    extent: Literal["excitation", "mode"] = "excitation",
+    delay_s: float = 1.0,
+) -> tuple[Segment, ...]:
+    """Turn ArduPilot System ID runs into sweep segments.
+
+    Parameters
+    ----------
+    runs : sequence of SystemIdRun, or Mapping of SIDS field name to array
+        The runs, as in :attr:`FlightLog.system_id_runs
+        <flightlogs.flightlog.FlightLog>` (a run ends at its `end_s`, the
+        last SIDD sample, at the latest; NaN when unknown); or the SIDS
+        messages as columns, holding ``TimeUS`` (µs) or ``time_s`` (s) and
+        ``Ax, Mag, FSt, FSp, TFin, TC, TR, TFout``, with no end known.
+    sidd_time_s : ndarray, shape (n_samples,), optional
+        Times of the SIDD samples, s. A run ends at its last SIDD sample at
+        the latest (the mode was left early, or stopped on a lean-angle
+        limit); a run without any SIDD sample is dropped.
+    extent : {"excitation", "mode"}, optional
+        ``"excitation"`` (default): from ``start_s + delay_s`` to
+        ``start_s + delay_s + TR``, where the chirp is non-zero; ``"mode"``:
+        from ``start_s`` to ``start_s + delay_s + TFin + TC + TR + TFout``,
+        when the mode reports "SystemID Finished".
+    delay_s : float, optional
+        Wait between entering the mode and starting the chirp, s
+        (``SYSTEM_ID_DELAY``, 1 s in ArduCopter). Default 1.
+
+    Returns
+    -------
+    tuple of Segment
+        One ``kind="sweep"``, ``source="sids"`` segment per run, in time order,
+        with `f_min_hz` and `f_max_hz` from FSt and FSp.
+
+    Raises
+    ------
+    DataError
+        If a field is missing or not finite, or a run names an unknown
+        ``SID_AXIS``.
+
+    Notes
+    -----
+    ``ModeSystemId::init`` writes SIDS on entering the mode and ``run`` feeds
+    ``Chirp::update(t - SYSTEM_ID_DELAY)``; in ``AP_Math/chirp.cpp`` the
+    fade-in, the dwell (``TC = 2 / FSt``) and the fade-out all lie inside
+    ``TR``, after which the chirp is zero.
+
+    Examples
+    --------
+    >>> run = SystemIdRun(100.0, float("nan"), 11, "mixer pitch", 0.1, 0.1, 10.0, 2.0, 20.0, 34.0, 1.0)
+    >>> seg, = segments_from_sid([run])
+    >>> seg.axis, seg.start_s, seg.end_s, seg.f_min_hz
+    ('lon', 101.0, 135.0, 0.1)
+    """
+    if extent not in ("excitation", "mode"):
+        raise DataError(f"{extent=} must be 'excitation' or 'mode'")
+    table = sorted(_sids_runs(runs), key=lambda r: r.start_s)
+    sidd = None if sidd_time_s is None else np.sort(np.asarray(sidd_time_s, dtype=np.float64))
+    out = []
+    for k, run in enumerate(table):
+        if run.axis not in SID_AXES:
+            raise DataError(f"SIDS row at {run.start_s:.2f} s: SID_AXIS={run.axis} is not a known axis (1-19)")
+        axis, name = SID_AXES[run.axis]
+        start, end = run.start_s + delay_s, run.start_s + delay_s + run.record_s
+        if extent == "mode":
+            start, end = run.start_s, end + run.fade_in_s + run.const_s + run.fade_out_s
+        if np.isfinite(run.end_s):
+            end = min(end, run.end_s)
+        if sidd is not None:
+            next_start = table[k + 1].start_s if k + 1 < len(table) else np.inf
+            inside = sidd[(sidd >= run.start_s) & (sidd < next_start)]
+            end = min(end, float(inside[-1])) if inside.size else -np.inf
+        if end <= start:
+            continue
+        lo, hi = sorted((run.f_start_hz, run.f_stop_hz))
+        detail = f"SID_AXIS={run.axis} ({name}), magnitude {run.magnitude:g}"
+        out.append(Segment(axis, "sweep", start, end, "sids", lo, hi, detail))  # type: ignore[arg-type]
+    return tuple(out)
+
+
+def read_segments_file(path: str | Path) -> tuple[Segment, ...]:
+    """Read user-defined segments from a TOML or CSV file.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.toml`` with ``[[segment]]`` tables (keys ``start_s``, ``end_s``,
+        ``axis``, ``kind``, ``f_min_hz``, ``f_max_hz``), or ``.csv`` with rows
+        ``start_s,end_s,axis[,kind[,f_min_hz,f_max_hz]]`` (a header row naming
+        the columns is optional; ``#`` starts a comment line). `kind` defaults
+        to ``"sweep"``; hover rows leave `axis` empty.
+
+    Returns
+    -------
+    tuple of Segment
+        ``source="user"``, in time order.
+
+    Raises
+    ------
+    DataError
+        If the file cannot be read or parsed, holds no segment, or a row is
+        invalid (end before start, unknown axis or kind, not a number); the
+        message names the file and the line.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     path = Path(tmp) / "segments.csv"
+    ...     _ = path.write_text("start_s,end_s,axis,kind\\n12.5,46.5,lon,sweep\\n")
+    ...     read_segments_file(path)[0].axis
+    'lon'
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        raise DataError(f"{path}: cannot be read ({err}).") from err
+    suffix = path.suffix.lower()
+    if suffix not in (".toml", ".csv"):
+        raise DataError(f"{path}: a segments file is .toml or .csv, not {suffix or 'without extension'}.")
+    entries = _toml_entries(path, text) if suffix == ".toml" else _csv_entries(path, text)
+    if not entries:
+        raise DataError(f"{path}: no segment found.")
+    segments = []
+    for line, entry in entries:
+        try:
+            segments.append(_user_segment(entry))
+        except DataError as err:
+            raise DataError(f"{path}:{line}: {err}.") from None
+    return tuple(sorted(segments, key=lambda s: s.start_s))
+
+
+# ------------------------------------------------------------------ checks of detection inputs
+
+
+def _uniform(time_s: np.ndarray) -> tuple[np.ndarray, float]:
+    t = np.asarray(time_s, dtype=np.float64)
+    if t.ndim != 1 or t.size < 10 or not np.isfinite(t).all():
+        raise DataError(f"time_s must be a finite 1-D array of at least 10 samples, got shape {t.shape}")
+    steps = np.diff(t)
+    dt = float(np.median(steps))
+    if dt <= 0 or np.max(np.abs(steps - dt)) > 1e-3 * dt:
+        raise DataError("time_s must be uniformly sampled; resample the inputs first")
+    return t, dt
+
+
+def _check_inputs(inputs: Mapping[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
+    if not inputs:
+        raise DataError("no mixer input given")
+    traces = {}
+    for axis, values in inputs.items():
+        x = np.asarray(values, dtype=np.float64)
+        if axis not in AXES:
+            raise DataError(f"unknown axis {axis!r} (expected {', '.join(AXES)})")
+        if x.shape != (n,):
+            raise DataError(f"input {axis!r} has shape {x.shape}, time_s has {n} samples")
+        if not np.isfinite(x).all():
+            raise DataError(f"input {axis!r} holds non-finite values; split the record at its gaps")
+        traces[axis] = x
+    return traces
+
+
+# ------------------------------------------------------------------ System ID runs and segment files
+
+
+def _sids_runs(runs: Sequence[SystemIdRun] | Mapping[str, Any]) -> list[SystemIdRun]:
+    """Checked runs, from runs or from SIDS columns (whose runs have no known end)."""
+    if not isinstance(runs, Mapping):
+        return [_checked_run(run) for run in runs]
+    if "time_s" in runs:
+        times = np.asarray(runs["time_s"], dtype=np.float64)
+    elif "TimeUS" in runs:
+        times = np.asarray(runs["TimeUS"], dtype=np.float64) * 1e-6
+    else:
+        raise DataError("SIDS rows need a TimeUS (µs) or time_s (s) column")
+    missing = [name for name in _SID_FIELDS if name not in runs]
+    if missing:
+        raise DataError(f"SIDS rows lack the field(s) {', '.join(missing)}")
+    columns = {ours: np.asarray(runs[name], dtype=np.float64) for name, ours in _SID_FIELDS.items()}
+    rows = [
+        SystemIdRun(
+            float(t),
+            float("nan"),
+            int(columns["axis"][i]),
+            "",
+            *(float(columns[k][i]) for k in _SID_FIELDS.values() if k != "axis"),
+        )
+        for i, t in enumerate(times)
+    ]
+    return [replace(run, axis_name=_axis_name(run.axis)) for run in map(_checked_run, rows)]
+
+
+def _axis_name(axis: int) -> str:
+    """ArduPilot's name of a ``SID_AXIS`` in lower case (``"rate roll"``), ``"other"`` if unknown."""
+    return SID_AXES[axis][1].lower() if axis in SID_AXES else "other"
+
+
+def _checked_run(run: SystemIdRun) -> SystemIdRun:
+    """`run` with an integer axis, after checking its settings are finite (a non-finite end is unknown)."""
+    for item in fields(SystemIdRun):
+        value = getattr(run, item.name)
+        if item.name not in ("end_s", "axis_name") and not np.isfinite(value):
+            raise DataError(f"SIDS row at {run.start_s}: {item.name}={value} is not finite")
+    if int(run.axis) != run.axis:
+        raise DataError(f"SIDS row at {run.start_s:.2f} s: axis={run.axis} is not an integer")
+    return replace(run, axis=int(run.axis))
+
+
+def _toml_entries(path: Path, text: str) -> list[tuple[int, dict]]:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise DataError(f"{path}: not valid TOML ({err}).") from err
+    unknown = [key for key in data if key != "segment"]
+    if unknown:
+        raise DataError(f"{path}: unknown top-level key {unknown[0]!r} (expected [[segment]] tables).")
+    tables = data.get("segment", [])
+    if not isinstance(tables, list) or not all(isinstance(item, dict) for item in tables):
+        raise DataError(f"{path}: 'segment' must be an array of tables, written [[segment]].")
+    lines = [n for n, row in enumerate(text.splitlines(), 1) if re.match(r"\s*\[\[\s*segment\s*\]\]", row)]
+    return list(zip(lines + [0] * (len(tables) - len(lines)), tables))
+
+
+def _csv_entries(path: Path, text: str) -> list[tuple[int, dict]]:
+    entries: list[tuple[int, dict]] = []
+    header = None
+    for line, row in enumerate(csv.reader(text.splitlines()), 1):
+        cells = [cell.strip() for cell in row]
+        if not any(cells) or cells[0].startswith("#"):
+            continue
+        if header is None and not entries and not _is_number(cells[0]):
+            header = [cell.lower() for cell in cells]
+            unknown = [name for name in header if name not in _USER_KEYS]
+            if unknown:
+                raise DataError(f"{path}:{line}: unknown column {unknown[0]!r} (expected {', '.join(_USER_KEYS)}).")
+            continue
+        names = header or list(_USER_KEYS)
+        if len(cells) > len(names):
+            raise DataError(f"{path}:{line}: {len(cells)} fields, expected at most {len(names)}.")
+        entries.append((line, {name: cell for name, cell in zip(names, cells) if cell != ""}))
+    return entries
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _user_segment(entry: dict) -> Segment:
+    unknown = [key for key in entry if key not in _USER_KEYS]
+    if unknown:
+        raise DataError(f"unknown key {unknown[0]!r} (expected {', '.join(_USER_KEYS)})")
+    values: dict[str, Any] = {}
+    for key in ("start_s", "end_s", "f_min_hz", "f_max_hz"):
+        if key in entry:
+            try:
+                values[key] = float(entry[key])
+            except (TypeError, ValueError):
+                raise DataError(f"{key}={entry[key]!r} is not a number") from None
+        elif key in ("start_s", "end_s"):
+            raise DataError(f"{key} is missing")
+    if values["end_s"] <= values["start_s"]:
+        raise DataError(f"end_s={values['end_s']:g} is not after start_s={values['start_s']:g}")
+    axis = str(entry.get("axis", "")).strip().lower()
+    kind = str(entry.get("kind", "sweep")).strip().lower()
+    return Segment(None if axis in ("", "none") else axis, kind, source="user", **values)  # type: ignore[arg-type]

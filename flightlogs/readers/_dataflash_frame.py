@@ -1,0 +1,281 @@
+"""Framing of DataFlash bytes: where each message is, and the layout it has.
+
+The implementation behind :func:`flightlogs.readers.dataflash.decode_messages`; the
+rules (DFReader's, quirks included) are in :mod:`flightlogs.readers.dataflash`. FMT
+messages are parsed from header candidates found by a vectorised scan, the
+chain of messages is walked as DFReader steps, the bytes left over are
+reported, and the offsets are grouped per layout. :class:`MessageFormat` is
+re-exported by :mod:`flightlogs.readers.dataflash`.
+"""
+
+from __future__ import annotations
+
+import bisect
+import struct
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+from pymavlink.DFReader import FORMAT_TO_STRUCT, DFFormat
+
+from flightlogs.errors import LogFormatError
+
+__all__ = ["MessageFormat"]
+
+HEAD1, HEAD2, FMT_TYPE = 0xA3, 0x95, 0x80
+LISTED = 8  # gaps or resets spelled out in warnings before summarising
+_FMT = DFFormat(FMT_TYPE, "FMT", 89, "BBnNZ", "Type,Length,Name,Format,Columns")  # as DFReader
+_NUMPY_CODE = {
+    "b": "i1",
+    "B": "u1",
+    "h": "<i2",
+    "H": "<u2",
+    "i": "<i4",
+    "I": "<u4",
+    "f": "<f4",
+    "d": "<f8",
+    "e": "<f2",
+    "q": "<i8",
+    "Q": "<u8",
+}
+_CHAR_SIZE = {c: struct.calcsize("<" + code) for c, (code, _, _) in FORMAT_TO_STRUCT.items()}
+_VALID_CHARS = frozenset(FORMAT_TO_STRUCT)
+
+
+@dataclass(frozen=True, slots=True)
+class MessageFormat:
+    """Layout of one message type, from its FMT (and FMTU) messages.
+
+    Parameters
+    ----------
+    type_id : int
+        Message type byte (0-255).
+    name : str
+        Message name, e.g. ``"IMU"``.
+    length : int
+        Message length in bytes, 3-byte header included.
+    format : str
+        DataFlash format characters, one per column.
+    columns : tuple of str
+        Column names.
+    units : tuple of str
+        Unit of each column as DFReader derives it from FMTU/UNIT/MULT
+        (``""`` when unknown); empty when the log has no FMTU.
+    instance_field : str or None
+        Column holding the sensor instance (FMTU ``#``), if any.
+    """
+
+    type_id: int
+    name: str
+    length: int
+    format: str
+    columns: tuple[str, ...]
+    units: tuple[str, ...] = ()
+    instance_field: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class _Definition:
+    """One FMT message, parsed; `decodable` when its Length fits its format characters."""
+
+    offset: int
+    fmt: MessageFormat
+    decodable: bool
+
+
+_FMT_DEF = _Definition(-1, MessageFormat(FMT_TYPE, "FMT", _FMT.len, _FMT.format, tuple(_FMT.columns)), True)
+
+
+def frame_messages(
+    buf: np.ndarray, path: Path, warnings: list[str]
+) -> tuple[list[tuple[str, MessageFormat, np.ndarray]], int]:
+    """``(table key, format, offsets)`` of the messages DFReader would decode, per layout; bytes skipped.
+
+    The FMT messages on the chain of messages define the chain (types and
+    lengths), so the walk is repeated until the two agree (once, in practice).
+    """
+    heads = np.flatnonzero(buf[:-2] == HEAD1) if buf.size > 2 else np.empty(0, np.int64)
+    heads = heads[buf[heads + 1] == HEAD2].astype(np.int64)
+    parsed = {
+        d.offset: d for d in _parse_fmts(buf, heads[(buf[heads + 2] == FMT_TYPE) & (heads + _FMT.len <= buf.size)])
+    }
+    on_chain = {o for o, d in parsed.items() if d.decodable and d.fmt.name.isprintable() and d.fmt.name}
+    for _ in range(6):
+        by_type = _by_type([parsed[o] for o in sorted(on_chain) if o in parsed])
+        starts, ends, decodes = _walk(buf, heads, by_type)
+        found = set(starts[buf[starts + 2] == FMT_TYPE].tolist())
+        if found == on_chain:
+            break
+        on_chain = found
+    if len(by_type) == 1:
+        kind = "a text DataFlash log" if buf[:4].tobytes() == b"FMT," else "no DataFlash FMT message"
+        raise LogFormatError(f"{path}: holds {kind} (searched {buf.size} bytes from byte offset 0).")
+    offsets, skipped = _account(buf, starts, ends, decodes, path, warnings)
+    return _layouts(buf, offsets, by_type, path, warnings), skipped
+
+
+def _by_type(defs: list[_Definition]) -> dict[int, list[_Definition]]:
+    by_type: dict[int, list[_Definition]] = {FMT_TYPE: [_FMT_DEF]}
+    for d in defs:
+        if d.fmt.type_id != FMT_TYPE:
+            by_type.setdefault(d.fmt.type_id, []).append(d)
+    return by_type
+
+
+def _walk(
+    buf: np.ndarray, heads: np.ndarray, by_type: dict[int, list[_Definition]]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Start, end and decodability of each message, stepping as DFReader does.
+
+    After a message, the next one is the first candidate ``A3 95 <known
+    type>`` at or after its end. The Python loop turns once per
+    discontinuity (garbage, a header inside a payload), not per message.
+    """
+    types = buf[heads + 2]
+    lenmap, okmap = np.zeros(256, np.int64), np.zeros(256, bool)
+    for type_id, defs in by_type.items():
+        lenmap[type_id], okmap[type_id] = defs[-1].fmt.length if defs[-1].decodable else 3, defs[-1].decodable
+    lengths, decodes = lenmap[types], okmap[types]
+    for defs in by_type.values():
+        if len({(d.fmt.length, d.decodable) for d in defs}) > 1:  # length redefined: the FMT in force
+            sel = np.flatnonzero(types == defs[0].fmt.type_id)
+            which = np.searchsorted([d.offset for d in defs], heads[sel]) - 1  # -1: the last (DFReader preload)
+            lengths[sel] = np.array([d.fmt.length if d.decodable else 3 for d in defs])[which]
+            decodes[sel] = np.array([d.decodable for d in defs])[which]
+    known = lengths > 0
+    cand, ends, decodes = heads[known], heads[known] + lengths[known], decodes[known]
+    nxt = np.arange(1, cand.size + 1)
+    jump = np.flatnonzero(ends[:-1] != cand[1:])  # usually a message ends where the next begins
+    nxt[jump] = np.searchsorted(cand, ends[jump])
+    breaks = jump.tolist()
+    starts, stops, i = [], [], 0
+    while i < cand.size:
+        k = bisect.bisect_left(breaks, i)
+        j = breaks[k] if k < len(breaks) else cand.size - 1
+        starts.append(i)
+        stops.append(j)
+        i = int(nxt[j]) if k < len(breaks) else cand.size
+    mark = np.zeros(cand.size + 1, np.int64)
+    np.add.at(mark, np.array(starts, np.int64), 1)
+    np.add.at(mark, np.array(stops, np.int64) + 1, -1)
+    chain = np.flatnonzero(np.cumsum(mark[:-1]) > 0)
+    return cand[chain], ends[chain], decodes[chain]
+
+
+def _account(
+    buf: np.ndarray, starts: np.ndarray, ends: np.ndarray, decodes: np.ndarray, path: Path, warnings: list[str]
+) -> tuple[np.ndarray, int]:
+    """Offsets of the decodable, complete messages; the rest reported in `warnings`."""
+    size, name = buf.size, path.name
+    if not decodes.all():
+        types = ", ".join(sorted({str(t) for t in buf[starts[~decodes] + 2].tolist()}))
+        warnings.append(
+            f"{name}: {int((~decodes).sum())} messages of type(s) {types} have a FMT length "
+            "that disagrees with their format; skipped."
+        )
+    truncated = ends > size
+    if truncated.any():
+        at = int(starts[truncated][0])
+        warnings.append(
+            f"{name}: truncated final message (type {buf[at + 2]}) at byte offset {at}: "
+            f"{size - at} bytes left of {int(ends[truncated][0]) - at}."
+        )
+    gap_at = np.concatenate([[0], np.minimum(ends, size)])
+    gap_len = np.concatenate([starts, [size]]) - gap_at
+    shown = np.flatnonzero(gap_len > 0)
+    warnings.extend(f"{name}: skipped {int(gap_len[k])} bytes at offset {int(gap_at[k])}." for k in shown[:LISTED])
+    if shown.size > LISTED:
+        warnings.append(f"{name}: skipped bytes at {shown.size - LISTED} more places.")
+    skipped = int(gap_len.sum() + 3 * (~decodes).sum() + (size - starts[truncated]).sum())
+    return starts[decodes & ~truncated], skipped
+
+
+def _layouts(
+    buf: np.ndarray, offsets: np.ndarray, by_type: dict[int, list[_Definition]], path: Path, warnings: list[str]
+) -> list[tuple[str, MessageFormat, np.ndarray]]:
+    """Group message offsets by layout (name, format, columns) under their table key."""
+    types = buf[offsets + 2]
+    order = np.argsort(types, kind="stable")
+    present, first = np.unique(types[order], return_index=True)
+    layouts: dict[tuple[str, str, tuple[str, ...]], list[np.ndarray]] = {}
+    formats: dict[tuple[str, str, tuple[str, ...]], MessageFormat] = {}
+    for type_id, lo, hi in zip(present.tolist(), first.tolist(), [*first[1:].tolist(), order.size]):
+        sel, defs = offsets[order[lo:hi]], by_type[type_id]
+        pieces = [(defs[0], sel)]
+        if len(defs) > 1:  # the FMT in force for each message (the last one before any FMT)
+            which = np.searchsorted([d.offset for d in defs], sel) - 1
+            pieces = [(defs[k], sel[which == k]) for k in np.unique(which).tolist()]
+        for d, part in pieces:
+            key = (d.fmt.name, d.fmt.format, d.fmt.columns)
+            layouts.setdefault(key, []).append(part)
+            formats.setdefault(key, d.fmt)
+    result, seen = [], dict[str, int]()
+    for key in sorted(layouts, key=lambda k: min(int(a[0]) for a in layouts[k])):
+        seen[key[0]] = seen.get(key[0], -1) + 1
+        label = key[0] if seen[key[0]] == 0 else f"{key[0]}@{seen[key[0]]}"
+        if seen[key[0]]:
+            warnings.append(
+                f"{path.name}: {key[0]} is redefined with format {key[1]!r}; those messages are in {label!r}."
+            )
+        parts = layouts[key]
+        result.append((label, formats[key], parts[0] if len(parts) == 1 else np.sort(np.concatenate(parts))))
+    return result
+
+
+def _parse_fmts(buf: np.ndarray, offsets: np.ndarray) -> list[_Definition]:
+    """Parse FMT candidates at `offsets`; formats pymavlink cannot read are left out."""
+    if offsets.size == 0:
+        return []
+    rows = gather(buf, offsets, _FMT.len)
+    rec = rows.view(layout(_FMT.format, _FMT.len)[0]).ravel()
+    defs = []
+    texts = (strings(rec[f"f{i}"], _null_term).tolist() for i in (2, 3, 4))
+    for off, type_id, length, name, fmt, cols in zip(offsets.tolist(), rec["f0"].tolist(), rec["f1"].tolist(), *texts):
+        if not _VALID_CHARS.issuperset(fmt):
+            continue
+        size = sum(_CHAR_SIZE[c] for c in fmt)
+        columns = tuple(cols.split(",")) if cols else ()
+        defs.append(_Definition(off, MessageFormat(type_id, name, length, fmt, columns), length == size + 3))
+    return defs
+
+
+@lru_cache(maxsize=512)
+def layout(fmt: str, length: int | None) -> tuple[np.dtype, tuple[str, ...]]:
+    """Structured dtype over a whole message (header included) and the format char of each field."""
+    names, offsets, at = ["h1", "h2", "type"], [0, 1, 2], 3
+    formats: list[object] = ["u1", "u1", "u1"]
+    for i, c in enumerate(fmt):
+        code = FORMAT_TO_STRUCT[c][0]
+        names.append(f"f{i}")
+        formats.append(("<i2", (32,)) if c == "a" else "S" + code[:-1] if code.endswith("s") else _NUMPY_CODE[code])
+        offsets.append(at)
+        at += struct.calcsize(code)
+    spec = {"names": names, "formats": formats, "offsets": offsets, "itemsize": length or at}
+    return np.dtype(spec), tuple(fmt)  # type: ignore[call-overload]
+
+
+def gather(buf: np.ndarray, offsets: np.ndarray, length: int) -> np.ndarray:
+    """Copy the `length` bytes at each offset into a contiguous ``(n, length)`` array."""
+    if offsets.size == 0 or buf.size < length:
+        return np.empty((0, length), np.uint8)
+    windows = np.ndarray((buf.size - length + 1, length), np.uint8, buffer=buf, strides=(1, 1))
+    return windows[offsets]
+
+
+def strings(raw: np.ndarray, decode: Callable[[bytes], str]) -> np.ndarray:
+    """Decode a bytes column with `decode`, vectorised when it is plain ASCII with nothing after a NUL."""
+    raw = np.ascontiguousarray(raw)
+    mat = raw.view(np.uint8).reshape(raw.size, raw.dtype.itemsize)
+    zero = mat == 0
+    if (mat < 128).all() and not ((np.cumsum(zero, axis=1) > 0) & ~zero).any():
+        return raw.astype(f"U{raw.dtype.itemsize}")  # what either decoding rule gives for such bytes
+    unique, inverse = np.unique(raw, return_inverse=True)
+    decoded = np.array([decode(v) for v in unique.tolist()] or [""], dtype=str)
+    return decoded[inverse.ravel()] if raw.size else decoded[:0]
+
+
+def _null_term(value: bytes) -> str:
+    """pymavlink's ``null_term(bytes)``: decode with backslashreplace, cut at the first NUL."""
+    return value.split(b"\0", 1)[0].decode("utf-8", errors="backslashreplace")

@@ -1,0 +1,430 @@
+"""Fast bulk decoder of ArduPilot DataFlash binary logs (``.bin``).
+
+A DataFlash log is a stream of messages, ``A3 95 <type>`` then a fixed-size
+body; ``FMT`` messages (type 128) define the other types. Format characters,
+struct codes and multipliers come from pymavlink (``FORMAT_TO_STRUCT``,
+``DFFormat``); the decoding differs: message boundaries come from a
+vectorised scan for header candidates and a walk that loops in Python only
+where the stream is not contiguous, and each type is decoded at once through
+a numpy structured dtype.
+
+Notes
+-----
+Values equal those of pymavlink's ``DFReader_binary`` read with
+``_parse_next``, and the framing follows it, quirks included:
+
+* Bytes that do not start a known message are skipped until the next
+  ``A3 95 <known type>``, which is trusted (no look-ahead, no checksum).
+* A message is decoded with the latest FMT for its type before it; before
+  any, with the type's last FMT in the file (DFReader preloads them all).
+* A type whose FMT ``Length`` disagrees with its format cannot be unpacked;
+  the scan resumes three bytes on. DFReader also stops for good when that
+  happens within 528 bytes of the end; we read on. A truncated final
+  message is dropped. Where a type is redefined with another layout
+  (appended logs of other firmware), DFReader keeps its cached struct and
+  misreads; we decode with the FMT in force and keep the layouts apart.
+* ``c C e E`` (×0.01) and ``L`` (×1e-7) become float64 divided by
+  ``1/multiplier``, as DFReader computes them; ``f`` stays float32 and
+  ``g`` float16 (same values); integers keep their width; ``M`` (flight
+  mode) stays a number, as in DFReader. Strings (``n N Z``): UTF-8, else
+  ISO-8859-1, cut at the first NUL; ``FILE.Data`` stays raw bytes; ``a`` is
+  ``int16[32]``, shape ``(n, 32)``. A repeated column name keeps its last
+  field (DFReader's ``colhash``).
+* DFReader's ``_timestamp`` (GPS-based, always 18 leap seconds) is not
+  reproduced: :attr:`MessageTable.time_s` is the log clock.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Collection, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+
+import numpy as np
+from pymavlink.DFReader import FORMAT_TO_STRUCT, MULT_TO_PREFIX
+
+from flightlogs.errors import LogFormatError
+from flightlogs.readers._dataflash_frame import (  # noqa: F401  (kept importable from here)
+    FMT_TYPE,
+    HEAD1,
+    HEAD2,
+    LISTED,
+    MessageFormat,
+    frame_messages,
+    gather,
+    layout,
+    strings,
+)
+
+__all__ = [
+    "MessageFormat",
+    "MessageTable",
+    "DataFlashMessages",
+    "read_messages",
+    "decode_messages",
+    "message_dtype",
+]
+
+_ULOG_MAGIC = b"ULog\x01\x12\x35"
+_INSTANCE_COLUMNS = ("I", "Instance", "Inst", "C", "Core")
+
+
+@dataclass(frozen=True, slots=True)
+class MessageTable:
+    """All messages of one type, as columns.
+
+    Parameters
+    ----------
+    format : MessageFormat
+        The layout they share.
+    columns : Mapping[str, ndarray]
+        Values by column name, shape ``(n,)`` (``(n, 32)`` for ``a``), with
+        multipliers applied as DFReader applies them.
+    offsets : ndarray of int64, shape (n,)
+        Byte offset of each message in the file, increasing.
+    """
+
+    format: MessageFormat
+    columns: Mapping[str, np.ndarray]
+    offsets: np.ndarray
+
+    def __post_init__(self) -> None:
+        for array in (*self.columns.values(), self.offsets):
+            array.flags.writeable = False
+        object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
+
+    def __len__(self) -> int:
+        return int(self.offsets.size)
+
+    def __getitem__(self, column: str) -> np.ndarray:
+        return self.columns[column]
+
+    def __contains__(self, column: object) -> bool:
+        return column in self.columns
+
+    @property
+    def time_s(self) -> np.ndarray | None:
+        """Log-clock time of each message, s: ``TimeUS/1e6`` or ``TimeMS/1e3``.
+
+        Old GPS messages whose ``TimeMS`` is GPS time of week use their boot
+        time ``T`` instead (as DFReader's msec clock does). None without any.
+        """
+        cols = self.columns
+        if "TimeUS" in cols:
+            return cols["TimeUS"].astype(np.float64) / 1e6
+        if "T" in cols and "Week" in cols and self.format.name.startswith("GPS"):
+            return cols["T"].astype(np.float64) / 1e3
+        if "TimeMS" in cols:
+            return cols["TimeMS"].astype(np.float64) / 1e3
+        return None
+
+    def select(self, rows: np.ndarray) -> MessageTable:
+        """Return the messages picked by a boolean mask or index array."""
+        return MessageTable(self.format, {k: v[rows] for k, v in self.columns.items()}, self.offsets[rows])
+
+
+@dataclass(frozen=True, slots=True)
+class DataFlashMessages:
+    """Every message of a DataFlash log, decoded per type.
+
+    Parameters
+    ----------
+    path : Path
+        File read (``Path("<bytes>")`` for in-memory data).
+    file_size : int
+        Bytes in the file.
+    tables : Mapping[str, MessageTable]
+        Decoded messages by name. When a name is redefined with a different
+        layout, the later layouts are stored as ``"NAME@1"``, ``"NAME@2"``.
+    counts : Mapping[str, int]
+        Messages found per name, decoded or not.
+    warnings : tuple of str
+        Recovered problems: skipped bytes, truncation, time resets.
+    bytes_skipped : int
+        Bytes that were not part of any decoded message.
+    """
+
+    path: Path
+    file_size: int
+    tables: Mapping[str, MessageTable]
+    counts: Mapping[str, int]
+    warnings: tuple[str, ...] = ()
+    bytes_skipped: int = 0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "tables", MappingProxyType(dict(self.tables)))
+        object.__setattr__(self, "counts", MappingProxyType(dict(self.counts)))
+        object.__setattr__(self, "warnings", tuple(self.warnings))
+
+    def __getitem__(self, name: str) -> MessageTable:
+        return self.tables[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.tables
+
+    def get(self, name: str) -> MessageTable | None:
+        """The table of `name`, or None when absent or empty."""
+        table = self.tables.get(name)
+        return table if table is not None and len(table) else None
+
+    def instance_field(self, name: str) -> str | None:
+        """Column that numbers the instances of `name` (FMTU ``#``, else ``I``, ``C``...)."""
+        table = self.tables[name]
+        if table.format.instance_field is not None:
+            return table.format.instance_field
+        chars = dict(zip(table.format.columns, table.format.format))
+        return next((c for c in _INSTANCE_COLUMNS if c in table.columns and chars.get(c, "") in {"b", "B"}), None)
+
+    def instances(self, name: str) -> dict[int, MessageTable]:
+        """Split `name` by sensor instance, for new and old logs alike.
+
+        Newer logs carry an instance column (``IMU.I``, ``XKF1.C``); older
+        logs use numbered names (``IMU``, ``IMU2``, ``IMU3`` are instances
+        0, 1, 2). Returns ``{instance: table}``, empty when `name` is absent.
+        """
+        if self.get(name) is None:
+            return {}
+        column = self.instance_field(name)
+        if column is not None:
+            values = self.tables[name][column]
+            return {int(i): self.tables[name].select(values == i) for i in np.unique(values)}
+        found = {0: self.tables[name]}
+        for k in range(2, 10):
+            table = self.get(f"{name}{k}")
+            if table is not None:
+                found[k - 1] = table
+        return found
+
+
+def read_messages(
+    path: str | Path,
+    *,
+    types: Collection[str] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> DataFlashMessages:
+    """Read and decode a DataFlash ``.bin`` log.
+
+    Parameters
+    ----------
+    path : str or Path
+        The log file.
+    types : collection of str, optional
+        Names to decode (all when None); FMTU, UNIT and MULT are always read.
+    progress : callable, optional
+        ``progress(done, total)`` in bytes while decoding.
+
+    Returns
+    -------
+    DataFlashMessages
+        Columns per message type, warnings and the count of skipped bytes.
+
+    Raises
+    ------
+    LogFormatError
+        If the file cannot be read, is empty, is a ULog, or holds no FMT.
+    """
+    path = Path(path)
+    try:
+        data = np.fromfile(path, dtype=np.uint8)
+    except OSError as err:
+        raise LogFormatError(f"{path}: cannot be read ({err.strerror or err}) at byte offset 0.") from err
+    return decode_messages(data, path=path, types=types, progress=progress)
+
+
+def decode_messages(
+    data: bytes | np.ndarray,
+    *,
+    path: str | Path = "<bytes>",
+    types: Collection[str] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> DataFlashMessages:
+    """Decode DataFlash bytes already in memory.
+
+    Parameters
+    ----------
+    data : bytes or ndarray of uint8
+        The whole log.
+    path : str or Path, optional
+        Name used in messages and stored in the result.
+    types : collection of str, optional
+        Names to decode (all when None); FMTU, UNIT and MULT are always read.
+    progress : callable, optional
+        ``progress(done, total)`` in bytes while decoding.
+
+    Returns
+    -------
+    DataFlashMessages
+        As :func:`read_messages`.
+
+    Raises
+    ------
+    LogFormatError
+        If `data` is empty, a ULog, or holds no FMT message.
+
+    Examples
+    --------
+    >>> from flightlogs.writers.dataflash import MessageBlock, MessageSpec, encode_dataflash
+    >>> spec = MessageSpec("ATT", "Qcc", ("TimeUS", "Roll", "Pitch"))
+    >>> block = MessageBlock(spec, {"TimeUS": [1000, 2000], "Roll": [1.5, -2.25], "Pitch": [0.0, 0.1]})
+    >>> decode_messages(encode_dataflash([block]))["ATT"]["Roll"]
+    array([ 1.5 , -2.25])
+    """
+    path = Path(path)
+    buf = np.ascontiguousarray(
+        np.frombuffer(data, dtype=np.uint8)
+        if isinstance(data, (bytes, bytearray, memoryview))
+        else np.asarray(data, dtype=np.uint8).ravel()
+    )
+    size = int(buf.size)
+    if size == 0:
+        raise LogFormatError(f"{path}: the file is empty (no DataFlash message at byte offset 0).")
+    if buf[: len(_ULOG_MAGIC)].tobytes() == _ULOG_MAGIC:
+        raise LogFormatError(
+            f"{path}: is a PX4 ULog file, not an ArduPilot DataFlash log (ULog magic at byte offset 0)."
+        )
+    warnings: list[str] = []
+    groups, skipped = frame_messages(buf, path, warnings)
+    done = 0
+    if progress is not None:
+        progress(0, size)
+    meta = {k: _decode_table(buf, f, o, warnings) for k, f, o in groups if k in ("FMTU", "UNIT", "MULT")}
+    units = _unit_context(meta)
+    tables: dict[str, MessageTable] = {}
+    counts: dict[str, int] = {}
+    for key, fmt, offsets in groups:
+        counts[fmt.name] = counts.get(fmt.name, 0) + offsets.size
+        if types is None or fmt.name in types or key in meta:
+            fmt = _with_units(fmt, *units) if units else fmt
+            tables[key] = (
+                MessageTable(fmt, meta[key].columns, offsets)
+                if key in meta
+                else _decode_table(buf, fmt, offsets, warnings)
+            )
+            done += offsets.size * fmt.length
+            if progress is not None:
+                progress(min(done, size), size)
+    warnings.extend(_time_resets(tables))
+    if progress is not None:
+        progress(size, size)
+    return DataFlashMessages(path, size, tables, counts, tuple(warnings), skipped)
+
+
+def message_dtype(fmt: str) -> np.dtype:
+    """Numpy structured dtype of a whole message with DataFlash format `fmt`.
+
+    Parameters
+    ----------
+    fmt : str
+        Format characters of pymavlink's ``FORMAT_TO_STRUCT``.
+
+    Returns
+    -------
+    numpy.dtype
+        Fields ``h1``, ``h2``, ``type`` (the 3-byte header) then ``f0``,
+        ``f1``... one per character, packed little-endian as the struct
+        codes; ``a`` is ``int16[32]``.
+
+    Examples
+    --------
+    >>> message_dtype("Qcc").itemsize
+    15
+    """
+    return layout(fmt, None)[0]
+
+
+def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray, warnings: list[str]) -> MessageTable:
+    dtype, chars = layout(fmt.format, fmt.length)
+    rec = gather(buf, offsets, fmt.length).view(dtype).ravel()
+    names = fmt.columns[: len(chars)]
+    if len(set(names)) != len(names) or len(fmt.columns) != len(chars):
+        warnings.append(
+            f"{fmt.name}: {len(fmt.columns)} column names for {len(chars)} fields "
+            f"{fmt.columns}; as in DFReader, a repeated name keeps its last field."
+        )
+    columns = {name: _column(rec[f"f{i}"], chars[i], fmt.name) for i, name in enumerate(names)}
+    return MessageTable(fmt, columns, offsets)
+
+
+def _column(raw: np.ndarray, char: str, message: str) -> np.ndarray:
+    """Convert one raw field to the values DFReader returns."""
+    mult = FORMAT_TO_STRUCT[char][1]
+    if mult is not None:
+        if 0.0 < mult < 1.0:  # DFReader divides by 1/mult for accuracy
+            return raw.astype(np.float64) / (1 / mult)
+        return raw.astype(np.float64) * mult
+    if raw.dtype.kind == "S":
+        if message == "FILE" and char == "Z":
+            return np.array([bytes(v).ljust(raw.dtype.itemsize, b"\0") for v in raw.tolist()], dtype=object)
+        return strings(raw, _df_string)
+    return np.ascontiguousarray(raw)
+
+
+def _df_string(value: bytes) -> str:
+    """DFReader's string rule: UTF-8, else ISO-8859-1, cut at the first NUL."""
+    try:
+        text = value.decode("utf-8")
+    except UnicodeDecodeError:
+        text = value.decode("ISO-8859-1")
+    return text.split("\0", 1)[0]
+
+
+_UnitContext = tuple[dict[int, tuple[str, str]], dict[str, str], dict[str, float]]
+
+
+def _unit_context(meta: dict[str, MessageTable]) -> _UnitContext | None:
+    """FMTU ids per type (the last FMTU wins), UNIT labels and MULT values, as DFReader indexes them."""
+    fmtu, unit, mult = meta.get("FMTU"), meta.get("UNIT"), meta.get("MULT")
+    if fmtu is None or "FmtType" not in fmtu or "UnitIds" not in fmtu:
+        return None
+    unit_of = {chr(int(i) & 0xFF): str(s) for i, s in zip(unit["Id"], unit["Label"])} if unit else {}
+    mult_of = {chr(int(i) & 0xFF): float("%.7g" % m) for i, m in zip(mult["Id"], mult["Mult"])} if mult else {}
+    mult_ids = fmtu["MultIds"] if "MultIds" in fmtu else np.full(len(fmtu), "")
+    return {int(t): (str(u), str(m)) for t, u, m in zip(fmtu["FmtType"], fmtu["UnitIds"], mult_ids)}, unit_of, mult_of
+
+
+def _with_units(
+    fmt: MessageFormat, ids: dict[int, tuple[str, str]], unit_of: dict[str, str], mult_of: dict[str, float]
+) -> MessageFormat:
+    """`fmt` with the units and instance column ``DFFormat.set_unit_ids/set_mult_ids`` derive."""
+    if fmt.type_id not in ids:
+        return fmt
+    unit_ids, mults = ids[fmt.type_id]
+    units = [unit_of.get(unit_ids[i], "") if i < len(unit_ids) else "" for i in range(len(fmt.columns))]
+    for i, char in enumerate(fmt.format[: len(units)]):
+        if FORMAT_TO_STRUCT[char][1] is None and units[i] and i < len(mults) and mults[i] in mult_of:
+            m = mult_of[mults[i]]
+            units[i] = MULT_TO_PREFIX[m] + units[i] if m in MULT_TO_PREFIX else "%.4g %s" % (m, units[i])
+    instance = fmt.columns[unit_ids.index("#")] if "#" in unit_ids[: len(fmt.columns)] else None
+    return MessageFormat(fmt.type_id, fmt.name, fmt.length, fmt.format, fmt.columns, tuple(units), instance)
+
+
+def _time_resets(tables: dict[str, MessageTable]) -> list[str]:
+    """Warn where the log clock jumps back by more than a second (logs appended)."""
+    best: tuple[int, str, list[tuple[int, float, float]]] | None = None
+    last_time: dict[str, float] = {}
+    for key, table in tables.items():
+        column = next((c for c in ("TimeUS", "TimeMS") if c in table.columns), None)
+        if column is None or not len(table) or key.startswith("GPS"):
+            continue
+        name, stamp = key.split("@")[0], table[column].astype(np.int64)
+        drops = np.flatnonzero(np.diff(stamp) < -(10**6 if column == "TimeUS" else 10**3))
+        if not drops.size and name not in last_time:
+            last_time[name] = stamp[-1] / (1e6 if column == "TimeUS" else 1e3)
+            continue
+        time_s = table.time_s
+        assert time_s is not None
+        resets = [(int(table.offsets[k + 1]), float(time_s[k]), float(time_s[k + 1])) for k in drops]
+        if name in last_time and time_s[0] < last_time[name] - 1.0:  # a later layout of the same name
+            resets.insert(0, (int(table.offsets[0]), last_time[name], float(time_s[0])))
+        last_time[name] = float(time_s[-1])
+        if resets and (best is None or len(table) > best[0]):
+            best = (len(table), key, resets)
+    if best is None:
+        return []
+    _, name, resets = best
+    where = ", ".join(f"byte offset {o} ({a:.3f} s → {b:.3f} s)" for o, a, b in resets[:LISTED])
+    return [
+        f"{name}: the log clock goes back {len(resets)} time(s), at {where}: several logs are "
+        "appended in one file; all their messages are kept."
+    ]

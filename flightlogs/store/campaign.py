@@ -1,0 +1,138 @@
+"""Ingest a flight-test campaign: logs, anemometer files, pairing and conditioning."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from flightlogs.conditioning.align import pair_winds
+from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions, condition_flight
+from flightlogs.errors import DataError, LogFormatError
+from flightlogs.flightlog import FlightLog
+from flightlogs.readers.anemometer import WindMeasurement, read_anemometer_csv
+from flightlogs.readers.dispatch import read_log
+
+__all__ = ["Campaign", "ingest_campaign", "expand_wind_paths"]
+
+
+@dataclass(frozen=True, slots=True)
+class Campaign:
+    """Everything read and conditioned in one ingest.
+
+    Parameters
+    ----------
+    logs : tuple of FlightLog
+        The flights, in the order given.
+    winds : tuple of WindMeasurement
+        Every anemometer file read.
+    conditioned : tuple of ConditionedFlight or None
+        For each log, its conditioned records, or None when it could not be
+        conditioned (the reason is in `notes`).
+    notes : tuple of tuple of str
+        For each log, why conditioning was skipped (empty when it was not).
+    """
+
+    logs: tuple[FlightLog, ...]
+    winds: tuple[WindMeasurement, ...]
+    conditioned: tuple[ConditionedFlight | None, ...]
+    notes: tuple[tuple[str, ...], ...]
+
+    @property
+    def flights(self) -> tuple[ConditionedFlight, ...]:
+        """The flights that could be conditioned, in the order given."""
+        return tuple(flight for flight in self.conditioned if flight is not None)
+
+    def require_flights(self) -> tuple[ConditionedFlight, ...]:
+        """`flights`, or DataError saying why no log could be conditioned.
+
+        Raises
+        ------
+        DataError
+            If no log could be conditioned (the message gives each log's reason).
+        """
+        if not self.flights:
+            reasons = "; ".join(note for notes in self.notes for note in notes)
+            raise DataError(f"no log could be conditioned ({reasons})")
+        return self.flights
+
+
+def expand_wind_paths(paths: Sequence[Path]) -> list[Path]:
+    """Files given as they are, folders as the ``*.csv`` files inside them (sorted).
+
+    Parameters
+    ----------
+    paths : sequence of Path
+        Files or folders.
+
+    Raises
+    ------
+    LogFormatError
+        If a folder holds no CSV file.
+    """
+    found: list[Path] = []
+    for path in paths:
+        if Path(path).is_dir():
+            inside = sorted(p for p in Path(path).iterdir() if p.suffix.lower() == ".csv")
+            if not inside:
+                raise LogFormatError(f"{path}: the folder holds no .csv anemometer file")
+            found.extend(inside)
+        else:
+            found.append(Path(path))
+    return found
+
+
+def ingest_campaign(
+    log_paths: Sequence[Path],
+    wind_paths: Sequence[Path] = (),
+    *,
+    columns: Mapping[str, str] | None = None,
+    options: ConditioningOptions = ConditioningOptions(),
+    progress: Callable[[str, int, int], None] | None = None,
+) -> Campaign:
+    """Read logs and anemometer files, pair them by UTC and condition each flight.
+
+    Parameters
+    ----------
+    log_paths : sequence of Path
+        Flight logs (any supported format).
+    wind_paths : sequence of Path, optional
+        Anemometer CSV files or folders of them.
+    columns : Mapping[str, str], optional
+        Anemometer column override (see :func:`read_anemometer_csv`).
+    options : ConditioningOptions, optional
+        Conditioning choices.
+    progress : callable, optional
+        ``progress(file_name, done, total)`` while reading, bytes.
+
+    Returns
+    -------
+    Campaign
+
+    Raises
+    ------
+    LogFormatError, DataError
+        On a file that cannot be read, or wind that cannot be aligned.
+    """
+    logs = []
+    for path in log_paths:
+
+        def report(done: int, total: int, name: str = Path(path).name) -> None:
+            if progress is not None:
+                progress(name, done, total)
+
+        logs.append(read_log(path, progress=report))
+    winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
+    paired = pair_winds(logs, winds, clock_offset_s=options.wind_offset_s)
+    conditioned: list[ConditionedFlight | None] = []
+    notes: list[tuple[str, ...]] = []
+    for log, wind in zip(logs, paired):
+        try:
+            conditioned.append(condition_flight(log, wind, options))
+            notes.append(())
+        except DataError as err:
+            if wind is not None:
+                raise  # the user asked for wind alignment: its failure is the answer
+            conditioned.append(None)
+            notes.append((f"not conditioned: {err}",))
+    return Campaign(tuple(logs), tuple(winds), tuple(conditioned), tuple(notes))

@@ -1,0 +1,368 @@
+"""The HDF5 dataset store: ingested logs and wind measurements, with provenance.
+
+Layout (schema version 1)::
+
+    /                               attrs: schema, schema_version, software, created_utc
+    /logs/<key>/                    attrs: path, sha256, log_format, autopilot, vehicle,
+                                           utc_offset_s (NaN when unknown), warnings (JSON)
+    /logs/<key>/parameters          compound dataset (name, value)
+    /logs/<key>/system_id_runs      compound dataset, one row per ArduPilot SIDS run (fields of SystemIdRun)
+    /logs/<key>/signals/<name>/     attrs: unit, source
+    /logs/<key>/signals/<name>/time_s   float64 (n_samples,), s, log clock
+    /logs/<key>/signals/<name>/values   float64 (n_samples,), in `unit`
+    /wind/<key>/                    attrs: path, sha256, and the measurement's scalar
+                                           fields; JSON for mappings and tuples
+    /wind/<key>/<array field>       float64 (n_samples,) (``utc_s`` in UNIX s, winds m/s)
+    /conditioned/<key>/             attrs: source, rate_hz, warnings (JSON), wind_alignment (JSON or "null")
+    /conditioned/<key>/segments     compound (axis, kind, start_s, end_s, source, f_min_hz, f_max_hz, detail)
+    /conditioned/<key>/records/<i>/ attrs: label, units (JSON), trim (JSON)
+    /conditioned/<key>/records/<i>/time_s, /<signal>   float64 (n_samples,), trim removed
+
+``<key>`` is the file's stem, made unique with a numeric suffix. Later steps
+add groups of their own beside these (aligned records, segments); a reader
+ignores groups it does not know.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, cast
+
+import h5py
+import numpy as np
+
+from flightlogs.flightlog import FlightLog, Signal, SystemIdRun
+from flightlogs.store.schema import open_schema, stamp_schema
+from flightlogs.writers.atomic import atomic_output
+
+__all__ = ["Dataset", "write_dataset", "read_dataset", "file_sha256", "SCHEMA_VERSION"]
+
+SCHEMA = "flight-sysid dataset"
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True, slots=True)
+class Dataset:
+    """What a dataset file holds.
+
+    Parameters
+    ----------
+    logs : tuple of FlightLog
+        Ingested flight logs, in the order they were written.
+    winds : tuple
+        Wind measurements (:class:`flightlogs.readers.anemometer.WindMeasurement`).
+    conditioned : tuple
+        Conditioned flights (:class:`flightlogs.conditioning.condition.ConditionedFlight`).
+    sha256 : dict
+        Hash of each source file as it was at ingest, by path string.
+    schema_version : int
+        Layout version of the file read.
+    """
+
+    logs: tuple[FlightLog, ...]
+    winds: tuple[Any, ...] = ()
+    conditioned: tuple[Any, ...] = ()
+    sha256: dict[str, str] = dataclasses.field(default_factory=dict)
+    schema_version: int = SCHEMA_VERSION
+
+
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 hex digest of a file's bytes (provenance of ingested inputs).
+
+    Parameters
+    ----------
+    path : str or Path
+        File to hash.
+    """
+    digest = hashlib.sha256()
+    with Path(path).open("rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def write_dataset(
+    path: str | Path, logs: Sequence[FlightLog], winds: Sequence[Any] = (), conditioned: Sequence[Any] = ()
+) -> None:
+    """Write logs, wind measurements and conditioned flights to an HDF5 dataset, atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination ``.h5``; replaced only once the whole file is written.
+    logs : sequence of FlightLog
+        Logs to store.
+    winds : sequence of WindMeasurement, optional
+        Anemometer measurements to store.
+    conditioned : sequence of ConditionedFlight, optional
+        Aligned records, segments and alignment of each flight.
+    """
+    with atomic_output(path) as tmp, h5py.File(tmp, "w") as h5:
+        stamp_schema(h5, SCHEMA, SCHEMA_VERSION)
+        log_group = h5.create_group("logs")
+        for log in logs:
+            _write_log(log_group.create_group(_unique_key(log_group, log.path)), log)
+        wind_group = h5.create_group("wind")
+        for wind in winds:
+            _write_dataclass(wind_group.create_group(_unique_key(wind_group, wind.path)), wind)
+        flights = h5.create_group("conditioned")
+        for flight in conditioned:
+            _write_conditioned(flights.create_group(_unique_key(flights, flight.source)), flight)
+
+
+def read_dataset(path: str | Path) -> Dataset:
+    """Read a dataset written by :func:`write_dataset`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.h5`` file.
+
+    Raises
+    ------
+    LogFormatError
+        If the file is not an HDF5 dataset of this schema, or of a newer version.
+    """
+    path = Path(path)
+    with open_schema(
+        path,
+        SCHEMA,
+        SCHEMA_VERSION,
+        what="dataset",
+        not_hdf5="an HDF5 dataset",
+        wrong_schema="HDF5 file is not a flight-sysid dataset.",
+    ) as (h5, version):
+        logs = tuple(_read_log(group) for group in h5["logs"].values())
+        sha = {g.attrs["path"]: g.attrs["sha256"] for g in h5["logs"].values()}
+        winds = tuple(_read_wind(group) for group in h5.get("wind", {}).values())
+        sha.update({g.attrs["path"]: g.attrs["sha256"] for g in h5.get("wind", {}).values()})
+        conditioned = tuple(_read_conditioned(g) for g in h5.get("conditioned", {}).values())
+    return Dataset(logs=logs, winds=winds, conditioned=conditioned, sha256=sha, schema_version=version)
+
+
+def _unique_key(group: h5py.Group, path: Path) -> str:
+    stem = Path(path).stem.replace("/", "_") or "log"
+    key, n = stem, 1
+    while key in group:
+        n += 1
+        key = f"{stem}_{n}"
+    return key
+
+
+def _source_hash(path: Path) -> str:
+    return file_sha256(path) if Path(path).is_file() else ""
+
+
+def _write_log(group: h5py.Group, log: FlightLog) -> None:
+    group.attrs["path"] = str(log.path)
+    group.attrs["sha256"] = _source_hash(log.path)
+    group.attrs["log_format"] = log.log_format
+    group.attrs["autopilot"] = log.autopilot
+    group.attrs["vehicle"] = log.vehicle
+    group.attrs["utc_offset_s"] = np.nan if log.utc_offset_s is None else log.utc_offset_s
+    group.attrs["warnings"] = json.dumps(list(log.warnings))
+    names = sorted(log.parameters)
+    table = np.array(
+        [(name, float(log.parameters[name])) for name in names],
+        dtype=[("name", h5py.string_dtype()), ("value", "f8")],
+    )
+    group.create_dataset("parameters", data=table)
+    runs = [dataclasses.astuple(run) for run in log.system_id_runs]
+    group.create_dataset("system_id_runs", data=np.array(runs, dtype=_RUN_DTYPE))
+    signals = group.create_group("signals")
+    for name, signal in log.signals.items():
+        sub = signals.create_group(name)
+        sub.attrs["unit"] = signal.unit
+        sub.attrs["source"] = signal.source
+        sub.create_dataset("time_s", data=signal.time_s, compression="gzip", shuffle=True)
+        sub.create_dataset("values", data=signal.values, compression="gzip", shuffle=True)
+
+
+def _read_log(group: h5py.Group) -> FlightLog:
+    signals = {
+        name: Signal(name, sub["time_s"][()], sub["values"][()], str(sub.attrs["unit"]), str(sub.attrs["source"]))
+        for name, sub in group["signals"].items()
+    }
+    table = group["parameters"][()]
+    parameters = {
+        (row["name"].decode() if isinstance(row["name"], bytes) else str(row["name"])): float(row["value"])
+        for row in table
+    }
+    offset = float(group.attrs["utc_offset_s"])
+    runs = tuple(_run_from_row(row) for row in group["system_id_runs"][()]) if "system_id_runs" in group else ()
+    return FlightLog(
+        path=Path(group.attrs["path"]),
+        log_format=str(group.attrs["log_format"]),  # type: ignore[arg-type]
+        autopilot=str(group.attrs["autopilot"]),  # type: ignore[arg-type]
+        signals=signals,
+        vehicle=str(group.attrs["vehicle"]),
+        parameters=parameters,
+        utc_offset_s=None if np.isnan(offset) else offset,
+        warnings=tuple(json.loads(group.attrs["warnings"])),
+        system_id_runs=runs,
+    )
+
+
+_RUN_DTYPE = np.dtype(
+    [
+        (f.name, h5py.string_dtype() if f.name == "axis_name" else ("i8" if f.name == "axis" else "f8"))
+        for f in dataclasses.fields(SystemIdRun)
+    ]
+)
+
+
+def _run_from_row(row: np.void) -> SystemIdRun:
+    numbers = [
+        float(row[name])
+        for name in ("magnitude", "f_start_hz", "f_stop_hz", "fade_in_s", "const_s", "record_s", "fade_out_s")
+    ]
+    return SystemIdRun(float(row["start_s"]), float(row["end_s"]), int(row["axis"]), _text(row["axis_name"]), *numbers)
+
+
+def _write_dataclass(group: h5py.Group, item: Any) -> None:
+    """Store a frozen dataclass: arrays as datasets, the rest as attributes."""
+    group.attrs["sha256"] = _source_hash(item.path)
+    for field in dataclasses.fields(item):
+        value = getattr(item, field.name)
+        if isinstance(value, np.ndarray):
+            group.create_dataset(field.name, data=value, compression="gzip", shuffle=True)
+        elif isinstance(value, Path):
+            group.attrs[field.name] = str(value)
+        elif value is None:
+            group.attrs[field.name] = "null"
+            group.attrs[f"{field.name}.json"] = True
+        elif isinstance(value, (str, int, float, bool, np.floating, np.integer)):
+            group.attrs[field.name] = value
+        else:
+            group.attrs[field.name] = json.dumps(_jsonable(value))
+            group.attrs[f"{field.name}.json"] = True
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, dict) or hasattr(value, "items"):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (tuple, list)):
+        return [_jsonable(v) for v in value]
+    return value
+
+
+def _read_wind(group: h5py.Group) -> Any:
+    from flightlogs.readers.anemometer import WindMeasurement
+
+    kwargs: dict[str, Any] = {}
+    for field in dataclasses.fields(WindMeasurement):
+        if field.name in group:
+            kwargs[field.name] = group[field.name][()]
+        elif field.name in group.attrs:
+            raw = group.attrs[field.name]
+            if group.attrs.get(f"{field.name}.json", False):
+                raw = json.loads(raw)
+                raw = tuple(raw) if isinstance(raw, list) else raw
+            kwargs[field.name] = raw
+    kwargs["path"] = Path(kwargs["path"])
+    return WindMeasurement(**kwargs)
+
+
+_SEGMENT_DTYPE = np.dtype(
+    [
+        ("axis", h5py.string_dtype()),
+        ("kind", h5py.string_dtype()),
+        ("start_s", "f8"),
+        ("end_s", "f8"),
+        ("source", h5py.string_dtype()),
+        ("f_min_hz", "f8"),
+        ("f_max_hz", "f8"),
+        ("detail", h5py.string_dtype()),
+    ]
+)
+
+
+def _text(value: Any) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _write_conditioned(group: h5py.Group, flight: Any) -> None:
+    group.attrs["source"] = str(flight.source)
+    group.attrs["rate_hz"] = flight.rate_hz
+    group.attrs["warnings"] = json.dumps(list(flight.warnings))
+    group.attrs["wind_alignment"] = json.dumps(_jsonable(_asdict(flight.wind)))
+    rows = [
+        (
+            s.axis or "",
+            s.kind,
+            s.start_s,
+            s.end_s,
+            s.source,
+            np.nan if s.f_min_hz is None else s.f_min_hz,
+            np.nan if s.f_max_hz is None else s.f_max_hz,
+            s.detail,
+        )
+        for s in flight.segments
+    ]
+    group.create_dataset("segments", data=np.array(rows, dtype=_SEGMENT_DTYPE))
+    records = group.create_group("records")
+    for k, record in enumerate(flight.records):
+        sub = records.create_group(str(k))
+        sub.attrs["label"] = record.label
+        sub.attrs["units"] = json.dumps(dict(record.units))
+        sub.attrs["trim"] = json.dumps(dict(record.trim))
+        sub.create_dataset("time_s", data=record.time_s)
+        for name in record.signals:
+            sub.create_dataset(name, data=record[name], compression="gzip", shuffle=True)
+
+
+def _asdict(item: Any) -> Any:
+    return None if item is None else dataclasses.asdict(item)
+
+
+def _read_conditioned(group: h5py.Group) -> Any:
+    import pandas as pd
+
+    from flightlogs.conditioning.align import WindAlignment
+    from flightlogs.conditioning.condition import ConditionedFlight
+    from flightlogs.conditioning.lag import LagEstimate, TransportDelay
+    from flightlogs.maneuvers.segments import Segment
+    from flightlogs.record import Record
+
+    segments = tuple(
+        Segment(
+            cast(Any, _text(row["axis"]) or None),
+            cast(Any, _text(row["kind"])),
+            float(row["start_s"]),
+            float(row["end_s"]),
+            cast(Any, _text(row["source"])),
+            None if np.isnan(row["f_min_hz"]) else float(row["f_min_hz"]),
+            None if np.isnan(row["f_max_hz"]) else float(row["f_max_hz"]),
+            _text(row["detail"]),
+        )
+        for row in group["segments"][()]
+    )
+    source = Path(group.attrs["source"])
+    records = []
+    for key in sorted(group["records"], key=int):
+        sub = group["records"][key]
+        units = json.loads(sub.attrs["units"])
+        table = pd.DataFrame({name: sub[name][()] for name in units}, index=pd.Index(sub["time_s"][()], name="time_s"))
+        records.append(Record(table, units, json.loads(sub.attrs["trim"]), source, str(sub.attrs["label"])))
+    raw = json.loads(group.attrs["wind_alignment"])
+    wind = None
+    if raw is not None:
+        raw["wind_path"] = Path(raw["wind_path"])
+        raw["transport"] = TransportDelay(**raw["transport"])
+        raw["residual"] = None if raw["residual"] is None else LagEstimate(**raw["residual"])
+        wind = WindAlignment(**raw)
+    return ConditionedFlight(
+        source,
+        tuple(records),
+        segments,
+        float(group.attrs["rate_hz"]),
+        wind,
+        tuple(json.loads(group.attrs["warnings"])),
+    )

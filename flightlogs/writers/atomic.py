@@ -1,0 +1,79 @@
+"""Write output files so that a failure never leaves half a file behind."""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+import stat
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+from flightlogs.errors import DataError
+
+__all__ = ["atomic_output"]
+
+
+@contextlib.contextmanager
+def atomic_output(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path beside `path`; rename it over `path` on success.
+
+    If the block raises, the temporary file is removed and an existing file at
+    `path` is left untouched. The result has the permissions an ordinary
+    ``open(path, "w")`` would give: those of the file it replaces, else
+    0o666 less the umask (the temporary file itself is private, 0o600).
+
+    Parameters
+    ----------
+    path : str or Path
+        Final destination. Its folder must exist.
+
+    Raises
+    ------
+    DataError
+        If the folder of `path` does not exist or is not a folder.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.txt"
+    >>> with atomic_output(target) as tmp:
+    ...     _ = tmp.write_text("done")
+    >>> target.read_text()
+    'done'
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise DataError(
+            f"{folder}: the output folder does not exist"
+            if not folder.exists()
+            else f"{folder}: the output folder is a file"
+        )
+    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=folder)
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        yield tmp
+        os.chmod(tmp, _mode_for(path))
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _mode_for(path: Path) -> int:
+    """Permission bits for a new `path`: those of the file there, else 0o666 less the umask."""
+    try:
+        return stat.S_IMODE(path.stat().st_mode)
+    except FileNotFoundError:
+        return 0o666 & ~_umask()
+
+
+@functools.cache
+def _umask() -> int:
+    """The process umask (read once: setting it to read it is not thread-safe)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask

@@ -1,0 +1,1 @@
+"""The autopilot: cascaded hover control and the excitation it injects."""

@@ -1,0 +1,1 @@
+"""Flights: batches of nonlinear trials, linear-model hover flights and heave-only flights."""

@@ -1,0 +1,1 @@
+"""The vehicle: rigid body, rotors, mixer, motors and battery; presets; trim and linearisation."""

@@ -1,0 +1,321 @@
+"""A time-domain verification on disk: versioned JSON with every time history, so a report can be redrawn.
+
+``sysid validate --json`` prints a summary (errors and TIC per output); this
+file keeps the whole :class:`~sysid.verify.Verification`: per record the
+measured, simulated and one-step-ahead time histories, biases and reference
+shifts, with and without the wind term. Non-finite numbers are written as
+``null``; floats keep every digit, so a file read back redraws the same
+report. Files are written atomically.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from flightlogs.errors import DataError
+from sysid._json import finite_or_none as _num
+from sysid._json import float_array as _array
+from sysid._json import float_or_nan as _float
+from sysid._json import json_floats as _list
+from sysid._json import read_json_object, write_json
+from sysid.verify import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection
+
+__all__ = [
+    "VERIFICATION_SCHEMA",
+    "VERIFICATION_SCHEMA_VERSION",
+    "SavedVerification",
+    "verification_to_dict",
+    "verification_from_dict",
+    "write_verification",
+    "read_verification",
+]
+
+VERIFICATION_SCHEMA = "flight-sysid/verification"
+VERIFICATION_SCHEMA_VERSION = 2
+_READABLE_VERSIONS = (1, 2)  # version 1 had no excited input, off-axis outputs or off-axis summary
+
+
+@dataclass(frozen=True, slots=True)
+class SavedVerification:
+    """A verification with what it was run on and with.
+
+    Parameters
+    ----------
+    verification : Verification
+        The result of :func:`sysid.verify.verify`.
+    model : str, optional
+        The model file verified (its name or path).
+    options : Mapping[str, Any], optional
+        Options of the verification (JSON-compatible: initial state, seconds
+        kept before and after each doublet ...).
+    created_utc : str, optional
+        ISO 8601 time the verification was run.
+    """
+
+    verification: Verification
+    model: str = ""
+    options: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    created_utc: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "options", MappingProxyType(dict(self.options)))
+
+
+def _optional(value: Any) -> float | None:
+    return None if value is None else float(value)
+
+
+def _output_to_dict(o: OutputVerification) -> dict[str, Any]:
+    return {
+        "name": o.name,
+        "unit": o.unit,
+        "measured": _list(o.measured),
+        "simulated": _list(o.simulated),
+        "bias": _num(o.bias),
+        "rmse": _num(o.rmse),
+        "tic": _num(o.tic),
+        "predicted": None if o.predicted is None else _list(o.predicted),
+        "prediction_rmse": _num(o.prediction_rmse),
+        "prediction_tic": _num(o.prediction_tic),
+    }
+
+
+def _record_to_dict(r: RecordVerification) -> dict[str, Any]:
+    return {
+        "label": r.label,
+        "source": str(r.source),
+        "time_s": _list(r.time_s),
+        "inputs": list(r.inputs),
+        "outputs": [_output_to_dict(o) for o in r.outputs],
+        "reference_shifts": {k: _num(v) for k, v in r.reference_shifts.items()},
+        "rmse": _num(r.rmse),
+        "tic": _num(r.tic),
+        "growth": _num(r.growth),
+        "unstable": bool(r.unstable),
+        "notice": r.notice,
+        "excited": r.excited,
+        "off_axis": list(r.off_axis),
+        "unstable_modes": list(r.unstable_modes),
+    }
+
+
+def verification_to_dict(
+    verification: Verification, *, model: str = "", options: Mapping[str, Any] | None = None, created_utc: str = ""
+) -> dict[str, Any]:
+    """The JSON document of a verification (schema ``flight-sysid/verification`` version 2).
+
+    Parameters
+    ----------
+    verification : Verification
+        The result to save.
+    model : str, optional
+        The model file verified.
+    options : Mapping[str, Any], optional
+        JSON-compatible options of the verification.
+    created_utc : str, optional
+        ISO 8601 time of the verification.
+
+    Returns
+    -------
+    dict
+        JSON-compatible (non-finite numbers as None).
+    """
+    v = verification
+
+    def summaries(rows: tuple[OutputSummary, ...]) -> list[dict[str, Any]]:
+        return [
+            {
+                "name": s.name,
+                "unit": s.unit,
+                "rmse": _num(s.rmse),
+                "tic": _num(s.tic),
+                "n_records": s.n_records,
+                "n_samples": s.n_samples,
+                "prediction_rmse": _num(s.prediction_rmse),
+                "prediction_tic": _num(s.prediction_tic),
+            }
+            for s in rows
+        ]
+
+    return {
+        "schema": VERIFICATION_SCHEMA,
+        "schema_version": VERIFICATION_SCHEMA_VERSION,
+        "model": model,
+        "options": dict(options or {}),
+        "created_utc": created_utc,
+        "rmse": _num(v.rmse),
+        "tic": _num(v.tic),
+        "summary": summaries(v.summary),
+        "off_axis": summaries(v.off_axis),
+        "records": [_record_to_dict(r) for r in v.records],
+        "without_wind": [_record_to_dict(r) for r in v.without_wind],
+        "wind_correction": [
+            {"name": c.name, "unit": c.unit, "rmse_without": _num(c.rmse_without), "rmse_with": _num(c.rmse_with)}
+            for c in v.wind_correction
+        ],
+    }
+
+
+def _output_from_dict(d: Mapping[str, Any]) -> OutputVerification:
+    predicted = d.get("predicted")
+    return OutputVerification(
+        d["name"],
+        d["unit"],
+        _array(d["measured"]),
+        _array(d["simulated"]),
+        _float(d["bias"]),
+        _float(d["rmse"]),
+        _float(d["tic"]),
+        None if predicted is None else _array(predicted),
+        _optional(d.get("prediction_rmse")),
+        _optional(d.get("prediction_tic")),
+    )
+
+
+def _record_from_dict(d: Mapping[str, Any]) -> RecordVerification:
+    return RecordVerification(
+        d["label"],
+        Path(d["source"]),
+        _array(d["time_s"]),
+        tuple(d["inputs"]),
+        tuple(_output_from_dict(o) for o in d["outputs"]),
+        {k: _float(v) for k, v in d["reference_shifts"].items()},
+        _float(d["rmse"]),
+        _float(d["tic"]),
+        _float(d["growth"]),
+        bool(d["unstable"]),
+        d.get("notice", ""),
+        d.get("excited"),
+        tuple(d.get("off_axis", ())),
+        tuple(d.get("unstable_modes", ())),
+    )
+
+
+def _summary_from_dict(s: Mapping[str, Any]) -> OutputSummary:
+    return OutputSummary(
+        s["name"],
+        s["unit"],
+        _float(s["rmse"]),
+        _float(s["tic"]),
+        int(s["n_records"]),
+        int(s["n_samples"]),
+        _optional(s.get("prediction_rmse")),
+        _optional(s.get("prediction_tic")),
+    )
+
+
+def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> SavedVerification:
+    """Rebuild a saved verification from its JSON document.
+
+    Parameters
+    ----------
+    doc : Mapping[str, Any]
+        As written by :func:`verification_to_dict`.
+    source : str, optional
+        Where it came from, for error messages.
+
+    Returns
+    -------
+    SavedVerification
+
+    Raises
+    ------
+    DataError
+        If the document is not a saved verification of a known version, or is damaged.
+    """
+    if doc.get("schema") != VERIFICATION_SCHEMA:
+        if "summary" in doc and "overall" in doc:
+            raise DataError(
+                f"{source}: this is the summary printed by 'sysid validate --json', which holds no time "
+                "histories; give a verification saved with its time histories (schema "
+                f"{VERIFICATION_SCHEMA})"
+            )
+        raise DataError(f"{source}: not a flight-sysid verification file (schema {doc.get('schema')!r})")
+    if doc.get("schema_version") not in _READABLE_VERSIONS:
+        raise DataError(
+            f"{source}: verification schema version {doc.get('schema_version')!r} is not supported "
+            f"(this version reads {', '.join(map(str, _READABLE_VERSIONS))})"
+        )
+    try:
+        verification = Verification(
+            tuple(_record_from_dict(r) for r in doc["records"]),
+            tuple(_summary_from_dict(s) for s in doc["summary"]),
+            _float(doc["rmse"]),
+            _float(doc["tic"]),
+            tuple(_record_from_dict(r) for r in doc.get("without_wind", [])),
+            tuple(
+                WindCorrection(c["name"], c["unit"], _float(c["rmse_without"]), _float(c["rmse_with"]))
+                for c in doc.get("wind_correction", [])
+            ),
+            tuple(_summary_from_dict(s) for s in doc.get("off_axis", [])),
+        )
+        return SavedVerification(
+            verification, str(doc.get("model", "")), dict(doc.get("options") or {}), str(doc.get("created_utc", ""))
+        )
+    except (KeyError, TypeError, ValueError, AttributeError) as err:
+        raise DataError(f"{source}: verification file is incomplete or damaged ({type(err).__name__}: {err})") from None
+
+
+def write_verification(
+    path: str | Path,
+    verification: Verification,
+    *,
+    model: str = "",
+    options: Mapping[str, Any] | None = None,
+    created_utc: str = "",
+) -> Path:
+    """Write a verification as versioned JSON, atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination (``validation.json``); its folder must exist.
+    verification : Verification
+        The result to save.
+    model : str, optional
+        The model file verified.
+    options : Mapping[str, Any], optional
+        JSON-compatible options of the verification.
+    created_utc : str, optional
+        ISO 8601 time of the verification.
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> t = np.arange(3) * 0.01
+    >>> out = OutputVerification("q", "rad/s", np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.9, 0.1]), 0.0, 0.08, 0.05)
+    >>> record = RecordVerification("lon doublet", Path("f.bin"), t, ("delta_lon",), (out,), {}, 4.6, 0.05, 1.0, False)
+    >>> path = write_verification(Path(tempfile.mkdtemp()) / "v.json", Verification((record,), (), 4.6, 0.05))
+    >>> read_verification(path).verification.records[0].output("q").simulated.tolist()
+    [0.0, 0.9, 0.1]
+    """
+    return write_json(path, verification_to_dict(verification, model=model, options=options, created_utc=created_utc))
+
+
+def read_verification(path: str | Path) -> SavedVerification:
+    """Read a verification written by :func:`write_verification`.
+
+    Parameters
+    ----------
+    path : str or Path
+        A verification JSON file.
+
+    Returns
+    -------
+    SavedVerification
+
+    Raises
+    ------
+    DataError
+        If the file cannot be read or is not a verification file of a supported version.
+    """
+    return verification_from_dict(read_json_object(path, DataError, "verification"), source=str(path))

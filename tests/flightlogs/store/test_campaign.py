@@ -1,0 +1,30 @@
+"""A campaign keeps the flights it could condition and says why when it could condition none."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from flightlogs.errors import DataError
+from flightlogs.store.campaign import Campaign, ingest_campaign
+
+
+def test_no_conditioned_flight_names_each_logs_reason() -> None:
+    campaign = Campaign(
+        (), (), (None, None), (("not conditioned: a.ulg has no attitude",), ("not conditioned: b.bin is 2 s long",))
+    )
+    assert campaign.flights == ()
+    with pytest.raises(
+        DataError,
+        match=r"^no log could be conditioned \(not conditioned: a.ulg has no attitude; "
+        r"not conditioned: b.bin is 2 s long\)$",
+    ):
+        campaign.require_flights()
+
+
+def test_real_logs_are_kept_in_order(real_data: Path) -> None:
+    logs = [real_data / "pyulog" / "sample_appended_multiple.ulg", real_data / "dronekit-la-testdata" / "log171.bin"]
+    campaign = ingest_campaign(logs)
+    assert campaign.require_flights() == campaign.flights
+    assert [f.source.name for f in campaign.flights] == [p.name for p in logs]

@@ -1,0 +1,157 @@
+"""Identified models on disk (JSON, .mat) and the python-control adapter, round-tripped."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy import io as sio
+
+from flightlogs.errors import ModelError
+from simulator.vehicle.identified import CALM_HOVER
+from sysid.fit import (
+    FitOptions,
+    IdentifiedModel,
+    Provenance,
+    fit_frequency_responses,
+    fit_summary,
+    from_control_layout,
+    from_statespace,
+    model_from_fit,
+    read_model,
+    synthetic_responses,
+    to_control_layout,
+    to_statespace,
+    write_mat,
+    write_model,
+)
+from sysid.model import load_structure, structure_model
+from sysid.model.statespace import DelayedStateSpace
+
+PAIRS = ["p/delta_lat", "ay/delta_lat", "q/delta_lon", "ax/delta_lon", "r/delta_yaw", "az/delta_thr"]
+
+
+@pytest.fixture(scope="module")
+def model() -> IdentifiedModel:
+    structure = load_structure("hover-wind")
+    truth, _ = structure_model(structure, dict(CALM_HOVER) | {"X_w_lon": -0.356, "Z_w_lon": 1.323})
+    responses = synthetic_responses(truth, PAIRS, noise_db=0.5, noise_deg=3.0, fit_range=(0.8, 50.0))
+    fit = fit_frequency_responses(structure, responses, options=FitOptions(max_steps=2))
+    return model_from_fit(
+        fit,
+        trim={"u": 2.2, "theta": -0.04},
+        provenance=Provenance(("a.bin",), {"a.bin": "0" * 64}, {"starts": 1}, {"numpy": "2"}, "now"),
+        notes=("u/delta_lon: dropped by gating",),
+    )
+
+
+def test_json_round_trip_keeps_everything(model: IdentifiedModel, tmp_path) -> None:
+    path = write_model(tmp_path / "model.json", model)
+    back = read_model(path)
+    assert back.parameters == model.parameters
+    assert back.cost == model.cost and back.reduction == model.reduction and back.notes == model.notes
+    assert back.correlation_names == model.correlation_names
+    assert np.array_equal(np.isnan(back.correlation), np.isnan(model.correlation))
+    assert np.allclose(np.nan_to_num(back.correlation), np.nan_to_num(model.correlation), rtol=0, atol=0)
+    assert back.provenance == model.provenance and dict(back.trim) == dict(model.trim)
+    for a, b in zip(back.responses, model.responses):
+        assert a.pair == b.pair and a.fit_range == b.fit_range
+        assert np.array_equal(a.response, b.response) and np.array_equal(a.coherence, b.coherence)
+    one, two = back.linear_model(), model.linear_model()
+    assert np.array_equal(one.a, two.a) and np.array_equal(one.d, two.d) and one.inputs == two.inputs
+    doc = json.loads(path.read_text())
+    assert doc["schema_version"] == 1 and doc["parameters"]["X_w_lon"]["status"] == "dropped"
+    assert doc["parameters"]["N_r"]["cr_percent"] is None  # NaN is written as null
+
+
+def test_how_each_response_was_computed_is_kept(model: IdentifiedModel, tmp_path) -> None:
+    first = dataclasses.replace(model.responses[0], reference="excitation", whole_record=True)
+    changed = dataclasses.replace(model, responses=(first, *model.responses[1:]))
+    back = read_model(write_model(tmp_path / "model.json", changed))
+    assert [(r.reference, r.whole_record) for r in back.responses] == [
+        (r.reference, r.whole_record) for r in changed.responses
+    ]
+    assert (back.responses[0].reference, back.responses[0].whole_record) == ("excitation", True)
+
+
+def test_wind_parameters_without_a_wind_step_are_dropped_and_logged(model: IdentifiedModel) -> None:
+    assert model.parameter("X_w_lon").dropped and model.parameter("X_w_lon").stage == "wind"
+    assert any(s.parameter == "tau_w_thr" and "no wind record" in s.reason for s in model.reduction)
+    assert model.linear_model(include_wind=False).inputs == ("delta_lat", "delta_lon", "delta_yaw", "delta_thr")
+    assert model.linear_model().inputs[-2:] == ("wind_lon", "wind_lon")
+
+
+def test_bad_model_files_are_refused(model: IdentifiedModel, tmp_path) -> None:
+    path = write_model(tmp_path / "model.json", model)
+    doc = json.loads(path.read_text())
+    for change, message in (
+        ({"schema_version": 99}, "version 99"),
+        ({"schema": "x"}, "not a flight-sysid model"),
+        ({"cost": {}}, "cost has no average"),
+    ):
+        (tmp_path / "bad.json").write_text(json.dumps(doc | change))
+        with pytest.raises(ModelError, match=message):
+            read_model(tmp_path / "bad.json")
+    (tmp_path / "text.json").write_text("{not json")
+    with pytest.raises(ModelError, match="text.json"):
+        read_model(tmp_path / "text.json")
+
+
+def test_mat_file_holds_the_matrices(model: IdentifiedModel, tmp_path) -> None:
+    content = sio.loadmat(write_mat(tmp_path / "model.mat", model))
+    linear = model.linear_model()
+    assert np.array_equal(content["A"], linear.a) and np.array_equal(content["D"], linear.d)
+    assert [str(s[0]) for s in content["states"].ravel()] == list(linear.states)
+    names = [str(s[0]) for s in content["parameter_names"].ravel()]
+    assert content["parameter_values"].ravel()[names.index("X_u")] == model.parameter("X_u").value
+
+
+def test_summary_has_the_fields_scripts_use(model: IdentifiedModel) -> None:
+    summary = fit_summary(model)
+    assert set(summary["parameters"]["X_u"]) >= {"value", "cr_percent", "insensitivity_percent"}
+    assert summary["cost"]["average"] == model.cost.average and set(summary["cost"]["responses"]) == set(
+        model.cost.responses
+    )
+    assert {"real", "imag", "damping", "natural_frequency_rad_s", "mode"} <= set(summary["eigenvalues"][0])
+    assert set(summary["dropped"]) >= {"X_w_lon", "Z_w_lon"}
+    json.dumps(summary, allow_nan=False)  # NaN-free
+
+
+def test_layout_adapter_round_trips() -> None:
+    response = np.random.default_rng(0).normal(size=(7, 3, 2)) + 0j
+    assert to_control_layout(response).shape == (3, 2, 7)
+    assert np.array_equal(from_control_layout(to_control_layout(response)), response)
+
+
+def test_control_statespace_reproduces_the_response(model: IdentifiedModel) -> None:
+    linear = model.linear_model(include_wind=False)
+    omega = np.geomspace(0.5, 30.0, 25)
+    undelayed = DelayedStateSpace(
+        linear.a,
+        linear.b,
+        linear.c,
+        linear.d,
+        linear.states,
+        linear.inputs,
+        linear.outputs,
+        np.zeros(len(linear.inputs)),
+    )
+    system = to_statespace(undelayed)
+    ours = from_control_layout(system.frequency_response(omega).complex)
+    assert np.allclose(ours, undelayed.frequency_response(omega), rtol=1e-9, atol=1e-12)
+    back = from_statespace(system, linear.input_delays_s)
+    assert np.allclose(back.frequency_response(omega), linear.frequency_response(omega), rtol=1e-9, atol=1e-12)
+    # Pade: phase error of a 3rd-order approximant of exp(-s tau) is below 1e-3 rad for omega tau < 1
+    pade = from_control_layout(to_statespace(linear, delays="pade", pade_order=3).frequency_response(omega).complex)
+    assert np.allclose(pade, linear.frequency_response(omega), rtol=2e-3, atol=1e-9)
+
+
+def test_control_names_are_unique_for_a_signal_entering_twice(model: IdentifiedModel) -> None:
+    system = to_statespace(model)
+    assert system.input_labels[-2:] == ["wind_lon", "wind_lon_2"]
+    with pytest.raises(TypeError):
+        to_statespace(object())
+    assert math.isfinite(model.cost.average)
