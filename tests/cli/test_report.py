@@ -8,7 +8,6 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from types import ModuleType
 
 import pytest
 from click.testing import CliRunner
@@ -22,6 +21,8 @@ from sysid.verify import Verification
 from sysid.verify.io import read_verification, write_verification
 from sysid_cli.main import cli
 from sysid_cli.report import ingest_card
+
+import builders
 
 _FOOTER = re.compile(r"<footer>.*?</footer>", re.S)
 INGEST = {
@@ -42,12 +43,10 @@ INGEST = {
 
 
 @pytest.fixture(scope="module")
-def saved(
-    tmp_path_factory: pytest.TempPathFactory, report_browser: ModuleType, report_models: ModuleType
-) -> tuple[Path, Path, IdentifiedModel, Verification]:
+def saved(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, IdentifiedModel, Verification]:
     folder = tmp_path_factory.mktemp("saved")
-    model = report_models.small_model(files=("flight.bin", "anemometer.csv"))
-    verification = report_browser.sample_verification()
+    model = builders.small_model(files=("flight.bin", "anemometer.csv"))
+    verification = builders.sample_verification()
     write_model(folder / "model.json", model)
     write_verification(
         folder / "validation.json",

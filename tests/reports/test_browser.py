@@ -9,18 +9,19 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from types import ModuleType
 
 import pytest
 
 from reports.model_report import write_model_report
 
+import browser
+import builders
+
 ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
 
 
 @pytest.fixture(scope="module")
-def chromium(report_browser: ModuleType) -> Path:
-    browser = report_browser
+def chromium() -> Path:
     try:
         return browser.chromium_path()
     except browser.BrowserUnavailable as err:
@@ -29,19 +30,16 @@ def chromium(report_browser: ModuleType) -> Path:
         pytest.skip(str(err))
 
 
-def test_model_report_renders_in_chromium(
-    chromium: Path, tmp_path: Path, report_browser: ModuleType, report_models: ModuleType
-) -> None:
+def test_model_report_renders_in_chromium(chromium: Path, tmp_path: Path) -> None:
     """What ``sysid validate --report`` and ``sysid report`` write: the model with its verification."""
-    browser, fixtures = report_browser, report_models
-    model = fixtures.small_model(files=("flight.bin", "anemometer.csv"))
-    verification = browser.sample_verification()
+    model = builders.small_model(files=("flight.bin", "anemometer.csv"))
+    verification = builders.sample_verification()
     page = write_model_report(
         tmp_path / "model.html",
         model,
         verification=verification,
         logs_summary={"vehicle": "linear octocopter"},
-        generated_utc=fixtures.STAMP,
+        generated_utc=builders.STAMP,
     )
     shot = ARTIFACTS / "model_report.png"
     seen = browser.render_in_browser(page, shot)
@@ -57,14 +55,14 @@ def test_model_report_renders_in_chromium(
     assert shot.stat().st_size > 50_000
 
 
-def test_a_blank_page_is_seen_as_blank(chromium: Path, tmp_path: Path, report_browser: ModuleType) -> None:
+def test_a_blank_page_is_seen_as_blank(chromium: Path, tmp_path: Path) -> None:
     """The helper itself: an empty page has no figures and no ink; a broken script and a fetch are reported."""
     page = tmp_path / "blank.html"
     page.write_text(
         "<!DOCTYPE html><html><body><script>undefinedFunction()</script>"
         '<img src="http://127.0.0.1:9/pixel.png" alt=""></body></html>'
     )  # loopback discard port
-    seen = report_browser.render_in_browser(page, tmp_path / "blank.png")
+    seen = browser.render_in_browser(page, tmp_path / "blank.png")
     assert seen.n_figures == 0 and not seen.screenshot_nonblank
     assert any("undefinedFunction" in error for error in seen.console_errors)
     assert seen.external_requests == ("http://127.0.0.1:9/pixel.png",)

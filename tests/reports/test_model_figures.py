@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from types import ModuleType
 
 import numpy as np
 import pytest
@@ -14,6 +13,8 @@ from reports.svg import figure_svg
 from sysid.fit import IdentifiedModel
 from sysid.model.modes import Mode, modes
 from sysid.model.statespace import DelayedStateSpace
+
+import builders
 
 
 def _first_order(delay_s: float = 0.0) -> DelayedStateSpace:
@@ -139,8 +140,8 @@ def test_pole_map_of_an_identified_model_has_every_mode(small_model: IdentifiedM
 
 
 @pytest.fixture(scope="module")
-def small_model(report_models: ModuleType) -> IdentifiedModel:
+def small_model() -> IdentifiedModel:
     """Two longitudinal, one lateral and one heave response of a hover model, with 3 deg phase noise."""
-    model: IdentifiedModel = report_models.small_model()
-    assert [r.pair for r in model.responses] == list(report_models.PAIRS)
+    model: IdentifiedModel = builders.small_model()
+    assert [r.pair for r in model.responses] == list(builders.PAIRS)
     return model

@@ -12,10 +12,7 @@ import dataclasses
 import math
 import re
 from collections.abc import Mapping
-from importlib import resources
-from types import ModuleType
 
-import numpy as np
 import pytest
 
 from reports.model_report import (
@@ -29,73 +26,12 @@ from reports.model_report import (
     model_report_html,
     model_verdict,
 )
-from simulator.vehicle.identified import CALM_HOVER
-from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate, Provenance, ReductionStep, synthetic_responses
-from sysid.model import parse_structure
+from sysid.fit import IdentifiedModel
 from sysid.verify import OutputSummary, Verification
 
+from builders import STAMP, sample_verification, small_model
+
 HOSTILE = '<script>alert("x")</script><img src=x onerror=alert(1)>'
-STAMP = "2024-05-01 12:00 UTC"
-PAIRS = ("q/delta_lon", "u/delta_lon", "p/delta_lat", "az/delta_thr")
-DROPPED = ("N_r", "Z_w", "tau_thr")
-_NORMALISED = "normalised (-1..1)"
-
-
-def small_model(
-    *,
-    average: float = 40.0,
-    costs: Mapping[str, float] | None = None,
-    accuracy: Mapping[str, tuple[float, float]] | None = None,
-    files: tuple[str, ...] = ("flight.bin",),
-    notes: tuple[str, ...] = (),
-    responses: bool = True,
-) -> IdentifiedModel:
-    """The hover structure at Table 3.3's values (per normalised input) with chosen costs and accuracies."""
-    text = (resources.files("sysid.model") / "builtin" / "hover.toml").read_text()
-    structure = parse_structure(text, source="hover")
-    values = dict(CALM_HOVER) | {"N_r": 0.0, "Z_w": 0.0, "tau_thr": 0.0}
-    for name in ("X_lon", "M_lon", "Y_lat", "L_lat", "N_yaw", "Z_thr"):
-        values[name] *= 100.0  # the mixer input is logged normalised to -1..1
-    accuracy = dict(accuracy or {})
-    parameters = []
-    for p in structure.parameters:
-        estimated = p.name not in DROPPED
-        cr, ins = accuracy.get(p.name, (5.0, 2.0)) if estimated else (math.nan, math.nan)
-        unit = re.sub(r"\{delta_\w+\}", _NORMALISED, p.unit)
-        parameters.append(
-            ParameterEstimate(p.name, values[p.name], cr, ins, "estimated" if estimated else "dropped", unit)
-        )
-    names = tuple(p.name for p in parameters if p.status == "estimated")
-    correlation = np.eye(len(names))
-    correlation[0, 1] = correlation[1, 0] = -0.95  # X_u, M_u: the one pair beyond |r| = 0.9
-    correlation[2, 3] = correlation[3, 2] = 0.5
-    constants = {"g": 9.81, "U0": 0.0, "V0": 0.0, "W0": 0.0, "phi0": 0.0, "theta0": 0.0}
-    model = IdentifiedModel(
-        "hover", text, tuple(parameters), names, correlation, CostSummary(average), constants=constants
-    )
-    fitted = (
-        synthetic_responses(model.linear_model(), PAIRS, noise_db=0.5, noise_deg=3.0, fit_range=(1.0, 40.0), seed=3)
-        if responses
-        else ()
-    )
-    costs = dict(costs) if costs is not None else {pair: average for pair in PAIRS}
-    reduction = (ReductionStep(1, "N_r", "dropped", 0.0, -0.02, 80.0, 45.0, "I% = 45 > 10", average, average),)
-    provenance = Provenance(
-        files,
-        {f: "ab" * 32 for f in files},
-        {"min_coherence": 0.5, "fit": {"starts": 1}},
-        {"flight-sysid": "0.1.0"},
-        "2024-05-01T12:00:00+00:00",
-    )
-    return dataclasses.replace(
-        model,
-        cost=CostSummary(average, costs),
-        responses=fitted,
-        reduction=reduction,
-        provenance=provenance,
-        notes=notes,
-        input_units={"delta_lon": _NORMALISED},
-    )
 
 
 def verification_with(tics: Mapping[str, float]) -> Verification:
@@ -105,13 +41,13 @@ def verification_with(tics: Mapping[str, float]) -> Verification:
 
 
 @pytest.fixture(scope="module")
-def hostile_page(report_browser: ModuleType) -> tuple[str, IdentifiedModel, Verification]:
+def hostile_page() -> tuple[str, IdentifiedModel, Verification]:
     """A full report where every string from a log or a file is hostile."""
     model = small_model(files=(f"flight{HOSTILE}.bin", "anemometer.csv"), notes=(f"note {HOSTILE}",))
     model = dataclasses.replace(
         model, provenance=dataclasses.replace(model.provenance, options={"min_coherence": 0.5, "kind": HOSTILE})
     )
-    sample = report_browser.sample_verification()
+    sample = sample_verification()
     records = tuple(dataclasses.replace(r, label=f"{r.label} {HOSTILE}") for r in sample.records)
     verification = dataclasses.replace(sample, records=records)
     page = model_report_html(

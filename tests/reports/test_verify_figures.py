@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
-from types import ModuleType
 
 import numpy as np
 import pytest
@@ -14,10 +13,12 @@ from reports.model_report import model_report_html
 from reports.verify_figures import display_scale, record_figure, verification_figures, wind_correction_figure
 from sysid.verify import Verification, WindCorrection
 
+import builders
+
 
 @pytest.fixture(scope="module")
-def verification(report_browser: ModuleType) -> Verification:
-    result: Verification = report_browser.sample_verification()
+def verification() -> Verification:
+    result: Verification = builders.sample_verification()
     return result
 
 
@@ -103,11 +104,9 @@ def test_figures_are_the_wind_bars_then_one_per_record(verification: Verificatio
     assert len(verification_figures(plain)) == len(verification.records)
 
 
-def test_the_report_tables_judge_on_axis_outputs_and_list_the_others(
-    verification: Verification, report_models: ModuleType
-) -> None:
+def test_the_report_tables_judge_on_axis_outputs_and_list_the_others(verification: Verification) -> None:
     page = model_report_html(
-        report_models.small_model(responses=False), verification=verification, generated_utc=report_models.STAMP
+        builders.small_model(responses=False), verification=verification, generated_utc=builders.STAMP
     )
     section = page[page.index('id="verification"') : page.index('id="reduction"')]
     judged, informative = section.split("Off-axis outputs", 1)

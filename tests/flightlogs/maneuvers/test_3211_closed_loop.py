@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from types import ModuleType
 
 import numpy as np
 import pytest
@@ -22,9 +21,8 @@ from flightlogs.readers.dispatch import read_log
 from simulator.campaign.fly import run_scenario
 from simulator.campaign.scenario import read_scenario
 
-RATE_HZ = 100.0
-DT = 1.0 / RATE_HZ
-AMPLITUDE = 0.15  # mixer units (0-1 scale), as test_excitation.py's
+from builders import AMPLITUDE, DT, RATE_HZ, closed_loop_roll_hold, input_3211
+
 ONE_SAMPLE_S = DT + 1e-9
 
 SCENARIO = """\
@@ -72,7 +70,7 @@ duration_s = 20.0
 @pytest.mark.parametrize(("gust", "seed"), [(0.1, 0), (0.3, 1)])
 @pytest.mark.parametrize("pass_", ["first", "second"])
 def test_a_closed_loop_3211_is_recovered_and_found_to_the_sample(
-    unit_s: float, gust: float, seed: int, pass_: str, excitation_tests: ModuleType
+    unit_s: float, gust: float, seed: int, pass_: str
 ) -> None:
     """3 s hover, the 3-2-1-1, 3 s hover; the feedback fitted on everything (first pass) or on 2 s of hover.
 
@@ -83,11 +81,10 @@ def test_a_closed_loop_3211_is_recovered_and_found_to_the_sample(
     after that). Before the joint 3-2-1-1 fit the 1 s unit was found as a
     doublet.
     """
-    assert (excitation_tests.DT, excitation_tests.AMPLITUDE) == (DT, AMPLITUDE)
     t = np.arange(int((6.0 + 7 * unit_s) * RATE_HZ)) * DT
     end_s = 3.0 + 7 * unit_s
-    injected = excitation_tests._3211(t, 3.0, unit_s)  # the cascaded roll hold of test_excitation.py
-    log = excitation_tests._closed_loop(injected, seed, gust)
+    injected = input_3211(t, 3.0, unit_s)  # the cascaded roll hold of tests/builders.py
+    log = closed_loop_roll_hold(injected, seed, gust)
     quiet = np.ones(t.size, dtype=bool) if pass_ == "first" else (t < 1.0) | (t > end_s + 2.0)
     states = {name: log[name] for name in ("p", "phi", "ve")}
     out = estimate_excitation({"lat": log["u"]}, states, quiet, time_s=t)["lat"]

@@ -16,52 +16,18 @@ from flightlogs.errors import DataError
 from flightlogs.maneuvers.excitation_recovery import estimate_excitation
 from flightlogs.maneuvers.segments import detect_segments
 
-RATE_HZ = 100.0
-DT = 1.0 / RATE_HZ
+from builders import (
+    AMPLITUDE,
+    DT,
+    RATE_HZ,
+    closed_loop_roll_hold,
+    doublet_input,
+    multisine_input,
+    sweep_input,
+)
+
 ONE_SAMPLE_S = DT + 1e-9
-AMPLITUDE = 0.15  # mixer units (0-1 scale), as the chapter 3 campaign's 15 % doublets
 GUST = {"calm": 0.1, "strong": 0.3}  # hover mixer activity 0.4 % and 1 % RMS (chapter 3 campaign: 0.2 %, 0.9 %)
-
-
-def _closed_loop(excitation: np.ndarray, seed: int, gust: float) -> dict[str, np.ndarray]:
-    """Mixer input ``u`` and the logged ``p phi ve`` of the roll axis with `excitation` summed at the mixer.
-
-    Plant: actuator lag 0.05 s, roll acceleration 60 rad/s² per unit input,
-    ``ve' = g phi``; turbulence as slowly varying torque and acceleration.
-    Gains: rate loop crossover 10 rad/s with its integrator at a fifth of it,
-    angle 4 /s, velocity 1 /s (integral 0.2), position 0.4 /s.
-    """
-    rng = np.random.default_rng(seed)
-    effectiveness, lag_s, substeps = 60.0, 0.05, 4
-    kp, ki, k_angle, k_vel, ki_vel, k_pos = 10 / effectiveness, 20 / effectiveness, 4.0, 1.0, 0.2, 0.4
-    actuator = p = phi = ve = pe = rate_integral = velocity_integral = torque = accel = 0.0
-    log = {name: np.zeros(excitation.size) for name in ("u", "p", "phi", "ve")}
-    h = DT / substeps
-    for k, e in enumerate(excitation):
-        noise = rng.standard_normal(3) * (0.005, 0.001, 0.02)  # rate, angle and velocity estimates
-        p_m, phi_m, ve_m = p + noise[0], phi + noise[1], ve + noise[2]
-        v_set = -k_pos * pe
-        velocity_integral += ki_vel * (v_set - ve_m) * DT
-        phi_set = (k_vel * (v_set - ve_m) + velocity_integral) / 9.81
-        rate_error = k_angle * (phi_set - phi_m) - p_m
-        rate_integral += ki * rate_error * DT
-        u = kp * rate_error + rate_integral + e
-        log["u"][k], log["p"][k], log["phi"][k], log["ve"][k] = u, p_m, phi_m, ve_m
-        torque = 0.995 * torque + gust * 0.3 * rng.standard_normal()
-        accel = 0.995 * accel + gust * 0.05 * rng.standard_normal()
-        for _ in range(substeps):
-            actuator += h * (u - actuator) / lag_s
-            p += h * (effectiveness * actuator + torque)
-            phi += h * p
-            ve += h * (9.81 * phi + accel)
-            pe += h * ve
-    return log
-
-
-def _doublet(t: np.ndarray, start_s: float, pulse_s: float) -> np.ndarray:
-    first = (t >= start_s) & (t < start_s + pulse_s)
-    second = (t >= start_s + pulse_s) & (t < start_s + 2 * pulse_s)
-    return AMPLITUDE * (first.astype(float) - second)
 
 
 def _excitation(log: dict[str, np.ndarray], quiet: np.ndarray, t: np.ndarray | None, scale: float = 1.0) -> np.ndarray:
@@ -92,8 +58,8 @@ def test_a_doublet_in_a_short_record_is_recovered_with_its_edges(wind: str, seed
     sample of the doublet.
     """
     t = np.arange(800) * DT
-    injected = _doublet(t, 3.0, 1.0)
-    log = _closed_loop(injected, seed, GUST[wind])
+    injected = doublet_input(t, 3.0, 1.0)
+    log = closed_loop_roll_hold(injected, seed, GUST[wind])
     quiet = np.ones(t.size, dtype=bool) if pass_ == "first" else (t < 1.0) | (t > 7.0)
     out = _excitation(log, quiet, t)
     inside = (t >= 3.0) & (t < 5.0)
@@ -106,7 +72,7 @@ def test_a_doublet_in_a_short_record_is_recovered_with_its_edges(wind: str, seed
 @pytest.mark.parametrize("pulse_s", [0.25, 2.5])
 def test_short_and_long_pulses_are_found(pulse_s: float) -> None:
     t = np.arange(int((6.0 + 2 * pulse_s) * RATE_HZ)) * DT
-    log = _closed_loop(_doublet(t, 3.0, pulse_s), 4, GUST["strong"])
+    log = closed_loop_roll_hold(doublet_input(t, 3.0, pulse_s), 4, GUST["strong"])
     (found,) = _maneuvers(t, _excitation(log, np.ones(t.size, dtype=bool), t))
     assert (found.axis, found.kind) == ("lat", "doublet")
     assert abs(found.start_s - 3.0) <= ONE_SAMPLE_S and abs(found.end_s - (3.0 + 2 * pulse_s)) <= ONE_SAMPLE_S
@@ -115,7 +81,7 @@ def test_short_and_long_pulses_are_found(pulse_s: float) -> None:
 def test_in_a_long_record_the_quiet_fit_finds_the_doublet() -> None:
     """40 s of hover around the doublet: the quiet-sample fit is trusted, and the doublet is found to the sample."""
     t = np.arange(4000) * DT
-    log = _closed_loop(_doublet(t, 20.0, 1.0), 5, GUST["strong"])
+    log = closed_loop_roll_hold(doublet_input(t, 20.0, 1.0), 5, GUST["strong"])
     quiet = (t < 18.0) | (t > 24.0)
     (found,) = _maneuvers(t, _excitation(log, quiet, t))
     assert (found.axis, found.kind) == ("lat", "doublet")
@@ -125,30 +91,12 @@ def test_in_a_long_record_the_quiet_fit_finds_the_doublet() -> None:
 def test_units_do_not_matter() -> None:
     """A mixer input logged in % instead of 0-1 gives the same excitation, ×100: every rule is a ratio."""
     t = np.arange(800) * DT
-    log = _closed_loop(_doublet(t, 3.0, 1.0), 6, GUST["strong"])
+    log = closed_loop_roll_hold(doublet_input(t, 3.0, 1.0), 6, GUST["strong"])
     quiet = np.ones(t.size, dtype=bool)
     np.testing.assert_allclose(_excitation(log, quiet, t, scale=100.0), 100.0 * _excitation(log, quiet, t), atol=1e-9)
 
 
 # ------------------------------------------------------------------ what is not a doublet
-
-
-def _sweep(t: np.ndarray, start_s: float, length_s: float) -> np.ndarray:
-    tau = np.clip(t - start_s, 0.0, length_s)
-    phase = 2 * np.pi * (0.3 * tau + (4.0 - 0.3) * tau**2 / (2 * length_s))  # 0.3 to 4 Hz, linear
-    return np.where((t >= start_s) & (t < start_s + length_s), 0.5 * AMPLITUDE * np.sin(phase), 0.0)
-
-
-def _3211(t: np.ndarray, start_s: float, unit_s: float) -> np.ndarray:
-    edges = start_s + unit_s * np.cumsum([0, 3, 2, 1, 1])
-    return AMPLITUDE * sum(sign * ((t >= a) & (t < b)) for sign, a, b in zip([1, -1, 1, -1], edges[:-1], edges[1:]))
-
-
-def _multisine(t: np.ndarray, start_s: float, length_s: float) -> np.ndarray:
-    tones = [0.4, 0.9, 1.3, 2.1, 2.9, 3.7]
-    phases = np.random.default_rng(9).uniform(0, 2 * np.pi, len(tones))
-    inside = (t >= start_s) & (t < start_s + length_s)
-    return 0.3 * AMPLITUDE * inside * sum(np.sin(2 * np.pi * f * t + ph) for f, ph in zip(tones, phases))
 
 
 @pytest.mark.parametrize("kind", ["sweep", "multisine", "hover"])
@@ -157,8 +105,12 @@ def test_other_maneuvers_and_hover_are_left_to_the_quiet_fit(kind: str, wind: st
     """No doublet is fitted into a 6 s sweep, a multisine or plain hover in 12 s (a 3-2-1-1 is fitted as one:
     tests/flightlogs/maneuvers/test_3211_closed_loop.py)."""
     t = np.arange(1200) * DT
-    injected = {"sweep": _sweep(t, 3.0, 6.0), "multisine": _multisine(t, 3.0, 6.0), "hover": np.zeros(t.size)}[kind]
-    log = _closed_loop(injected, 7, GUST[wind])
+    injected = {
+        "sweep": sweep_input(t, 3.0, 6.0),
+        "multisine": multisine_input(t, 3.0, 6.0),
+        "hover": np.zeros(t.size),
+    }[kind]
+    log = closed_loop_roll_hold(injected, 7, GUST[wind])
     quiet = np.ones(t.size, dtype=bool)
     np.testing.assert_array_equal(_excitation(log, quiet, t), _excitation(log, quiet, None))
 
@@ -177,6 +129,6 @@ def test_states_not_logged_leave_the_input_as_it_is() -> None:
     [(np.arange(799) * DT, "shape"), (np.r_[np.arange(400), np.arange(401, 801)] * DT, "uniformly sampled")],
 )
 def test_a_bad_time_base_is_a_data_error(time_s: np.ndarray, fragment: str) -> None:
-    log = _closed_loop(np.zeros(800), 0, GUST["calm"])
+    log = closed_loop_roll_hold(np.zeros(800), 0, GUST["calm"])
     with pytest.raises(DataError, match=fragment):
         _excitation(log, np.ones(800, dtype=bool), time_s)

@@ -70,7 +70,7 @@ def test_a_failed_write_leaves_the_old_file(tmp_path: Path) -> None:
     class Broken:
         path = tmp_path / "wind.csv"
 
-    with pytest.raises(Exception):
+    with pytest.raises(TypeError):
         write_dataset(out, [_log(tmp_path / "other.ulg")], [Broken()])
     assert out.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".part")] == []

@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 import json
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -15,10 +14,12 @@ from flightlogs.errors import DataError
 from sysid.verify import Verification
 from sysid.verify.io import VERIFICATION_SCHEMA_VERSION, read_verification, verification_to_dict, write_verification
 
+import builders
+
 
 @pytest.fixture(scope="module")
-def sample(report_browser: ModuleType) -> Verification:
-    verification: Verification = report_browser.sample_verification()
+def sample() -> Verification:
+    verification: Verification = builders.sample_verification()
     return verification
 
 

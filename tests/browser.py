@@ -13,12 +13,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
-
-from flightlogs.record import Record
-from sysid.model.statespace import DelayedStateSpace
-from sysid.verify import Verification, verify
-from sysid.verify._discrete import discretize, simulate
 
 #: Flags that work on the shared machine and CI: no sandbox (root), no GPU, nothing phoning home.
 CHROMIUM_FLAGS = (
@@ -134,74 +128,4 @@ def render_in_browser(html_path: Path, screenshot_path: Path, *, width: int = 11
         tuple(int(n) for n in marks),
         _nonblank(png),
         external,
-    )
-
-
-def sample_verification(*, seed: int = 0) -> Verification:
-    """A small verification to render: a pitch-like model with and without a wind term on two noisy doublets.
-
-    A weakly coupled roll rate ``p`` (driven by the pitch rate and its own input) is an off-axis output of the
-    ``delta_lon`` doublets, shown for information.
-    """
-    a = np.array([[-1.5, -6.0, 1.2, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, -20.0, 0.0], [0.3, 0.0, 0.0, -3.0]])
-    b = np.array([[0.0, 0.0, 0.3], [0.0, 0.0, 0.0], [20.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
-    c = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [-0.4, 0.0, 0.3, 0.0], [0.0, 0.0, 0.0, 1.0]])
-    d = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.5], [0.0, 0.0, 0.0]])
-    with_wind = DelayedStateSpace(
-        a,
-        b,
-        c,
-        d,
-        ("q", "theta", "d_lon", "p"),
-        ("delta_lon", "delta_lat", "wind_lon"),
-        ("q", "theta", "ax", "p"),
-        np.array([0.02, 0.02, 0.015]),
-    )
-    without = DelayedStateSpace(
-        a,
-        b[:, :2],
-        c,
-        d[:, :2],
-        with_wind.states,
-        with_wind.inputs[:2],
-        with_wind.outputs,
-        with_wind.input_delays_s[:2],
-    )
-    rng = np.random.default_rng(seed)
-    t = np.arange(400) * 0.01
-    records = []
-    for k in range(2):
-        doublet = np.where((t >= 0.5) & (t < 1.5), 0.4, 0.0) - np.where((t >= 1.5) & (t < 2.5), 0.4, 0.0)
-        wind = np.cumsum(rng.normal(scale=0.02, size=t.size))
-        inputs = np.column_stack([doublet, 0.05 * np.sin(2.0 * t), wind - wind.mean()])
-        y = simulate(discretize(with_wind, 0.01), inputs, np.zeros(4))
-        y += rng.normal(scale=[0.005, 0.001, 0.03, 0.005], size=y.shape)
-        table = pd.DataFrame(
-            {
-                "delta_lon": inputs[:, 0],
-                "delta_lat": inputs[:, 1],
-                "wind_lon": inputs[:, 2],
-                "q": y[:, 0],
-                "theta": y[:, 1],
-                "ax": y[:, 2],
-                "p": y[:, 3],
-            },
-            index=pd.Index(20.0 * k + 5.0 + t, name="time_s"),
-        )
-        units = {
-            "delta_lon": "%",
-            "delta_lat": "%",
-            "wind_lon": "m/s",
-            "q": "rad/s",
-            "theta": "rad",
-            "ax": "m/s^2",
-            "p": "rad/s",
-        }
-        records.append(Record(table, units, {}, Path("doublets.ulg"), f"doublets.ulg lon doublet {k + 1}"))
-    return verify(
-        without,
-        records,
-        wind_model=with_wind,
-        excited=["delta_lon", "delta_lon"],
-        axes={"delta_lon": ("q", "theta", "ax")},
     )

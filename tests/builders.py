@@ -1,0 +1,242 @@
+"""Builders the tests share: known closed-loop flights, a small identified model, a small verification.
+
+Importable from any test as ``import builders`` (``tests`` is on pytest's ``pythonpath``).
+
+- The roll axis of a hovering multirotor under a cascaded hold (position P, velocity PI,
+  angle P, rate PI), with the injected excitation known exactly, and the inputs flown in it.
+- The hover structure at Table 3.3's values with chosen costs and accuracies (for reports).
+- A small simulated verification of a pitch-like model on two noisy doublets (for reports).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from collections.abc import Mapping
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from flightlogs.record import Record
+from simulator.vehicle.identified import CALM_HOVER
+from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate, Provenance, ReductionStep, synthetic_responses
+from sysid.model import parse_structure
+from sysid.model.statespace import DelayedStateSpace
+from sysid.verify import Verification, verify
+from sysid.verify._discrete import discretize, simulate
+
+# ------------------------------------------------------------------ a closed-loop roll hold
+
+RATE_HZ = 100.0
+
+
+DT = 1.0 / RATE_HZ
+
+
+AMPLITUDE = 0.15  # mixer units (0-1 scale), as the chapter 3 campaign's 15 % doublets
+
+
+def closed_loop_roll_hold(excitation: np.ndarray, seed: int, gust: float) -> dict[str, np.ndarray]:
+    """Mixer input ``u`` and the logged ``p phi ve`` of the roll axis with `excitation` summed at the mixer.
+
+    Plant: actuator lag 0.05 s, roll acceleration 60 rad/s² per unit input,
+    ``ve' = g phi``; turbulence as slowly varying torque and acceleration.
+    Gains: rate loop crossover 10 rad/s with its integrator at a fifth of it,
+    angle 4 /s, velocity 1 /s (integral 0.2), position 0.4 /s.
+    """
+    rng = np.random.default_rng(seed)
+    effectiveness, lag_s, substeps = 60.0, 0.05, 4
+    kp, ki, k_angle, k_vel, ki_vel, k_pos = 10 / effectiveness, 20 / effectiveness, 4.0, 1.0, 0.2, 0.4
+    actuator = p = phi = ve = pe = rate_integral = velocity_integral = torque = accel = 0.0
+    log = {name: np.zeros(excitation.size) for name in ("u", "p", "phi", "ve")}
+    h = DT / substeps
+    for k, e in enumerate(excitation):
+        noise = rng.standard_normal(3) * (0.005, 0.001, 0.02)  # rate, angle and velocity estimates
+        p_m, phi_m, ve_m = p + noise[0], phi + noise[1], ve + noise[2]
+        v_set = -k_pos * pe
+        velocity_integral += ki_vel * (v_set - ve_m) * DT
+        phi_set = (k_vel * (v_set - ve_m) + velocity_integral) / 9.81
+        rate_error = k_angle * (phi_set - phi_m) - p_m
+        rate_integral += ki * rate_error * DT
+        u = kp * rate_error + rate_integral + e
+        log["u"][k], log["p"][k], log["phi"][k], log["ve"][k] = u, p_m, phi_m, ve_m
+        torque = 0.995 * torque + gust * 0.3 * rng.standard_normal()
+        accel = 0.995 * accel + gust * 0.05 * rng.standard_normal()
+        for _ in range(substeps):
+            actuator += h * (u - actuator) / lag_s
+            p += h * (effectiveness * actuator + torque)
+            phi += h * p
+            ve += h * (9.81 * phi + accel)
+            pe += h * ve
+    return log
+
+
+def doublet_input(t: np.ndarray, start_s: float, pulse_s: float) -> np.ndarray:
+    first = (t >= start_s) & (t < start_s + pulse_s)
+    second = (t >= start_s + pulse_s) & (t < start_s + 2 * pulse_s)
+    return AMPLITUDE * (first.astype(float) - second)
+
+
+def sweep_input(t: np.ndarray, start_s: float, length_s: float) -> np.ndarray:
+    tau = np.clip(t - start_s, 0.0, length_s)
+    phase = 2 * np.pi * (0.3 * tau + (4.0 - 0.3) * tau**2 / (2 * length_s))  # 0.3 to 4 Hz, linear
+    return np.where((t >= start_s) & (t < start_s + length_s), 0.5 * AMPLITUDE * np.sin(phase), 0.0)
+
+
+def input_3211(t: np.ndarray, start_s: float, unit_s: float) -> np.ndarray:
+    edges = start_s + unit_s * np.cumsum([0, 3, 2, 1, 1])
+    return AMPLITUDE * sum(sign * ((t >= a) & (t < b)) for sign, a, b in zip([1, -1, 1, -1], edges[:-1], edges[1:]))
+
+
+def multisine_input(t: np.ndarray, start_s: float, length_s: float) -> np.ndarray:
+    tones = [0.4, 0.9, 1.3, 2.1, 2.9, 3.7]
+    phases = np.random.default_rng(9).uniform(0, 2 * np.pi, len(tones))
+    inside = (t >= start_s) & (t < start_s + length_s)
+    return 0.3 * AMPLITUDE * inside * sum(np.sin(2 * np.pi * f * t + ph) for f, ph in zip(tones, phases))
+
+
+# ------------------------------------------------------------------ a small identified model (reports)
+
+STAMP = "2024-05-01 12:00 UTC"
+
+
+PAIRS = ("q/delta_lon", "u/delta_lon", "p/delta_lat", "az/delta_thr")
+
+
+DROPPED = ("N_r", "Z_w", "tau_thr")
+
+
+NORMALISED_UNIT = "normalised (-1..1)"
+
+
+def small_model(
+    *,
+    average: float = 40.0,
+    costs: Mapping[str, float] | None = None,
+    accuracy: Mapping[str, tuple[float, float]] | None = None,
+    files: tuple[str, ...] = ("flight.bin",),
+    notes: tuple[str, ...] = (),
+    responses: bool = True,
+) -> IdentifiedModel:
+    """The hover structure at Table 3.3's values (per normalised input) with chosen costs and accuracies."""
+    text = (resources.files("sysid.model") / "builtin" / "hover.toml").read_text()
+    structure = parse_structure(text, source="hover")
+    values = dict(CALM_HOVER) | {"N_r": 0.0, "Z_w": 0.0, "tau_thr": 0.0}
+    for name in ("X_lon", "M_lon", "Y_lat", "L_lat", "N_yaw", "Z_thr"):
+        values[name] *= 100.0  # the mixer input is logged normalised to -1..1
+    accuracy = dict(accuracy or {})
+    parameters = []
+    for p in structure.parameters:
+        estimated = p.name not in DROPPED
+        cr, ins = accuracy.get(p.name, (5.0, 2.0)) if estimated else (math.nan, math.nan)
+        unit = re.sub(r"\{delta_\w+\}", NORMALISED_UNIT, p.unit)
+        parameters.append(
+            ParameterEstimate(p.name, values[p.name], cr, ins, "estimated" if estimated else "dropped", unit)
+        )
+    names = tuple(p.name for p in parameters if p.status == "estimated")
+    correlation = np.eye(len(names))
+    correlation[0, 1] = correlation[1, 0] = -0.95  # X_u, M_u: the one pair beyond |r| = 0.9
+    correlation[2, 3] = correlation[3, 2] = 0.5
+    constants = {"g": 9.81, "U0": 0.0, "V0": 0.0, "W0": 0.0, "phi0": 0.0, "theta0": 0.0}
+    model = IdentifiedModel(
+        "hover", text, tuple(parameters), names, correlation, CostSummary(average), constants=constants
+    )
+    fitted = (
+        synthetic_responses(model.linear_model(), PAIRS, noise_db=0.5, noise_deg=3.0, fit_range=(1.0, 40.0), seed=3)
+        if responses
+        else ()
+    )
+    costs = dict(costs) if costs is not None else {pair: average for pair in PAIRS}
+    reduction = (ReductionStep(1, "N_r", "dropped", 0.0, -0.02, 80.0, 45.0, "I% = 45 > 10", average, average),)
+    provenance = Provenance(
+        files,
+        {f: "ab" * 32 for f in files},
+        {"min_coherence": 0.5, "fit": {"starts": 1}},
+        {"flight-sysid": "0.1.0"},
+        "2024-05-01T12:00:00+00:00",
+    )
+    return dataclasses.replace(
+        model,
+        cost=CostSummary(average, costs),
+        responses=fitted,
+        reduction=reduction,
+        provenance=provenance,
+        notes=notes,
+        input_units={"delta_lon": NORMALISED_UNIT},
+    )
+
+
+# ------------------------------------------------------------------ a small verification (reports)
+
+
+def sample_verification(*, seed: int = 0) -> Verification:
+    """A small verification to render: a pitch-like model with and without a wind term on two noisy doublets.
+
+    A weakly coupled roll rate ``p`` (driven by the pitch rate and its own input) is an off-axis output of the
+    ``delta_lon`` doublets, shown for information.
+    """
+    a = np.array([[-1.5, -6.0, 1.2, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, -20.0, 0.0], [0.3, 0.0, 0.0, -3.0]])
+    b = np.array([[0.0, 0.0, 0.3], [0.0, 0.0, 0.0], [20.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
+    c = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [-0.4, 0.0, 0.3, 0.0], [0.0, 0.0, 0.0, 1.0]])
+    d = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.5], [0.0, 0.0, 0.0]])
+    with_wind = DelayedStateSpace(
+        a,
+        b,
+        c,
+        d,
+        ("q", "theta", "d_lon", "p"),
+        ("delta_lon", "delta_lat", "wind_lon"),
+        ("q", "theta", "ax", "p"),
+        np.array([0.02, 0.02, 0.015]),
+    )
+    without = DelayedStateSpace(
+        a,
+        b[:, :2],
+        c,
+        d[:, :2],
+        with_wind.states,
+        with_wind.inputs[:2],
+        with_wind.outputs,
+        with_wind.input_delays_s[:2],
+    )
+    rng = np.random.default_rng(seed)
+    t = np.arange(400) * 0.01
+    records = []
+    for k in range(2):
+        doublet = np.where((t >= 0.5) & (t < 1.5), 0.4, 0.0) - np.where((t >= 1.5) & (t < 2.5), 0.4, 0.0)
+        wind = np.cumsum(rng.normal(scale=0.02, size=t.size))
+        inputs = np.column_stack([doublet, 0.05 * np.sin(2.0 * t), wind - wind.mean()])
+        y = simulate(discretize(with_wind, 0.01), inputs, np.zeros(4))
+        y += rng.normal(scale=[0.005, 0.001, 0.03, 0.005], size=y.shape)
+        table = pd.DataFrame(
+            {
+                "delta_lon": inputs[:, 0],
+                "delta_lat": inputs[:, 1],
+                "wind_lon": inputs[:, 2],
+                "q": y[:, 0],
+                "theta": y[:, 1],
+                "ax": y[:, 2],
+                "p": y[:, 3],
+            },
+            index=pd.Index(20.0 * k + 5.0 + t, name="time_s"),
+        )
+        units = {
+            "delta_lon": "%",
+            "delta_lat": "%",
+            "wind_lon": "m/s",
+            "q": "rad/s",
+            "theta": "rad",
+            "ax": "m/s^2",
+            "p": "rad/s",
+        }
+        records.append(Record(table, units, {}, Path("doublets.ulg"), f"doublets.ulg lon doublet {k + 1}"))
+    return verify(
+        without,
+        records,
+        wind_model=with_wind,
+        excited=["delta_lon", "delta_lon"],
+        axes={"delta_lon": ("q", "theta", "ax")},
+    )
