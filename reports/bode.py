@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -20,7 +20,7 @@ from .svg import figure_svg, new_figure
 __all__ = ["bode_figure", "write_bode_svg"]
 
 #: A model's response for one pair: complex values on the response's omega, or a function of omega (rad/s).
-ModelResponse = Union[np.ndarray, Callable[[np.ndarray], np.ndarray]]
+ModelResponse = np.ndarray | Callable[[np.ndarray], np.ndarray]
 
 _DATA = "#1f4e79"
 _MODEL = "#c0392b"

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from typing import Literal, Union
+from typing import Literal
 
 import numpy as np
 
@@ -53,7 +53,7 @@ __all__ = [
 Method = Literal["spline", "pchip", "linear"]
 
 #: A signal as accepted here: a :class:`Signal`, or a ``(time_s, values)`` pair of arrays.
-SeriesLike = Union[Signal, tuple[np.ndarray, np.ndarray]]
+SeriesLike = Signal | tuple[np.ndarray, np.ndarray]
 
 _DOWNSAMPLE_MARGIN = 1.02  # filter only when the source is > 2 % faster than the target
 

@@ -378,7 +378,7 @@ def _unit_context(meta: dict[str, MessageTable]) -> _UnitContext | None:
     if fmtu is None or "FmtType" not in fmtu or "UnitIds" not in fmtu:
         return None
     unit_of = {chr(int(i) & 0xFF): str(s) for i, s in zip(unit["Id"], unit["Label"])} if unit else {}
-    mult_of = {chr(int(i) & 0xFF): float("%.7g" % m) for i, m in zip(mult["Id"], mult["Mult"])} if mult else {}
+    mult_of = {chr(int(i) & 0xFF): float(f"{float(m):.7g}") for i, m in zip(mult["Id"], mult["Mult"])} if mult else {}
     mult_ids = fmtu["MultIds"] if "MultIds" in fmtu else np.full(len(fmtu), "")
     return {int(t): (str(u), str(m)) for t, u, m in zip(fmtu["FmtType"], fmtu["UnitIds"], mult_ids)}, unit_of, mult_of
 
@@ -394,7 +394,7 @@ def _with_units(
     for i, char in enumerate(fmt.format[: len(units)]):
         if FORMAT_TO_STRUCT[char][1] is None and units[i] and i < len(mults) and mults[i] in mult_of:
             m = mult_of[mults[i]]
-            units[i] = MULT_TO_PREFIX[m] + units[i] if m in MULT_TO_PREFIX else "%.4g %s" % (m, units[i])
+            units[i] = MULT_TO_PREFIX[m] + units[i] if m in MULT_TO_PREFIX else f"{float(m):.4g} {units[i]}"
     instance = fmt.columns[unit_ids.index("#")] if "#" in unit_ids[: len(fmt.columns)] else None
     return MessageFormat(fmt.type_id, fmt.name, fmt.length, fmt.format, fmt.columns, tuple(units), instance)
 
