@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from flightlogs.errors import DataError, LogFormatError
 from flightlogs.readers.anemometer import SPEED_UNITS, WindMeasurement, read_anemometer_csv
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "anemometer"
+DATA = Path(__file__).resolve().parents[2] / "data" / "anemometer"
 T0 = datetime(2024, 5, 1, 10, 0, 0, tzinfo=UTC).timestamp()  # 1714557600
 KNOT, KMH, MPH = 0.514444, 1 / 3.6, 0.44704
 

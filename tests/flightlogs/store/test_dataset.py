@@ -101,7 +101,7 @@ def test_foreign_hdf5_and_newer_schema_are_refused(tmp_path: Path) -> None:
 def test_wind_measurements_round_trip(tmp_path: Path) -> None:
     from flightlogs.readers.anemometer import read_anemometer_csv
 
-    csv = Path(__file__).resolve().parents[1] / "data" / "anemometer" / "iso_utc_speed_dir.csv"
+    csv = Path(__file__).resolve().parents[2] / "data" / "anemometer" / "iso_utc_speed_dir.csv"
     wind = read_anemometer_csv(csv)
     out = tmp_path / "w.h5"
     write_dataset(out, [], [wind])
