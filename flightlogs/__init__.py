@@ -1,1 +1,73 @@
-"""flight-sysid."""
+"""flight-sysid's flight-log layer: read, condition, segment and store flight logs.
+
+The core types are re-exported here: the errors (:mod:`flightlogs.errors`), the
+canonical signal names (:mod:`flightlogs.signals`), :class:`FlightLog` and
+:class:`Signal` (:mod:`flightlogs.flightlog`), :class:`Record`
+(:mod:`flightlogs.record`) and the frame conversions (:mod:`flightlogs.frames`).
+The subpackages are namespaces of their own (``from flightlogs.readers import
+read_log``): :mod:`flightlogs.readers`, :mod:`flightlogs.writers`,
+:mod:`flightlogs.maneuvers`, :mod:`flightlogs.conditioning` and
+:mod:`flightlogs.store`; ``flightlogs.readers`` loads one on first use.
+"""
+
+import importlib as _importlib
+from types import ModuleType as _ModuleType
+
+from flightlogs.errors import (
+    DataError,
+    FitError,
+    LogFormatError,
+    MissingSignalError,
+    ModelError,
+    SysidError,
+    SysidWarning,
+)
+from flightlogs.flightlog import Autopilot, FlightLog, LogFormat, Signal, SystemIdRun
+from flightlogs.frames import air_velocity_body, earth_to_body, quaternion_to_euler, wind_to_body_axes
+from flightlogs.record import Record
+from flightlogs.signals import (
+    CANONICAL_SIGNALS,
+    ESTIMATOR_SIGNALS,
+    LOGGED_SIGNALS,
+    SignalSpec,
+    describe,
+    is_canonical,
+)
+
+_SUBPACKAGES = ("conditioning", "maneuvers", "readers", "store", "writers")
+__all__ = [
+    "SysidError",
+    "LogFormatError",
+    "DataError",
+    "MissingSignalError",
+    "ModelError",
+    "FitError",
+    "SysidWarning",
+    "SignalSpec",
+    "CANONICAL_SIGNALS",
+    "LOGGED_SIGNALS",
+    "ESTIMATOR_SIGNALS",
+    "is_canonical",
+    "describe",
+    "Signal",
+    "SystemIdRun",
+    "FlightLog",
+    "Autopilot",
+    "LogFormat",
+    "Record",
+    "quaternion_to_euler",
+    "earth_to_body",
+    "air_velocity_body",
+    "wind_to_body_axes",
+    *_SUBPACKAGES,
+]
+
+
+def __getattr__(name: str) -> _ModuleType:
+    if name in _SUBPACKAGES:  # scipy's pattern: subpackages load on first use, not with the package
+        return _importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_SUBPACKAGES))

@@ -1,1 +1,33 @@
-"""Maneuvers: find the sweeps, doublets, 3211s, multisines and hover in a flight, and recover the excitation."""
+"""Maneuvers: find the sweeps, doublets, 3211s, multisines and hover in a flight, and recover the excitation.
+
+The public names of :mod:`~flightlogs.maneuvers.excitation_recovery` and
+:mod:`~flightlogs.maneuvers.segments` are re-exported here: write ``from flightlogs.maneuvers import
+name``. Modules with a leading underscore are private.
+"""
+
+from flightlogs.maneuvers.excitation_recovery import FEEDBACK_STATES, estimate_excitation
+from flightlogs.maneuvers.segments import (
+    AXES,
+    SID_AXES,
+    Axis,
+    Kind,
+    Segment,
+    SegmentSource,
+    detect_segments,
+    read_segments_file,
+    segments_from_sid,
+)
+
+__all__ = [
+    "FEEDBACK_STATES",
+    "estimate_excitation",
+    "Axis",
+    "Kind",
+    "SegmentSource",
+    "AXES",
+    "SID_AXES",
+    "Segment",
+    "detect_segments",
+    "segments_from_sid",
+    "read_segments_file",
+]

@@ -22,8 +22,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from flightlogs.errors import DataError
+from flightlogs.maneuvers._detection import _activity, _bursts, _runs
 from flightlogs.maneuvers._doublet_fit import fit_doublet
-from flightlogs.maneuvers.detection import _activity, _bursts, _runs
 
 __all__ = ["FEEDBACK_STATES", "estimate_excitation"]
 

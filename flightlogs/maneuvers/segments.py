@@ -25,7 +25,7 @@ import numpy as np
 
 from flightlogs.errors import DataError
 from flightlogs.flightlog import SystemIdRun
-from flightlogs.maneuvers.detection import find_maneuvers, hover_spans
+from flightlogs.maneuvers._detection import find_maneuvers, hover_spans
 
 __all__ = [
     "Axis",

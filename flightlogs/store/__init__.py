@@ -1,1 +1,28 @@
-"""Storage: the versioned HDF5 dataset, campaigns of logs and anemometer files, and their summaries."""
+"""Storage: the versioned HDF5 dataset, campaigns of logs and anemometer files, and their summaries.
+
+The public names of :mod:`~flightlogs.store.campaign`, :mod:`~flightlogs.store.dataset`,
+:mod:`~flightlogs.store.schema` and :mod:`~flightlogs.store.summary` are re-exported here: write
+``from flightlogs.store import name``. Modules with a leading underscore are private.
+"""
+
+from flightlogs.store.campaign import Campaign, expand_wind_paths, ingest_campaign
+from flightlogs.store.dataset import SCHEMA_VERSION, Dataset, file_sha256, read_dataset, write_dataset
+from flightlogs.store.schema import open_schema, software_version, stamp_schema
+from flightlogs.store.summary import conditioned_summary, log_summary, wind_summary
+
+__all__ = [
+    "Campaign",
+    "ingest_campaign",
+    "expand_wind_paths",
+    "Dataset",
+    "write_dataset",
+    "read_dataset",
+    "file_sha256",
+    "SCHEMA_VERSION",
+    "software_version",
+    "stamp_schema",
+    "open_schema",
+    "log_summary",
+    "wind_summary",
+    "conditioned_summary",
+]

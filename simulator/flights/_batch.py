@@ -1,25 +1,86 @@
-"""The integration loop of :func:`simulator.flights.nonlinear.simulate_flights`: setup, stepping, logging."""
+"""The integration loop of :func:`simulator.flights.nonlinear.simulate_flights`: setup, stepping, logging.
+
+The flight it returns, :class:`NonlinearFlight`, is defined here and re-exported by
+:mod:`simulator.flights.nonlinear`, so the loop needs nothing from the module that calls it.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
 from flightlogs.frames import air_velocity_body, quaternion_to_euler
-from simulator.autopilot.control import ControllerGains, controller_step, excitation_table, initial_controller_state
+from simulator.autopilot.control import (
+    ControllerGains,
+    Injection,
+    controller_step,
+    excitation_table,
+    initial_controller_state,
+)
+from simulator.flights.linear import SimulatedFlight
 from simulator.vehicle.dynamics import Conditions, vehicle_derivative
 from simulator.vehicle.linearize import Trim, trim_hover
 from simulator.vehicle.multirotor import Vehicle, mixer_commands
 from simulator.world.environment import ground_effect_function
 from simulator.world.wind_field import BatchWindField, FrozenField, realize_field
 
-__all__: list[str] = []
+__all__ = ["NonlinearFlight", "run_batch"]
 
 _MARGIN_M = 30.0  # along-wind room for the vehicle's excursions
+
+
+@dataclass(frozen=True, slots=True)
+class NonlinearFlight(SimulatedFlight):
+    """A simulated flight with the anemometer's record and the noise-free truth.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (n_samples,)
+        Log times, s.
+    signals : Mapping[str, ndarray]
+        Canonical signals as logged (noise and biases applied): ``p q r phi
+        theta psi u v w ax ay az vn ve vd height_agl delta_lat delta_lon
+        delta_yaw delta_thr`` (mixer inputs in %, thrust from hover trim),
+        ``motor_1..n`` (rotor command, % of full scale) and ``battery_v`` (V).
+    wind_at_vehicle : ndarray, shape (n_samples, 2)
+        ``wind_n, wind_e`` at the vehicle, m/s.
+    maneuvers : tuple of Maneuver
+        Sweeps and doublets flown.
+    parameters : Mapping[str, float]
+        The truth: hover derivatives of the vehicle (Table 3.3 names) and the trial's settings.
+    wind_at_anemometer : ndarray, shape (n_samples, 2)
+        ``wind_n, wind_e`` at the anemometer on the log clock, m/s.
+    anemometer_ne_m : ndarray, shape (2,)
+        Anemometer position from the hover point, north and east, m.
+    transport_delay_s : float
+        Distance along the wind over mean speed, s (Taylor's hypothesis).
+    truth : Mapping[str, ndarray]
+        The same signals without noise or biases, plus ``pn pe`` (position from the hover point, m),
+        ``wind_d`` (m/s) and ``mass_kg``.
+    injections : tuple of Injection
+        3-2-1-1s and multisines flown.
+    label : str
+        The trial's label.
+    """
+
+    wind_at_anemometer: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    anemometer_ne_m: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    transport_delay_s: float = 0.0
+    truth: Mapping[str, np.ndarray] = field(default_factory=dict)
+    injections: tuple[Injection, ...] = ()
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.time_s)[0]
+        if np.shape(self.wind_at_vehicle) != (n, 2) or np.shape(self.wind_at_anemometer) != (n, 2):
+            raise ValueError(f"wind_at_vehicle and wind_at_anemometer must have shape ({n}, 2)")
+        for name, values in self.signals.items():
+            if np.shape(values) != (n,):
+                raise ValueError(f"signal {name!r} must have shape ({n},), got {np.shape(values)}")
 
 
 @dataclass(frozen=True, slots=True)
@@ -340,9 +401,32 @@ def run_batch(
     method: str,
     progress: Callable[[int, int], None] | None,
 ) -> list:
-    """Simulate trials of equal length together; returns NonlinearFlight objects without the truth parameters."""
-    from simulator.flights.nonlinear import NonlinearFlight
+    """Simulate trials of equal length together.
 
+    Parameters
+    ----------
+    trials : list of Trial
+        The trials (:class:`simulator.flights.nonlinear.Trial`), all of `n_log` log samples.
+    vehicle : Vehicle
+        The vehicle.
+    gains : ControllerGains
+        The controller.
+    n_log : int
+        Log samples per trial.
+    rate_hz : float
+        Integration and control rate, Hz.
+    decimation : int
+        Integration steps per log sample.
+    method : str
+        ``"euler"`` for semi-implicit Euler, anything else for RK4.
+    progress : callable or None
+        Called as ``progress(steps_done, steps_total)``.
+
+    Returns
+    -------
+    list of NonlinearFlight
+        In the order of `trials`, without the truth parameters (the caller adds them).
+    """
     setup = _setup(trials, vehicle, gains, n_log, rate_hz, decimation)
     logs = _integrate(setup, vehicle, gains, "euler" if method == "euler" else "rk4", progress)
     time = np.arange(n_log) / (rate_hz / decimation)

@@ -22,7 +22,7 @@ import numpy as np
 
 from simulator.autopilot.control import ControllerGains, HeightSteps, Injection, design_gains
 from simulator.autopilot.excitation import Maneuver
-from simulator.flights.linear import SimulatedFlight
+from simulator.flights._batch import NonlinearFlight, run_batch
 from simulator.vehicle.linearize import hover_derivatives, linearize_hover
 from simulator.vehicle.multirotor import Vehicle
 from simulator.vehicle.presets import OCTO_S1000
@@ -79,56 +79,6 @@ class Trial:
         """Heading held, rad."""
         heading = self.environment.wind.direction_from_deg if self.heading_deg is None else self.heading_deg
         return float(np.radians(heading))
-
-
-@dataclass(frozen=True, slots=True)
-class NonlinearFlight(SimulatedFlight):
-    """A simulated flight with the anemometer's record and the noise-free truth.
-
-    Parameters
-    ----------
-    time_s : ndarray, shape (n_samples,)
-        Log times, s.
-    signals : Mapping[str, ndarray]
-        Canonical signals as logged (noise and biases applied): ``p q r phi
-        theta psi u v w ax ay az vn ve vd height_agl delta_lat delta_lon
-        delta_yaw delta_thr`` (mixer inputs in %, thrust from hover trim),
-        ``motor_1..n`` (rotor command, % of full scale) and ``battery_v`` (V).
-    wind_at_vehicle : ndarray, shape (n_samples, 2)
-        ``wind_n, wind_e`` at the vehicle, m/s.
-    maneuvers : tuple of Maneuver
-        Sweeps and doublets flown.
-    parameters : Mapping[str, float]
-        The truth: hover derivatives of the vehicle (Table 3.3 names) and the trial's settings.
-    wind_at_anemometer : ndarray, shape (n_samples, 2)
-        ``wind_n, wind_e`` at the anemometer on the log clock, m/s.
-    anemometer_ne_m : ndarray, shape (2,)
-        Anemometer position from the hover point, north and east, m.
-    transport_delay_s : float
-        Distance along the wind over mean speed, s (Taylor's hypothesis).
-    truth : Mapping[str, ndarray]
-        The same signals without noise or biases, plus ``pn pe`` (position from the hover point, m),
-        ``wind_d`` (m/s) and ``mass_kg``.
-    injections : tuple of Injection
-        3-2-1-1s and multisines flown.
-    label : str
-        The trial's label.
-    """
-
-    wind_at_anemometer: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
-    anemometer_ne_m: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    transport_delay_s: float = 0.0
-    truth: Mapping[str, np.ndarray] = field(default_factory=dict)
-    injections: tuple[Injection, ...] = ()
-    label: str = ""
-
-    def __post_init__(self) -> None:
-        n = np.shape(self.time_s)[0]
-        if np.shape(self.wind_at_vehicle) != (n, 2) or np.shape(self.wind_at_anemometer) != (n, 2):
-            raise ValueError(f"wind_at_vehicle and wind_at_anemometer must have shape ({n}, 2)")
-        for name, values in self.signals.items():
-            if np.shape(values) != (n,):
-                raise ValueError(f"signal {name!r} must have shape ({n},), got {np.shape(values)}")
 
 
 _TRUTH_CACHE: dict[int, tuple[Vehicle, dict[str, float]]] = {}  # the vehicle is kept so its id stays its own
@@ -192,8 +142,6 @@ def simulate_flights(
     >>> flight.signals["az"].size, round(float(np.mean(flight.truth["az"])), 2)
     (100, -9.81)
     """
-    from simulator.flights._batch import run_batch  # the integration loop lives in its own module
-
     decimation = rate_hz / log_rate_hz
     if abs(decimation - round(decimation)) > 1e-9 or decimation < 1:
         raise ValueError(f"rate_hz={rate_hz} must be a whole multiple of log_rate_hz={log_rate_hz}")

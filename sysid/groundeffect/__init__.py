@@ -11,14 +11,7 @@ chosen model for a controller study (:func:`write_ground_effect_model`,
 
 from __future__ import annotations
 
-from sysid.groundeffect.data import (
-    GroundEffectDataConfig,
-    HoverStep,
-    HoverSteps,
-    ThrustRatioData,
-    load_thrust_ratio,
-    rig_thrust_ratio,
-)
+from sysid.groundeffect.data import load_thrust_ratio, rig_thrust_ratio
 from sysid.groundeffect.fitting import FitConfig, fit_ground_effect, fit_model
 from sysid.groundeffect.flight import flight_thrust_ratio, plateaus
 from sysid.groundeffect.modelfile import (
@@ -36,6 +29,7 @@ from sysid.groundeffect.models import (
     ModelName,
     evaluate_model,
 )
+from sysid.groundeffect.records import GroundEffectDataConfig, HoverStep, HoverSteps, ThrustRatioData
 from sysid.groundeffect.spacing import SpacingStudy, default_families, spacing_study, spacing_summary
 
 __all__ = [

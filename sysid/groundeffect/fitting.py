@@ -41,7 +41,6 @@ from scipy import optimize, stats
 
 from flightlogs.errors import FitError
 from sysid.groundeffect import formulas
-from sysid.groundeffect.data import ThrustRatioData
 from sysid.groundeffect.models import (
     MODEL_NAMES,
     PARAMETER_NAMES,
@@ -51,6 +50,7 @@ from sysid.groundeffect.models import (
     ModelName,
     evaluate_model,
 )
+from sysid.groundeffect.records import ThrustRatioData
 
 __all__ = ["FitConfig", "fit_ground_effect", "fit_model"]
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from flightlogs.errors import DataError, MissingSignalError
 from flightlogs.flightlog import FlightLog, Signal
-from sysid.groundeffect.data import GroundEffectDataConfig, HoverStep, HoverSteps, ThrustRatioData
+from sysid.groundeffect.records import GroundEffectDataConfig, HoverStep, HoverSteps, ThrustRatioData
 
 __all__ = ["flight_thrust_ratio", "plateaus"]
 

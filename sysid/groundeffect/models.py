@@ -12,7 +12,7 @@ from typing import Literal
 import numpy as np
 
 from sysid.groundeffect import formulas
-from sysid.groundeffect.data import ThrustRatioData
+from sysid.groundeffect.records import ThrustRatioData
 
 __all__ = [
     "ModelName",

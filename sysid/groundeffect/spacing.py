@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 
 from flightlogs.errors import DataError
-from sysid.groundeffect.data import ThrustRatioData
 from sysid.groundeffect.fitting import FitConfig, fit_ground_effect
 from sysid.groundeffect.models import MODEL_NAMES, GroundEffectFit, ModelName
+from sysid.groundeffect.records import ThrustRatioData
 
 __all__ = ["SpacingStudy", "spacing_study", "default_families", "spacing_summary"]
 

@@ -22,7 +22,7 @@ from sysid._json import float_array as _array
 from sysid._json import float_or_nan as _float
 from sysid._json import json_floats as _list
 from sysid._json import read_json_object, write_json
-from sysid.verify import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection
+from sysid.verify.results import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection
 
 __all__ = [
     "VERIFICATION_SCHEMA",
@@ -291,6 +291,7 @@ def write_verification(
     Examples
     --------
     >>> import tempfile
+    >>> import numpy as np
     >>> t = np.arange(3) * 0.01
     >>> out = OutputVerification("q", "rad/s", np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.9, 0.1]), 0.0, 0.08, 0.05)
     >>> record = RecordVerification("lon doublet", Path("f.bin"), t, ("delta_lon",), (out,), {}, 4.6, 0.05, 1.0, False)
