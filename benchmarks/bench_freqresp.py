@@ -69,17 +69,19 @@ def campaign_axis(seed: int = 0) -> list[Record]:
         excitation_signal(flight.time_s, tuple(Maneuver("lon", "sweep", s, 8.0, SWEEP_S) for s in starts), "lon")
         / 100.0
     )
-    whole = Record(table, {c: "-" for c in table.columns}, {}, Path("simulated-campaign"), "campaign")
+    whole = Record(
+        table=table, units={c: "-" for c in table.columns}, trim={}, source=Path("simulated-campaign"), label="campaign"
+    )
     pieces = []
     for start in starts:
         first = int(round(start * RATE_HZ))
         pieces.append(
             Record(
-                table.iloc[first : first + int(SWEEP_S * RATE_HZ)],
-                whole.units,
-                {},
-                whole.source,
-                f"sweep at {start:.0f} s",
+                table=table.iloc[first : first + int(SWEEP_S * RATE_HZ)],
+                units=whole.units,
+                trim={},
+                source=whole.source,
+                label=f"sweep at {start:.0f} s",
             )
         )
     return pieces

@@ -19,7 +19,7 @@ Autopilot = Literal["px4", "ardupilot"]
 LogFormat = Literal["ulog", "dataflash", "tlog"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Signal:
     """One canonical signal as logged, on its own time base.
 
@@ -76,7 +76,7 @@ class Signal:
         return (self.samples - 1) / span if span > 0 else 0.0
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class SystemIdRun:
     """One ArduPilot System ID maneuver, from a SIDS message and the SIDD that follow it.
 
@@ -120,7 +120,7 @@ class SystemIdRun:
     fade_out_s: float
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FlightLog:
     """Canonical signals read from one log file, with its metadata.
 

@@ -17,7 +17,7 @@ __all__ = ["Record"]
 _UNIFORM_TOLERANCE = 1e-6  # relative spread of sample intervals still called uniform
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Record:
     """A stretch of flight on one uniform time base, trim removed and kept.
 
@@ -114,9 +114,9 @@ class Record:
         """
         piece = self.table.loc[start_s:end_s].copy()
         return Record(
-            piece,
-            self.units,
-            self.trim,
-            self.source,
-            label if label is not None else f"{self.label} [{start_s:.2f}, {end_s:.2f}] s",
+            table=piece,
+            units=self.units,
+            trim=self.trim,
+            source=self.source,
+            label=label if label is not None else f"{self.label} [{start_s:.2f}, {end_s:.2f}] s",
         )

@@ -232,7 +232,15 @@ def sample_verification(*, seed: int = 0) -> Verification:
             "ax": "m/s^2",
             "p": "rad/s",
         }
-        records.append(Record(table, units, {}, Path("doublets.ulg"), f"doublets.ulg lon doublet {k + 1}"))
+        records.append(
+            Record(
+                table=table,
+                units=units,
+                trim={},
+                source=Path("doublets.ulg"),
+                label=f"doublets.ulg lon doublet {k + 1}",
+            )
+        )
     return verify(
         without,
         records,

@@ -62,7 +62,7 @@ _MAX_GPS_DISTANCE_M = 1000.0  # farther, the anemometer's position is more likel
 _MIN_CORRELATION_S = 20.0  # shortest stretch a residual clock offset is estimated over
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ConditioningOptions:
     """Choices for :func:`condition_flight`; every default follows the dissertation.
 
@@ -128,7 +128,7 @@ class ConditioningOptions:
             object.__setattr__(self, "anemometer_position_rad", (lat, lon))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ConditionedFlight:
     """A flight ready for frequency responses.
 
@@ -223,7 +223,9 @@ def condition_flight(
         _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}", notes)
         for k, span in enumerate(spans.spans)
     )
-    return ConditionedFlight(log.path, records, segments, rate_hz, alignment, tuple(notes))
+    return ConditionedFlight(
+        source=log.path, records=records, segments=segments, rate_hz=rate_hz, wind=alignment, warnings=tuple(notes)
+    )
 
 
 def _hold_edges(column: np.ndarray, time_base: np.ndarray, max_hold_s: float) -> np.ndarray:
@@ -276,9 +278,22 @@ def _wind_signals(
         )
     time_s = raw_time + delay.delay_s
     overlap = float(min(end, time_s[-1]) - max(start, time_s[0]))
-    alignment = WindAlignment(Path(wind.path), reference, clock_offset, source, delay, overlap)
+    alignment = WindAlignment(
+        wind_path=Path(wind.path),
+        reference=reference,
+        clock_offset_s=clock_offset,
+        clock_offset_source=source,
+        transport=delay,
+        overlap_s=overlap,
+    )
     series = {
-        name: Signal(name, time_s, column, "m/s", f"{Path(wind.path).name}:{label} (delayed {delay.delay_s:.3f} s)")
+        name: Signal(
+            name=name,
+            time_s=time_s,
+            values=column,
+            unit="m/s",
+            source=f"{Path(wind.path).name}:{label} (delayed {delay.delay_s:.3f} s)",
+        )
         for name, column, label in (("wind_n", wind.wind_n, "north"), ("wind_e", wind.wind_e, "east"))
     }
     return alignment, series
@@ -533,4 +548,4 @@ def _record(
             quiet |= (t >= segment.start_s) & (t <= segment.end_s)
     reference = table[quiet] if quiet.sum() >= 10 else table
     trim = {str(name): float(value) for name, value in reference.mean().items()}
-    return Record(table - pd.Series(trim), units, trim, log.path, label)
+    return Record(table=table - pd.Series(trim), units=units, trim=trim, source=log.path, label=label)

@@ -25,7 +25,7 @@ FROZEN_TURBULENCE_LIMIT = 0.5
 _EARTH_RADIUS_M = 6_371_008.8
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class LagEstimate:
     """How far one stream lags another.
 
@@ -110,7 +110,7 @@ def estimate_lag(
     return LagEstimate(lag_s=float((lags[peak] + shift) / rate_hz), correlation=float(full[peak]))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class TransportDelay:
     """Time the air takes from the anemometer to the vehicle (Taylor's hypothesis).
 
@@ -199,7 +199,14 @@ def transport_delay(
     speed = np.hypot(wind_ne[:, 0], wind_ne[:, 1])
     mean_speed, speed_std = float(speed.mean()), float(speed.std())
     if delay_s is not None:
-        return TransportDelay(float(delay_s), "user", distance_m, None, mean_speed, speed_std)
+        return TransportDelay(
+            delay_s=float(delay_s),
+            source="user",
+            distance_m=distance_m,
+            along_line_speed_m_s=None,
+            mean_speed_m_s=mean_speed,
+            speed_std_m_s=speed_std,
+        )
     if distance_m is None:
         raise DataError("the transport delay needs the anemometer-to-vehicle distance (--wind-distance) or a delay")
     mean_vector = wind_ne.mean(axis=0)
@@ -213,7 +220,15 @@ def transport_delay(
             "is not upstream of the vehicle, so no transport delay follows; give the delay explicitly"
         )
     bearing = None if bearing_rad is None else float(bearing_rad)
-    return TransportDelay(distance_m / along, "geometry", float(distance_m), along, mean_speed, speed_std, bearing)
+    return TransportDelay(
+        delay_s=distance_m / along,
+        source="geometry",
+        distance_m=float(distance_m),
+        along_line_speed_m_s=along,
+        mean_speed_m_s=mean_speed,
+        speed_std_m_s=speed_std,
+        bearing_rad=bearing,
+    )
 
 
 def bearing_and_distance(lat_from: float, lon_from: float, lat_to: float, lon_to: float) -> tuple[float, float]:

@@ -92,7 +92,7 @@ class Gap:
         return f"{self.signal}: {self.duration_s:.2f} s gap at {self.start_s:.2f} s"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ContiguousSpans:
     """Pieces of a time span where every signal has data, and the gaps that cut it.
 
@@ -442,7 +442,7 @@ def contiguous_spans(
     if grid is not None:
         covered = snap(covered, grid)
     kept = tuple((a, b) for a, b in covered if b - a >= min_duration_s - TIME_TOL_S)
-    return ContiguousSpans(kept, tuple(gaps))
+    return ContiguousSpans(spans=kept, gaps=tuple(gaps))
 
 
 # ---------------------------------------------------------------- helpers

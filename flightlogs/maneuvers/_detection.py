@@ -77,7 +77,7 @@ def find_maneuvers(
     return maneuvers, busy
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class _Activity:
     """One axis: raw and detrended trace (n_samples,), normalised envelopes, noise σ of both."""
 
@@ -91,7 +91,12 @@ class _Activity:
     def flipped(self) -> _Activity:
         """The same axis with time reversed (to find an end as a start)."""
         return _Activity(
-            self.raw[::-1], self.detrended[::-1], self.mean_z[::-1], self.rms_z[::-1], self.sigma, self.sigma_mean
+            raw=self.raw[::-1],
+            detrended=self.detrended[::-1],
+            mean_z=self.mean_z[::-1],
+            rms_z=self.rms_z[::-1],
+            sigma=self.sigma,
+            sigma_mean=self.sigma_mean,
         )
 
 
@@ -110,7 +115,9 @@ def _activity(x: np.ndarray, dt: float, threshold: float, trend_window_s: float)
         if calm.sum() < 10:
             break
         quiet = calm
-    return _Activity(x, xd, mean / sigma_mean, rms / sigma, sigma, sigma_mean)
+    return _Activity(
+        raw=x, detrended=xd, mean_z=mean / sigma_mean, rms_z=rms / sigma, sigma=sigma, sigma_mean=sigma_mean
+    )
 
 
 def _trend(x: np.ndarray, width: int) -> np.ndarray:

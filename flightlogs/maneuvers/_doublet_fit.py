@@ -61,7 +61,7 @@ _SIGNS = (1.0, -1.0, 1.0, -1.0)  # a 3-2-1-1's pulses, up to one common sign
 _BETTER_3211 = 0.5
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class DoubletFit:
     """One doublet or 3-2-1-1 found in a window (indices into the window).
 
@@ -152,7 +152,12 @@ def _candidate(
     lo, hi = min(burst[0], first), max(burst[1], int(edges[-1]) - 1)
     unexplained = float(np.sum(left[lo : hi + 1] ** 2) / max(np.sum(excitation[lo : hi + 1] ** 2), 1e-300))
     return DoubletFit(
-        first, width, tuple(float(a) for a in amplitudes), tuple(float(v) for v in z), unexplained, excitation
+        first=first,
+        width=width,
+        amplitudes=tuple(float(a) for a in amplitudes),
+        z=tuple(float(v) for v in z),
+        unexplained=unexplained,
+        excitation=excitation,
     )
 
 

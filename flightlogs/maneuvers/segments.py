@@ -86,7 +86,7 @@ _SID_FIELDS = {
 _USER_KEYS = ("start_s", "end_s", "axis", "kind", "f_min_hz", "f_max_hz")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Segment:
     """One maneuver, or one stretch of hover, in a flight.
 
@@ -217,9 +217,13 @@ def detect_segments(
     traces = _check_inputs(inputs, t.size)
     maneuvers, busy = find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s)
     segments = [
-        Segment(axis, kind, t[lo], t[hi], "detected", f_min, f_max) for axis, kind, lo, hi, f_min, f_max in maneuvers
+        Segment(axis=axis, kind=kind, start_s=t[lo], end_s=t[hi], source="detected", f_min_hz=f_min, f_max_hz=f_max)
+        for axis, kind, lo, hi, f_min, f_max in maneuvers
     ]
-    segments += [Segment(None, "hover", a, b, "detected") for a, b in hover_spans(t, busy, min_hover_s, hover_margin_s)]
+    segments += [
+        Segment(axis=None, kind="hover", start_s=a, end_s=b, source="detected")
+        for a, b in hover_spans(t, busy, min_hover_s, hover_margin_s)
+    ]
     return tuple(sorted(segments, key=lambda s: s.start_s))
 
 
@@ -274,7 +278,7 @@ def segments_from_sid(
 
     Examples
     --------
-    >>> run = SystemIdRun(100.0, float("nan"), 11, "mixer pitch", 0.1, 0.1, 10.0, 2.0, 20.0, 34.0, 1.0)
+    >>> run = SystemIdRun(start_s=100.0, end_s=float("nan"), axis=11, axis_name="mixer pitch", magnitude=0.1, f_start_hz=0.1, f_stop_hz=10.0, fade_in_s=2.0, const_s=20.0, record_s=34.0, fade_out_s=1.0)
     >>> seg, = segments_from_sid([run])
     >>> seg.axis, seg.start_s, seg.end_s, seg.f_min_hz
     ('lon', 101.0, 135.0, 0.1)
@@ -301,7 +305,18 @@ def segments_from_sid(
             continue
         lo, hi = sorted((run.f_start_hz, run.f_stop_hz))
         detail = f"SID_AXIS={run.axis} ({name}), magnitude {run.magnitude:g}"
-        out.append(Segment(axis, "sweep", start, end, "sids", lo, hi, detail))  # type: ignore[arg-type]
+        out.append(
+            Segment(
+                axis=axis,
+                kind="sweep",
+                start_s=start,
+                end_s=end,
+                source="sids",
+                f_min_hz=lo,
+                f_max_hz=hi,
+                detail=detail,
+            )
+        )  # type: ignore[arg-type]
     return tuple(out)
 
 
@@ -407,11 +422,11 @@ def _sids_runs(runs: Sequence[SystemIdRun] | Mapping[str, Any]) -> list[SystemId
     columns = {ours: np.asarray(runs[name], dtype=np.float64) for name, ours in _SID_FIELDS.items()}
     rows = [
         SystemIdRun(
-            float(t),
-            float("nan"),
-            int(columns["axis"][i]),
-            "",
-            *(float(columns[k][i]) for k in _SID_FIELDS.values() if k != "axis"),
+            start_s=float(t),
+            end_s=float("nan"),
+            axis=int(columns["axis"][i]),
+            axis_name="",
+            **{k: float(columns[k][i]) for k in _SID_FIELDS.values() if k != "axis"},
         )
         for i, t in enumerate(times)
     ]
@@ -494,4 +509,4 @@ def _user_segment(entry: dict) -> Segment:
         raise DataError(f"end_s={values['end_s']:g} is not after start_s={values['start_s']:g}")
     axis = str(entry.get("axis", "")).strip().lower()
     kind = str(entry.get("kind", "sweep")).strip().lower()
-    return Segment(None if axis in ("", "none") else axis, kind, source="user", **values)  # type: ignore[arg-type]
+    return Segment(axis=None if axis in ("", "none") else axis, kind=kind, source="user", **values)  # type: ignore[arg-type]

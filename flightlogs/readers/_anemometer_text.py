@@ -73,7 +73,7 @@ def load_rows(path: Path) -> tuple[list[list[str]], list[int]]:
     return rows, numbers
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Table:
     """Header, data rows and their line numbers, with typed column access."""
 

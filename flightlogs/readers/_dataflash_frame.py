@@ -44,7 +44,7 @@ _CHAR_SIZE = {c: struct.calcsize("<" + code) for c, (code, _, _) in FORMAT_TO_ST
 _VALID_CHARS = frozenset(FORMAT_TO_STRUCT)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class MessageFormat:
     """Layout of one message type, from its FMT (and FMTU) messages.
 
@@ -85,7 +85,11 @@ class _Definition:
     decodable: bool
 
 
-_FMT_DEF = _Definition(-1, MessageFormat(FMT_TYPE, "FMT", _FMT.len, _FMT.format, tuple(_FMT.columns)), True)
+_FMT_DEF = _Definition(
+    -1,
+    MessageFormat(type_id=FMT_TYPE, name="FMT", length=_FMT.len, format=_FMT.format, columns=tuple(_FMT.columns)),
+    True,
+)
 
 
 def frame_messages(
@@ -237,7 +241,13 @@ def _parse_fmts(buf: np.ndarray, offsets: np.ndarray) -> list[_Definition]:
             continue
         size = sum(_CHAR_SIZE[c] for c in fmt)
         columns = tuple(cols.split(",")) if cols else ()
-        defs.append(_Definition(off, MessageFormat(type_id, name, length, fmt, columns), length == size + 3))
+        defs.append(
+            _Definition(
+                off,
+                MessageFormat(type_id=type_id, name=name, length=length, format=fmt, columns=columns),
+                length == size + 3,
+            )
+        )
     return defs
 
 

@@ -24,7 +24,7 @@ RESPONSEONE = re.compile(
 )
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Readings:
     """The valid readings of a capture, in file order, and what was dropped."""
 
@@ -81,5 +81,10 @@ def read_readings(path: Path, rows: list[list[str]], numbers: list[int]) -> Read
             f"checksum, {len(flagged)} had a non-zero status)"
         )
     return Readings(
-        times, np.array(speeds), np.array(directions), lines, rows[0][0] if has_header else "field 1", tuple(warnings)
+        times=times,
+        speeds=np.array(speeds),
+        directions_deg=np.array(directions),
+        lines=lines,
+        time_column=rows[0][0] if has_header else "field 1",
+        warnings=tuple(warnings),
     )

@@ -33,4 +33,4 @@ def make_signal(
         )
     if not keep.any():
         return None
-    return Signal(name, time_s[keep], values[keep], unit, source)
+    return Signal(name=name, time_s=time_s[keep], values=values[keep], unit=unit, source=source)

@@ -43,7 +43,7 @@ FIELDS: dict[str, tuple[str, ...]] = {
 Key = tuple[int, int]  # (system id, component id)
 
 
-@dataclass(slots=True)
+@dataclass(slots=True, kw_only=True)
 class Scan:
     """What one pass over the file keeps: rows of wanted fields per source and type."""
 

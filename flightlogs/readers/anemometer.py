@@ -120,7 +120,7 @@ _SUFFIX_UNIT = re.compile(
 _KEYS = ("time", "date", "speed", "direction", "u", "v", "w")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindMeasurement:
     """Horizontal wind recorded by a ground anemometer, in NED earth axes.
 
@@ -268,7 +268,7 @@ def read_anemometer_csv(
     if not data:
         raise LogFormatError(f"{path}: no data rows below the header (line {line_numbers[0]})")
     used = _resolve_columns(path, header, columns or {})
-    table = Table(path, header, data, lines)
+    table = Table(path=path, header=header, rows=data, lines=lines)
     utc_s = parse_time_columns(table, used, utc_offset_hours)
     return _wind_from_columns(table, used, utc_s, default_unit)
 
@@ -380,13 +380,13 @@ def _wind_from_columns(
     wind_n = table.numbers(used["v"]) * _column_unit(path, used["v"], default_unit, [])[1]
     direction = np.mod(np.arctan2(-wind_e, -wind_n), 2.0 * np.pi)
     return WindMeasurement(
-        path,
-        utc_s,
-        wind_n,
-        wind_e,
-        np.hypot(wind_n, wind_e),
-        direction,
-        wind_d,
+        path=path,
+        utc_s=utc_s,
+        wind_n=wind_n,
+        wind_e=wind_e,
+        speed_m_s=np.hypot(wind_n, wind_e),
+        direction_from_rad=direction,
+        wind_d=wind_d,
         columns=used,
         unit=unit,
         layout="columns",
@@ -404,7 +404,16 @@ def _from_polar(
 ) -> WindMeasurement:
     """Measurement from speed (m/s) and direction FROM (rad): the air moves the other way."""
     wind_n, wind_e = -speed_m_s * np.cos(direction_rad), -speed_m_s * np.sin(direction_rad)
-    return WindMeasurement(path, utc_s, wind_n, wind_e, speed_m_s, direction_rad, wind_d, **metadata)
+    return WindMeasurement(
+        path=path,
+        utc_s=utc_s,
+        wind_n=wind_n,
+        wind_e=wind_e,
+        speed_m_s=speed_m_s,
+        direction_from_rad=direction_rad,
+        wind_d=wind_d,
+        **metadata,
+    )
 
 
 def _column_unit(path: Path, column: str, default_unit: str | None, warnings: list[str]) -> tuple[str, float]:

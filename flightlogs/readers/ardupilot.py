@@ -190,15 +190,15 @@ def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
     runs = system_id_runs(messages)
     _map_excitation(messages, runs, add)
     return FlightLog(
-        messages.path,
-        "dataflash",
-        "ardupilot",
-        signals,
-        _vehicle(messages, parameters, n_motors),
-        parameters,
-        _utc_offset(messages),
-        tuple(warnings),
-        runs,
+        path=messages.path,
+        log_format="dataflash",
+        autopilot="ardupilot",
+        signals=signals,
+        vehicle=_vehicle(messages, parameters, n_motors),
+        parameters=parameters,
+        utc_offset_s=_utc_offset(messages),
+        warnings=tuple(warnings),
+        system_id_runs=runs,
     )
 
 
@@ -402,11 +402,17 @@ def system_id_runs(messages: DataFlashMessages) -> tuple[SystemIdRun, ...]:
         axis = int(sids["Ax"][k])
         runs.append(
             SystemIdRun(
-                float(start),
-                float(inside[-1]) if inside.size else float("nan"),
-                axis,
-                _SYSID_AXES.get(axis, "other"),
-                *(float(sids[c][k]) for c in ("Mag", "FSt", "FSp", "TFin", "TC", "TR", "TFout")),
+                start_s=float(start),
+                end_s=float(inside[-1]) if inside.size else float("nan"),
+                axis=axis,
+                axis_name=_SYSID_AXES.get(axis, "other"),
+                magnitude=float(sids["Mag"][k]),
+                f_start_hz=float(sids["FSt"][k]),
+                f_stop_hz=float(sids["FSp"][k]),
+                fade_in_s=float(sids["TFin"][k]),
+                const_s=float(sids["TC"][k]),
+                record_s=float(sids["TR"][k]),
+                fade_out_s=float(sids["TFout"][k]),
             )
         )
     return tuple(runs)

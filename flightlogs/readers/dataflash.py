@@ -70,7 +70,7 @@ _ULOG_MAGIC = b"ULog\x01\x12\x35"
 _INSTANCE_COLUMNS = ("I", "Instance", "Inst", "C", "Core")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class MessageTable:
     """All messages of one type, as columns.
 
@@ -121,10 +121,12 @@ class MessageTable:
 
     def select(self, rows: np.ndarray) -> MessageTable:
         """Return the messages picked by a boolean mask or index array."""
-        return MessageTable(self.format, {k: v[rows] for k, v in self.columns.items()}, self.offsets[rows])
+        return MessageTable(
+            format=self.format, columns={k: v[rows] for k, v in self.columns.items()}, offsets=self.offsets[rows]
+        )
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class DataFlashMessages:
     """Every message of a DataFlash log, decoded per type.
 
@@ -265,7 +267,7 @@ def decode_messages(
     Examples
     --------
     >>> from flightlogs.writers.dataflash import MessageBlock, MessageSpec, encode_dataflash
-    >>> spec = MessageSpec("ATT", "Qcc", ("TimeUS", "Roll", "Pitch"))
+    >>> spec = MessageSpec(name="ATT", format="Qcc", columns=("TimeUS", "Roll", "Pitch"))
     >>> block = MessageBlock(spec, {"TimeUS": [1000, 2000], "Roll": [1.5, -2.25], "Pitch": [0.0, 0.1]})
     >>> decode_messages(encode_dataflash([block]))["ATT"]["Roll"]
     array([ 1.5 , -2.25])
@@ -297,7 +299,7 @@ def decode_messages(
         if types is None or fmt.name in types or key in meta:
             fmt = _with_units(fmt, *units) if units else fmt
             tables[key] = (
-                MessageTable(fmt, meta[key].columns, offsets)
+                MessageTable(format=fmt, columns=meta[key].columns, offsets=offsets)
                 if key in meta
                 else _decode_table(buf, fmt, offsets, warnings)
             )
@@ -307,7 +309,9 @@ def decode_messages(
     warnings.extend(_time_resets(tables))
     if progress is not None:
         progress(size, size)
-    return DataFlashMessages(path, size, tables, counts, tuple(warnings), skipped)
+    return DataFlashMessages(
+        path=path, file_size=size, tables=tables, counts=counts, warnings=tuple(warnings), bytes_skipped=skipped
+    )
 
 
 def message_dtype(fmt: str) -> np.dtype:
@@ -343,7 +347,7 @@ def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray, warn
             f"{fmt.columns}; as in DFReader, a repeated name keeps its last field."
         )
     columns = {name: _column(rec[f"f{i}"], chars[i], fmt.name) for i, name in enumerate(names)}
-    return MessageTable(fmt, columns, offsets)
+    return MessageTable(format=fmt, columns=columns, offsets=offsets)
 
 
 def _column(raw: np.ndarray, char: str, message: str) -> np.ndarray:
@@ -396,7 +400,15 @@ def _with_units(
             m = mult_of[mults[i]]
             units[i] = MULT_TO_PREFIX[m] + units[i] if m in MULT_TO_PREFIX else f"{float(m):.4g} {units[i]}"
     instance = fmt.columns[unit_ids.index("#")] if "#" in unit_ids[: len(fmt.columns)] else None
-    return MessageFormat(fmt.type_id, fmt.name, fmt.length, fmt.format, fmt.columns, tuple(units), instance)
+    return MessageFormat(
+        type_id=fmt.type_id,
+        name=fmt.name,
+        length=fmt.length,
+        format=fmt.format,
+        columns=fmt.columns,
+        units=tuple(units),
+        instance_field=instance,
+    )
 
 
 def _time_resets(tables: dict[str, MessageTable]) -> list[str]:

@@ -57,7 +57,7 @@ __all__ = [
 Conversion = Literal["copy", "negate", "degrees", "degrees_e7", "quaternion_to_euler", "rangefinder"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class TopicSource:
     """One candidate topic and its fields for a group of signals.
 
@@ -127,7 +127,7 @@ class SignalGroup:
                 raise ValueError(f"{source.topic}: one validity flag per signal is needed")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class MotorSource:
     """A topic holding one command per motor channel.
 
@@ -153,7 +153,7 @@ class MotorSource:
 
 
 def _xyz(topic: str, field: str, **options: object) -> TopicSource:
-    return TopicSource(topic, tuple(f"{field}[{i}]" for i in range(3)), **options)  # type: ignore[arg-type]
+    return TopicSource(topic=topic, fields=tuple(f"{field}[{i}]" for i in range(3)), **options)  # type: ignore[arg-type]
 
 
 #: Topics with ``time_utc_usec`` (GPS time) and the receiver's position, in order of preference.
@@ -167,41 +167,54 @@ PX4_GROUPS: tuple[SignalGroup, ...] = (
         "rad/s",
         (
             _xyz("vehicle_angular_velocity", "xyz"),
-            TopicSource("vehicle_attitude", ("rollspeed", "pitchspeed", "yawspeed")),  # before 2019
-            TopicSource("control_state", ("roll_rate", "pitch_rate", "yaw_rate")),  # 2016-2017
+            TopicSource(topic="vehicle_attitude", fields=("rollspeed", "pitchspeed", "yawspeed")),  # before 2019
+            TopicSource(topic="control_state", fields=("roll_rate", "pitch_rate", "yaw_rate")),  # 2016-2017
             _xyz("sensor_combined", "gyro_rad"),
             _xyz("sensor_combined", "gyro_rad_s"),  # before 2017
-            TopicSource("sensor_gyro", ("x", "y", "z")),
+            TopicSource(topic="sensor_gyro", fields=("x", "y", "z")),
         ),
     ),
     SignalGroup(
         ("phi", "theta", "psi"),
         "rad",
         (
-            TopicSource("vehicle_attitude", tuple(f"q[{i}]" for i in range(4)), "quaternion_to_euler"),
-            TopicSource("vehicle_attitude", ("roll", "pitch", "yaw")),  # before 2016
-            TopicSource("control_state", tuple(f"q[{i}]" for i in range(4)), "quaternion_to_euler"),
+            TopicSource(
+                topic="vehicle_attitude", fields=tuple(f"q[{i}]" for i in range(4)), conversion="quaternion_to_euler"
+            ),
+            TopicSource(topic="vehicle_attitude", fields=("roll", "pitch", "yaw")),  # before 2016
+            TopicSource(
+                topic="control_state", fields=tuple(f"q[{i}]" for i in range(4)), conversion="quaternion_to_euler"
+            ),
         ),
     ),
     SignalGroup(
         ("vn", "ve", "vd"),
         "m/s",
-        (TopicSource("vehicle_local_position", ("vx", "vy", "vz"), valid=("v_xy_valid", "v_xy_valid", "v_z_valid")),),
+        (
+            TopicSource(
+                topic="vehicle_local_position",
+                fields=("vx", "vy", "vz"),
+                valid=("v_xy_valid", "v_xy_valid", "v_z_valid"),
+            ),
+        ),
     ),
     SignalGroup(
         ("height_agl",),
         "m",
         (
             TopicSource(
-                "distance_sensor",
-                ("current_distance", "min_distance", "max_distance"),
-                "rangefinder",
+                topic="distance_sensor",
+                fields=("current_distance", "min_distance", "max_distance"),
+                conversion="rangefinder",
                 min_valid_fraction=0.5,
             ),
             TopicSource(
-                "vehicle_local_position", ("dist_bottom",), valid=("dist_bottom_valid",), min_valid_fraction=1.0
+                topic="vehicle_local_position",
+                fields=("dist_bottom",),
+                valid=("dist_bottom_valid",),
+                min_valid_fraction=1.0,
             ),
-            TopicSource("vehicle_local_position", ("z",), "negate", valid=("z_valid",)),
+            TopicSource(topic="vehicle_local_position", fields=("z",), conversion="negate", valid=("z_valid",)),
         ),
     ),
     SignalGroup(
@@ -210,7 +223,7 @@ PX4_GROUPS: tuple[SignalGroup, ...] = (
         (
             _xyz("vehicle_acceleration", "xyz"),
             _xyz("sensor_combined", "accelerometer_m_s2"),
-            TopicSource("sensor_accel", ("x", "y", "z")),
+            TopicSource(topic="sensor_accel", fields=("x", "y", "z")),
         ),
     ),
     SignalGroup(
@@ -218,50 +231,62 @@ PX4_GROUPS: tuple[SignalGroup, ...] = (
         "normalised",
         (
             _xyz("vehicle_torque_setpoint", "xyz"),
-            TopicSource("actuator_controls_0", ("control[0]", "control[1]", "control[2]")),
+            TopicSource(topic="actuator_controls_0", fields=("control[0]", "control[1]", "control[2]")),
         ),
     ),
     SignalGroup(
         ("delta_thr",),
         "normalised",
         (
-            TopicSource("vehicle_thrust_setpoint", ("xyz[2]",), "negate"),
-            TopicSource("actuator_controls_0", ("control[3]",)),
+            TopicSource(topic="vehicle_thrust_setpoint", fields=("xyz[2]",), conversion="negate"),
+            TopicSource(topic="actuator_controls_0", fields=("control[3]",)),
         ),
     ),
     SignalGroup(
         ("battery_v",),
         "V",
         (
-            TopicSource("battery_status", ("voltage_v",)),
-            TopicSource("battery_status", ("voltage_filtered_v",)),
+            TopicSource(topic="battery_status", fields=("voltage_v",)),
+            TopicSource(topic="battery_status", fields=("voltage_filtered_v",)),
         ),
     ),
     SignalGroup(
         ("est_wind_n", "est_wind_e"),
         "m/s",
         (
-            TopicSource("wind", ("windspeed_north", "windspeed_east")),
-            TopicSource("wind_estimate", ("windspeed_north", "windspeed_east")),
+            TopicSource(topic="wind", fields=("windspeed_north", "windspeed_east")),
+            TopicSource(topic="wind_estimate", fields=("windspeed_north", "windspeed_east")),
         ),
     ),
     SignalGroup(
         ("latitude", "longitude"),
         "rad",
         (
-            TopicSource("vehicle_global_position", ("lat", "lon"), "degrees", valid=("lat_lon_valid",) * 2),
-            TopicSource("sensor_gps", ("latitude_deg", "longitude_deg"), "degrees", at_least=_FIX_3D),  # v1.14 on
-            TopicSource("sensor_gps", ("lat", "lon"), "degrees_e7", at_least=_FIX_3D),
-            TopicSource("vehicle_gps_position", ("latitude_deg", "longitude_deg"), "degrees", at_least=_FIX_3D),
-            TopicSource("vehicle_gps_position", ("lat", "lon"), "degrees_e7", at_least=_FIX_3D),
+            TopicSource(
+                topic="vehicle_global_position",
+                fields=("lat", "lon"),
+                conversion="degrees",
+                valid=("lat_lon_valid",) * 2,
+            ),
+            TopicSource(
+                topic="sensor_gps", fields=("latitude_deg", "longitude_deg"), conversion="degrees", at_least=_FIX_3D
+            ),  # v1.14 on
+            TopicSource(topic="sensor_gps", fields=("lat", "lon"), conversion="degrees_e7", at_least=_FIX_3D),
+            TopicSource(
+                topic="vehicle_gps_position",
+                fields=("latitude_deg", "longitude_deg"),
+                conversion="degrees",
+                at_least=_FIX_3D,
+            ),
+            TopicSource(topic="vehicle_gps_position", fields=("lat", "lon"), conversion="degrees_e7", at_least=_FIX_3D),
         ),
     ),
 )
 
 #: Motor command topics in order of preference.
 PX4_MOTOR_SOURCES: tuple[MotorSource, ...] = (
-    MotorSource("actuator_motors", "control[{i}]", "normalised", "channels"),
-    MotorSource("actuator_outputs", "output[{i}]", "PWM us", "airframe"),
+    MotorSource(topic="actuator_motors", field_pattern="control[{i}]", unit="normalised", count_from="channels"),
+    MotorSource(topic="actuator_outputs", field_pattern="output[{i}]", unit="PWM us", count_from="airframe"),
 )
 
 #: MAVLink ``MAV_TYPE`` values seen on multirotors and their names.

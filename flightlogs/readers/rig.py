@@ -37,7 +37,7 @@ THRUST_UNITS = {"n": 1.0, "mn": 0.001, "g": 9.80665e-3, "kg": 9.80665, "gf": 9.8
 _SUFFIX = re.compile(r"(?:[_ ]|\s*[(\[])([a-z]+)[)\]]?\s*$", re.IGNORECASE)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class RigData:
     """Thrust readings of a ground-effect rig, in SI units.
 
@@ -130,7 +130,7 @@ def read_rig_csv(
     except OSError as err:
         raise DataError(f"{path}: cannot be read ({err.strerror or err})") from err
     header = [cell.strip() for cell in rows[0]]
-    table = Table(path, header, rows[1:], numbers[1:])
+    table = Table(path=path, header=header, rows=rows[1:], lines=numbers[1:])
     if not table.rows:
         raise DataError(f"{path}, line {numbers[0]}: a header but no readings")
     height_name = _column(table, height_column, numbers[0])
@@ -150,7 +150,14 @@ def read_rig_csv(
                 f"{path}, line {lines[bad[0]]}: column {name!r} must be > 0, "
                 f"got {values[bad[0]] / (height_scale if name == height_name else thrust_scale):g}"
             )
-    return RigData(path, height, thrust, lines, f"{height_name}{height_label}", f"{thrust_name}{thrust_label}")
+    return RigData(
+        path=path,
+        height_m=height,
+        thrust_n=thrust,
+        lines=lines,
+        height_source=f"{height_name}{height_label}",
+        thrust_source=f"{thrust_name}{thrust_label}",
+    )
 
 
 def _column(table: Table, wanted: str, header_line: int) -> str:

@@ -195,7 +195,7 @@ def _vehicle(scan: Scan, path: Path) -> tuple[Key, int, str]:
     raise LogFormatError(f"{path}: no HEARTBEAT from a vehicle, so the autopilot is unknown")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class _BootClock:
     """Maps tlog receive times and message times onto one log clock.
 
@@ -221,7 +221,7 @@ class _BootClock:
                 boot_parts.append(table[time_field] * scale)
         if not rx_parts:
             empty = np.empty(0)
-            return cls(empty, empty, np.empty(0, dtype=np.int64), np.zeros(1))
+            return cls(rx=empty, offset=empty, session=np.empty(0, dtype=np.int64), shift=np.zeros(1))
         rx = np.concatenate(rx_parts)
         boot = np.concatenate(boot_parts)
         order = np.argsort(rx, kind="stable")
@@ -229,7 +229,7 @@ class _BootClock:
         session = np.concatenate(([0], np.cumsum(np.diff(boot) < -_REBOOT_DROP_S)))
         offset = rx - boot
         medians = np.array([np.median(offset[session == s]) for s in range(session[-1] + 1)])
-        return cls(rx, offset, session, medians - medians[0])
+        return cls(rx=rx, offset=offset, session=session, shift=medians - medians[0])
 
     @property
     def reboots(self) -> int:

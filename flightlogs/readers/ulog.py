@@ -126,10 +126,10 @@ def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], No
         signals.update(_map_motors(datasets, parameters, notes))
         utc_offset_s = _utc_offset(datasets)
     log = FlightLog(
-        path,
-        "ulog",
-        "px4",
-        signals,
+        path=path,
+        log_format="ulog",
+        autopilot="px4",
+        signals=signals,
         vehicle=describe_vehicle(ulog.msg_info_dict, parameters),
         parameters=parameters,
         utc_offset_s=utc_offset_s,

@@ -16,7 +16,7 @@ from flightlogs.readers.dispatch import read_log
 __all__ = ["Campaign", "ingest_campaign", "expand_wind_paths"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Campaign:
     """Everything read and conditioned in one ingest.
 
@@ -135,4 +135,4 @@ def ingest_campaign(
                 raise  # the user asked for wind alignment: its failure is the answer
             conditioned.append(None)
             notes.append((f"not conditioned: {err}",))
-    return Campaign(tuple(logs), tuple(winds), tuple(conditioned), tuple(notes))
+    return Campaign(logs=tuple(logs), winds=tuple(winds), conditioned=tuple(conditioned), notes=tuple(notes))

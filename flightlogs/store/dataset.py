@@ -46,7 +46,7 @@ SCHEMA = "flight-sysid dataset"
 SCHEMA_VERSION = 1
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Dataset:
     """What a dataset file holds.
 
@@ -185,7 +185,13 @@ def _write_log(group: h5py.Group, log: FlightLog) -> None:
 
 def _read_log(group: h5py.Group) -> FlightLog:
     signals = {
-        name: Signal(name, sub["time_s"][()], sub["values"][()], str(sub.attrs["unit"]), str(sub.attrs["source"]))
+        name: Signal(
+            name=name,
+            time_s=sub["time_s"][()],
+            values=sub["values"][()],
+            unit=str(sub.attrs["unit"]),
+            source=str(sub.attrs["source"]),
+        )
         for name, sub in group["signals"].items()
     }
     table = group["parameters"][()]
@@ -217,11 +223,17 @@ _RUN_DTYPE = np.dtype(
 
 
 def _run_from_row(row: np.void) -> SystemIdRun:
-    numbers = [
-        float(row[name])
+    numbers = {
+        name: float(row[name])
         for name in ("magnitude", "f_start_hz", "f_stop_hz", "fade_in_s", "const_s", "record_s", "fade_out_s")
-    ]
-    return SystemIdRun(float(row["start_s"]), float(row["end_s"]), int(row["axis"]), _text(row["axis_name"]), *numbers)
+    }
+    return SystemIdRun(
+        start_s=float(row["start_s"]),
+        end_s=float(row["end_s"]),
+        axis=int(row["axis"]),
+        axis_name=_text(row["axis_name"]),
+        **numbers,
+    )
 
 
 def _write_dataclass(group: h5py.Group, item: Any) -> None:
@@ -333,14 +345,14 @@ def _read_conditioned(group: h5py.Group) -> Any:
 
     segments = tuple(
         Segment(
-            cast(Any, _text(row["axis"]) or None),
-            cast(Any, _text(row["kind"])),
-            float(row["start_s"]),
-            float(row["end_s"]),
-            cast(Any, _text(row["source"])),
-            None if np.isnan(row["f_min_hz"]) else float(row["f_min_hz"]),
-            None if np.isnan(row["f_max_hz"]) else float(row["f_max_hz"]),
-            _text(row["detail"]),
+            axis=cast(Any, _text(row["axis"]) or None),
+            kind=cast(Any, _text(row["kind"])),
+            start_s=float(row["start_s"]),
+            end_s=float(row["end_s"]),
+            source=cast(Any, _text(row["source"])),
+            f_min_hz=None if np.isnan(row["f_min_hz"]) else float(row["f_min_hz"]),
+            f_max_hz=None if np.isnan(row["f_max_hz"]) else float(row["f_max_hz"]),
+            detail=_text(row["detail"]),
         )
         for row in group["segments"][()]
     )
@@ -350,7 +362,15 @@ def _read_conditioned(group: h5py.Group) -> Any:
         sub = group["records"][key]
         units = json.loads(sub.attrs["units"])
         table = pd.DataFrame({name: sub[name][()] for name in units}, index=pd.Index(sub["time_s"][()], name="time_s"))
-        records.append(Record(table, units, json.loads(sub.attrs["trim"]), source, str(sub.attrs["label"])))
+        records.append(
+            Record(
+                table=table,
+                units=units,
+                trim=json.loads(sub.attrs["trim"]),
+                source=source,
+                label=str(sub.attrs["label"]),
+            )
+        )
     raw = json.loads(group.attrs["wind_alignment"])
     wind = None
     if raw is not None:
@@ -359,10 +379,10 @@ def _read_conditioned(group: h5py.Group) -> Any:
         raw["residual"] = None if raw["residual"] is None else LagEstimate(**raw["residual"])
         wind = WindAlignment(**raw)
     return ConditionedFlight(
-        source,
-        tuple(records),
-        segments,
-        float(group.attrs["rate_hz"]),
-        wind,
-        tuple(json.loads(group.attrs["warnings"])),
+        source=source,
+        records=tuple(records),
+        segments=segments,
+        rate_hz=float(group.attrs["rate_hz"]),
+        wind=wind,
+        warnings=tuple(json.loads(group.attrs["warnings"])),
     )

@@ -70,7 +70,7 @@ _MULT_VALUES = {
 }
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class MessageSpec:
     """Definition of one DataFlash message type, as its FMT (and FMTU) state it.
 
@@ -158,7 +158,7 @@ class MessageBlock:
 
 
 def _spec(name: str, fmt: str, columns: str, units: str = "", mults: str = "") -> MessageSpec:
-    return MessageSpec(name, fmt, tuple(columns.split(",")), units, mults)
+    return MessageSpec(name=name, format=fmt, columns=tuple(columns.split(",")), units=units, multipliers=mults)
 
 
 #: Message types as ArduCopter 4.x logs them (SIDD/SIDS as ``mode_systemid.cpp`` writes them).
@@ -422,7 +422,7 @@ def _assign_ids(specs: Sequence[MessageSpec], ids: dict[str, int]) -> dict[str, 
 
 
 def _fmt_block(specs: Sequence[MessageSpec], ids: Mapping[str, int]) -> MessageBlock:
-    fmt = MessageSpec("FMT", "BBnNZ", ("Type", "Length", "Name", "Format", "Columns"))
+    fmt = MessageSpec(name="FMT", format="BBnNZ", columns=("Type", "Length", "Name", "Format", "Columns"))
     return MessageBlock(
         fmt,
         {
@@ -443,7 +443,7 @@ def _unit_blocks(specs: Sequence[MessageSpec], ids: Mapping[str, int], time_us: 
     unit_ids = sorted({u for s in with_units for u in s.units})
     mult_ids = sorted({m for s in with_units for m in (s.multipliers or "?" * len(s.columns))})
     unit = MessageBlock(
-        MessageSpec("UNIT", "QbZ", ("TimeUS", "Id", "Label")),
+        MessageSpec(name="UNIT", format="QbZ", columns=("TimeUS", "Id", "Label")),
         {
             "TimeUS": np.full(len(unit_ids), time_us),
             "Id": np.array([ord(u) for u in unit_ids]),
@@ -451,7 +451,7 @@ def _unit_blocks(specs: Sequence[MessageSpec], ids: Mapping[str, int], time_us: 
         },
     )
     mult = MessageBlock(
-        MessageSpec("MULT", "Qbd", ("TimeUS", "Id", "Mult")),
+        MessageSpec(name="MULT", format="Qbd", columns=("TimeUS", "Id", "Mult")),
         {
             "TimeUS": np.full(len(mult_ids), time_us),
             "Id": np.array([ord(m) for m in mult_ids]),
@@ -459,7 +459,7 @@ def _unit_blocks(specs: Sequence[MessageSpec], ids: Mapping[str, int], time_us: 
         },
     )
     fmtu = MessageBlock(
-        MessageSpec("FMTU", "QBNN", ("TimeUS", "FmtType", "UnitIds", "MultIds")),
+        MessageSpec(name="FMTU", format="QBNN", columns=("TimeUS", "FmtType", "UnitIds", "MultIds")),
         {
             "TimeUS": np.full(len(with_units), time_us),
             "FmtType": np.array([ids[s.name] for s in with_units]),

@@ -84,7 +84,7 @@ def frequency_responses(
     >>> t = np.arange(6000) / 100.0
     >>> x = np.random.default_rng(0).normal(size=t.size)
     >>> table = pd.DataFrame({"delta_lon": x, "q": 2.0 * x}, index=t)
-    >>> record = Record(table, {"delta_lon": "%", "q": "rad/s"}, {}, Path("sim"))
+    >>> record = Record(table=table, units={"delta_lon": "%", "q": "rad/s"}, trim={}, source=Path("sim"))
     >>> (h,) = frequency_responses([record], ["delta_lon"], ["q"])
     >>> h.pair, bool(np.allclose(h.response, 2.0)), bool(np.all(h.coherence > 0.999))
     ('q/delta_lon', True, True)

@@ -256,7 +256,7 @@ def verify_record(
     >>> t = np.arange(200) * 0.01
     >>> step = (t >= 0.5).astype(float)
     >>> table = pd.DataFrame({"delta_lon": step, "q": 0.1 + step * (1 - np.exp(-2 * (t - 0.5)))}, index=t)
-    >>> result = verify_record(model, Record(table, {"delta_lon": "%", "q": "rad/s"}, {}, Path("demo.ulg")),
+    >>> result = verify_record(model, Record(table=table, units={"delta_lon": "%", "q": "rad/s"}, trim={}, source=Path("demo.ulg")),
     ...                        options=VerificationOptions(initial_state="zero", fit_reference_shift=False))
     >>> round(result.output("q").bias, 3), result.output("q").tic < 0.01
     (0.1, True)

@@ -15,7 +15,7 @@ from flightlogs.signals import LOGGED_SIGNALS, describe, is_canonical
 
 def _signal(name: str, n: int = 101, rate: float = 100.0) -> Signal:
     t = np.arange(n) / rate
-    return Signal(name, t, np.sin(t), describe(name).unit, f"test.{name}")
+    return Signal(name=name, time_s=t, values=np.sin(t), unit=describe(name).unit, source=f"test.{name}")
 
 
 def test_signal_rate_and_duration() -> None:
@@ -37,7 +37,7 @@ def test_signal_arrays_are_read_only() -> None:
 )
 def test_signal_rejects_bad_shapes_and_names(name: str, time_s: np.ndarray, values: np.ndarray) -> None:
     with pytest.raises(ValueError):
-        Signal(name, time_s, values, "rad/s", "test")
+        Signal(name=name, time_s=time_s, values=values, unit="rad/s", source="test")
 
 
 def test_canonical_names() -> None:
@@ -47,7 +47,9 @@ def test_canonical_names() -> None:
 
 def test_flightlog_reports_missing_and_utc() -> None:
     signals = {name: _signal(name) for name in ("p", "q", "r", "motor_1")}
-    log = FlightLog(Path("x.ulg"), "ulog", "px4", signals, utc_offset_s=1_700_000_000.0)
+    log = FlightLog(
+        path=Path("x.ulg"), log_format="ulog", autopilot="px4", signals=signals, utc_offset_s=1_700_000_000.0
+    )
     assert "p" not in log.missing and "phi" in log.missing
     assert "motor_1..n" not in log.missing
     assert set(log.missing) == set(LOGGED_SIGNALS) - {"p", "q", "r"}
@@ -56,20 +58,41 @@ def test_flightlog_reports_missing_and_utc() -> None:
 
 
 def test_flightlog_getitem_names_the_missing_signal() -> None:
-    log = FlightLog(Path("flight.bin"), "dataflash", "ardupilot", {"p": _signal("p")})
+    log = FlightLog(path=Path("flight.bin"), log_format="dataflash", autopilot="ardupilot", signals={"p": _signal("p")})
     with pytest.raises(MissingSignalError, match=r"flight.bin: no signal 'theta'"):
         log["theta"]
     assert log["p"].name == "p"
 
 
 def test_flightlog_signals_are_immutable() -> None:
-    log = FlightLog(Path("a.ulg"), "ulog", "px4", {"p": _signal("p")})
+    log = FlightLog(path=Path("a.ulg"), log_format="ulog", autopilot="px4", signals={"p": _signal("p")})
     with pytest.raises(TypeError):
         log.signals["q"] = _signal("q")  # type: ignore[index]
 
 
 def test_flightlog_keeps_system_id_runs_as_a_tuple() -> None:
-    run = SystemIdRun(5.0, 40.0, 7, "rate roll", 10.0, 0.5, 20.0, 1.0, 4.0, 30.0, 0.5)
-    log = FlightLog(Path("sysid.bin"), "dataflash", "ardupilot", {"p": _signal("p")}, system_id_runs=[run])
+    run = SystemIdRun(
+        start_s=5.0,
+        end_s=40.0,
+        axis=7,
+        axis_name="rate roll",
+        magnitude=10.0,
+        f_start_hz=0.5,
+        f_stop_hz=20.0,
+        fade_in_s=1.0,
+        const_s=4.0,
+        record_s=30.0,
+        fade_out_s=0.5,
+    )
+    log = FlightLog(
+        path=Path("sysid.bin"),
+        log_format="dataflash",
+        autopilot="ardupilot",
+        signals={"p": _signal("p")},
+        system_id_runs=[run],
+    )
     assert log.system_id_runs == (run,)
-    assert FlightLog(Path("a.ulg"), "ulog", "px4", {"p": _signal("p")}).system_id_runs == ()
+    assert (
+        FlightLog(path=Path("a.ulg"), log_format="ulog", autopilot="px4", signals={"p": _signal("p")}).system_id_runs
+        == ()
+    )

@@ -163,7 +163,13 @@ def test_a_gap_splits_the_record_and_is_reported(demo: dict) -> None:
     log = demo["log"]
     q = log["q"]
     keep = (q.time_s < 60.0) | (q.time_s > 61.0)
-    gapped = replace(log, signals={**log.signals, "q": Signal("q", q.time_s[keep], q.values[keep], q.unit, q.source)})
+    gapped = replace(
+        log,
+        signals={
+            **log.signals,
+            "q": Signal(name="q", time_s=q.time_s[keep], values=q.values[keep], unit=q.unit, source=q.source),
+        },
+    )
     flight = condition_flight(gapped)
     assert len(flight.records) == 2
     assert flight.records[0].end_s < 60.0 + ONE_SAMPLE_S and flight.records[1].start_s > 61.0 - ONE_SAMPLE_S

@@ -108,8 +108,8 @@ def test_a_long_gap_is_found_and_splits_the_record() -> None:
     t = np.arange(3000) / 100.0
     q_time = _with_hole(12.30, 13.14)
     signals = {
-        "p": Signal("p", t, np.sin(t), "rad/s", "test"),
-        "q": Signal("q", q_time, np.cos(q_time), "rad/s", "test"),
+        "p": Signal(name="p", time_s=t, values=np.sin(t), unit="rad/s", source="test"),
+        "q": Signal(name="q", time_s=q_time, values=np.cos(q_time), unit="rad/s", source="test"),
     }
     gaps = find_gaps(q_time, name="q")
     assert gaps == (Gap("q", 12.30, 13.14),)
@@ -151,8 +151,14 @@ def test_spans_shorter_than_asked_are_dropped() -> None:
 
 
 def test_the_default_time_base_is_the_fastest_rate_over_the_common_span() -> None:
-    fast = Signal("q", _jittered(100.0, 30.0, 0.0005, seed=3) + 0.002, np.zeros(3000), "rad/s", "test")
-    slow = Signal("wind_n", np.arange(5.03, 25.0, 0.05), np.zeros(400), "m/s", "test")
+    fast = Signal(
+        name="q",
+        time_s=_jittered(100.0, 30.0, 0.0005, seed=3) + 0.002,
+        values=np.zeros(3000),
+        unit="rad/s",
+        source="test",
+    )
+    slow = Signal(name="wind_n", time_s=np.arange(5.03, 25.0, 0.05), values=np.zeros(400), unit="m/s", source="test")
     time_base = uniform_time_base({"q": fast, "wind_n": slow})
     assert np.allclose(np.diff(time_base), 0.01)
     assert time_base[0] >= 5.03 and time_base[0] < 5.04
@@ -169,8 +175,8 @@ def test_resample_signals_resamples_each_signal_with_its_method() -> None:
     t = np.arange(0, 10.0, 0.05)
     step = (t >= 5.0).astype(float)
     signals = {
-        "wind_n": Signal("wind_n", t, np.sin(t), "m/s", "test"),
-        "excitation": Signal("excitation", t, step, "1", "test"),
+        "wind_n": Signal(name="wind_n", time_s=t, values=np.sin(t), unit="m/s", source="test"),
+        "excitation": Signal(name="excitation", time_s=t, values=step, unit="1", source="test"),
     }
     time_base = np.arange(0, 995) / 100.0
     out = resample_signals(signals, time_base, method={"excitation": "pchip"})

@@ -170,7 +170,10 @@ def test_bad_detection_input_is_a_data_error(inputs, time_s, fragment) -> None:
 
 def _run(start_s: float, axis: int, *settings: float) -> SystemIdRun:
     """A System ID run with SIDS `settings` (Mag, FSt, FSp, TFin, TC, TR, TFout) and no SIDD (end unknown)."""
-    return SystemIdRun(start_s, float("nan"), axis, "test", *settings)
+    names = ("magnitude", "f_start_hz", "f_stop_hz", "fade_in_s", "const_s", "record_s", "fade_out_s")
+    return SystemIdRun(
+        start_s=start_s, end_s=float("nan"), axis=axis, axis_name="test", **dict(zip(names, settings, strict=True))
+    )
 
 
 def test_sids_rows_give_exact_sweep_segments() -> None:
@@ -302,8 +305,32 @@ def test_an_inconsistent_segment_is_rejected(kwargs: dict, fragment: str) -> Non
 
 
 def test_runs_from_the_dataflash_reader_are_accepted() -> None:
-    run = SystemIdRun(50.0, 80.0, 10, "mixer roll", 0.1, 0.5, 20.0, 2.0, 4.0, 40.0, 1.0)
+    run = SystemIdRun(
+        start_s=50.0,
+        end_s=80.0,
+        axis=10,
+        axis_name="mixer roll",
+        magnitude=0.1,
+        f_start_hz=0.5,
+        f_stop_hz=20.0,
+        fade_in_s=2.0,
+        const_s=4.0,
+        record_s=40.0,
+        fade_out_s=1.0,
+    )
     (segment,) = segments_from_sid([run])
     assert (segment.axis, segment.start_s, segment.end_s) == ("lat", 51.0, 80.0)  # ended early at the last SIDD
-    no_sidd = SystemIdRun(50.0, float("nan"), 10, "mixer roll", 0.1, 0.5, 20.0, 2.0, 4.0, 40.0, 1.0)
+    no_sidd = SystemIdRun(
+        start_s=50.0,
+        end_s=float("nan"),
+        axis=10,
+        axis_name="mixer roll",
+        magnitude=0.1,
+        f_start_hz=0.5,
+        f_stop_hz=20.0,
+        fade_in_s=2.0,
+        const_s=4.0,
+        record_s=40.0,
+        fade_out_s=1.0,
+    )
     assert segments_from_sid([no_sidd])[0].end_s == 91.0

@@ -175,7 +175,14 @@ def test_result_is_immutable_and_checked():
     with pytest.raises(ValueError):
         wind.wind_n[0] = 1.0
     with pytest.raises(ValueError, match="shape"):
-        WindMeasurement(Path("x"), np.zeros(3), np.zeros(2), np.zeros(3), np.zeros(3), np.zeros(3))
+        WindMeasurement(
+            path=Path("x"),
+            utc_s=np.zeros(3),
+            wind_n=np.zeros(2),
+            wind_e=np.zeros(3),
+            speed_m_s=np.zeros(3),
+            direction_from_rad=np.zeros(3),
+        )
 
 
 # --------------------------------------------------------------------------- the real file

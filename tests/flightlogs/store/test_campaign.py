@@ -12,7 +12,10 @@ from flightlogs.store.campaign import Campaign, ingest_campaign
 
 def test_no_conditioned_flight_names_each_logs_reason() -> None:
     campaign = Campaign(
-        (), (), (None, None), (("not conditioned: a.ulg has no attitude",), ("not conditioned: b.bin is 2 s long",))
+        logs=(),
+        winds=(),
+        conditioned=(None, None),
+        notes=(("not conditioned: a.ulg has no attitude",), ("not conditioned: b.bin is 2 s long",)),
     )
     assert campaign.flights == ()
     with pytest.raises(

@@ -18,14 +18,18 @@ def _log(path: Path) -> FlightLog:
     rng = np.random.default_rng(7)
     t = np.cumsum(rng.uniform(0.004, 0.006, 500))
     signals = {
-        "q": Signal("q", t, rng.normal(size=500), "rad/s", "vehicle_angular_velocity[0].xyz[1]"),
-        "motor_1": Signal("motor_1", t[::2], rng.uniform(1000, 2000, 250), "us", "RCOU.C1"),
+        "q": Signal(
+            name="q", time_s=t, values=rng.normal(size=500), unit="rad/s", source="vehicle_angular_velocity[0].xyz[1]"
+        ),
+        "motor_1": Signal(
+            name="motor_1", time_s=t[::2], values=rng.uniform(1000, 2000, 250), unit="us", source="RCOU.C1"
+        ),
     }
     return FlightLog(
-        path,
-        "ulog",
-        "px4",
-        signals,
+        path=path,
+        log_format="ulog",
+        autopilot="px4",
+        signals=signals,
         vehicle="quad ∅ <x>",
         parameters={"MPC_THR_HOVER": 0.42, "SYS_AUTOSTART": 4001.0},
         utc_offset_s=1.6e9 + 0.125,
@@ -57,7 +61,7 @@ def test_round_trip_keeps_every_value(tmp_path: Path) -> None:
 
 
 def test_unknown_utc_round_trips_as_none(tmp_path: Path) -> None:
-    log = FlightLog(tmp_path / "a.bin", "dataflash", "ardupilot", {})
+    log = FlightLog(path=tmp_path / "a.bin", log_format="dataflash", autopilot="ardupilot", signals={})
     write_dataset(tmp_path / "a.h5", [log])
     assert read_dataset(tmp_path / "a.h5").logs[0].utc_offset_s is None
 
@@ -122,10 +126,36 @@ def test_system_id_runs_round_trip(tmp_path: Path) -> None:
     from flightlogs.flightlog import SystemIdRun
 
     runs = (
-        SystemIdRun(25.0, 59.99, 11, "mixer pitch", 0.08, 0.1, 10.0, 5.0, 0.0, 34.0, 1.0),
-        SystemIdRun(75.0, float("nan"), 10, "mixer roll", 0.08, 0.1, 10.0, 5.0, 0.0, 34.0, 1.0),
+        SystemIdRun(
+            start_s=25.0,
+            end_s=59.99,
+            axis=11,
+            axis_name="mixer pitch",
+            magnitude=0.08,
+            f_start_hz=0.1,
+            f_stop_hz=10.0,
+            fade_in_s=5.0,
+            const_s=0.0,
+            record_s=34.0,
+            fade_out_s=1.0,
+        ),
+        SystemIdRun(
+            start_s=75.0,
+            end_s=float("nan"),
+            axis=10,
+            axis_name="mixer roll",
+            magnitude=0.08,
+            f_start_hz=0.1,
+            f_stop_hz=10.0,
+            fade_in_s=5.0,
+            const_s=0.0,
+            record_s=34.0,
+            fade_out_s=1.0,
+        ),
     )
-    log = FlightLog(tmp_path / "sid.bin", "dataflash", "ardupilot", {}, system_id_runs=runs)
+    log = FlightLog(
+        path=tmp_path / "sid.bin", log_format="dataflash", autopilot="ardupilot", signals={}, system_id_runs=runs
+    )
     write_dataset(tmp_path / "sid.h5", [log])
     back = read_dataset(tmp_path / "sid.h5").logs[0].system_id_runs
     assert back[0] == runs[0]

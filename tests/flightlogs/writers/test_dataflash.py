@@ -95,7 +95,7 @@ def _blocks(draw: st.DrawFn) -> list[MessageBlock]:
             )
         )
         n = draw(st.integers(0, 6))
-        spec = MessageSpec(f"T{k}", "Q" + fmt, ("TimeUS", *(f"F{i}" for i in range(len(fmt)))))
+        spec = MessageSpec(name=f"T{k}", format="Q" + fmt, columns=("TimeUS", *(f"F{i}" for i in range(len(fmt)))))
         data = {"TimeUS": np.array(draw(st.lists(st.integers(0, 10**12), min_size=n, max_size=n)), dtype=np.uint64)}
         data.update({f"F{i}": draw(_column(c, n)) for i, c in enumerate(fmt)})
         blocks.append(MessageBlock(spec, data))
@@ -192,11 +192,14 @@ def test_write_dataflash_leaves_no_temporary_file(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("make", "message"),
     [
-        (lambda: MessageSpec("TOOLONG", "Q", ("TimeUS",)), "1 to 4 ASCII"),
-        (lambda: MessageSpec("X", "Qx", ("TimeUS", "A")), "format 'Qx'"),
-        (lambda: MessageSpec("X", "QB", ("TimeUS",)), "1 columns for format"),
-        (lambda: MessageSpec("X", "QB", ("TimeUS", "A"), units="s?"), "units"),
-        (lambda: MessageBlock(MessageSpec("X", "QB", ("TimeUS", "A")), {"TimeUS": [1]}), "no data for columns"),
+        (lambda: MessageSpec(name="TOOLONG", format="Q", columns=("TimeUS",)), "1 to 4 ASCII"),
+        (lambda: MessageSpec(name="X", format="Qx", columns=("TimeUS", "A")), "format 'Qx'"),
+        (lambda: MessageSpec(name="X", format="QB", columns=("TimeUS",)), "1 columns for format"),
+        (lambda: MessageSpec(name="X", format="QB", columns=("TimeUS", "A"), units="s?"), "units"),
+        (
+            lambda: MessageBlock(MessageSpec(name="X", format="QB", columns=("TimeUS", "A")), {"TimeUS": [1]}),
+            "no data for columns",
+        ),
         (lambda: encode_dataflash([standard_block("ATT", TimeUS=[1], Roll=[400.0])]), "outside the range"),
         (lambda: encode_dataflash([standard_block("RCOU", TimeUS=[1], C1=[1500.5])]), "fractions"),
         (lambda: encode_dataflash([standard_block("MSG", TimeUS=[1], Message=["x" * 65])]), "longer than 64"),
@@ -218,7 +221,7 @@ def test_standard_formats_are_valid_and_sized_like_ardupilot() -> None:
 
 def test_a_message_longer_than_255_bytes_is_refused(tmp_path: Path) -> None:
     """DataFlash's FMT Length is one byte: Q + four 64-byte strings (3 + 8 + 256 bytes) cannot be written."""
-    spec = MessageSpec("LONG", "QZZZZ", ("TimeUS", "A", "B", "C", "D"))
+    spec = MessageSpec(name="LONG", format="QZZZZ", columns=("TimeUS", "A", "B", "C", "D"))
     block = MessageBlock(
         spec, {"TimeUS": np.array([1], dtype=np.uint64), **{c: np.array(["x"], dtype=object) for c in "ABCD"}}
     )

@@ -51,7 +51,9 @@ def _record(axis: str, seed: int) -> Record:
         index=flight.time_s,
     )
     trim = table.mean()
-    return Record(table - trim, UNITS, trim.to_dict(), Path(f"{axis}.bin"), f"{axis} sweep")
+    return Record(
+        table=table - trim, units=UNITS, trim=trim.to_dict(), source=Path(f"{axis}.bin"), label=f"{axis} sweep"
+    )
 
 
 @pytest.fixture(scope="module")
@@ -88,7 +90,9 @@ def test_unresolved_wind_delays_are_dropped_to_zero(records: list[Record]) -> No
 
 def test_records_without_wind_are_refused(records: list[Record]) -> None:
     structure = load_structure("hover-wind")
-    bare = [Record(r.table.drop(columns="wind_lon"), r.units, r.trim, r.source) for r in records]
+    bare = [
+        Record(table=r.table.drop(columns="wind_lon"), units=r.units, trim=r.trim, source=r.source) for r in records
+    ]
     with pytest.raises(FitError, match="wind_lon"):
         fit_wind(structure, structure.values(), structure.default_constants(), bare)
     with pytest.raises(FitError, match="no wind parameters"):

@@ -39,7 +39,12 @@ def _truth(filt: tuple[np.ndarray, np.ndarray], omega: np.ndarray) -> np.ndarray
 
 def _record(columns: dict[str, np.ndarray]) -> Record:
     time_s = np.arange(next(iter(columns.values())).size) * DT
-    return Record(pd.DataFrame(columns, index=time_s), {name: "-" for name in columns}, {}, Path("simulated"))
+    return Record(
+        table=pd.DataFrame(columns, index=time_s),
+        units={name: "-" for name in columns},
+        trim={},
+        source=Path("simulated"),
+    )
 
 
 def _correlated_records(n_records: int = 4, seconds: float = 60.0, seed: int = 0) -> list[Record]:

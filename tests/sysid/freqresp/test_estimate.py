@@ -59,7 +59,12 @@ def _sweep(amplitude: float = 1.0, f_stop_hz: float = 12.0) -> Maneuver:
 
 
 def _record(columns: dict[str, np.ndarray], time_s: np.ndarray) -> Record:
-    return Record(pd.DataFrame(columns, index=time_s), {name: "-" for name in columns}, {}, Path("simulated"))
+    return Record(
+        table=pd.DataFrame(columns, index=time_s),
+        units={name: "-" for name in columns},
+        trim={},
+        source=Path("simulated"),
+    )
 
 
 def _open_loop_records(
@@ -333,7 +338,7 @@ def octocopter_sweeps() -> list[Record]:
     time_s = flight.time_s
     table = pd.DataFrame({name: flight.signals[name] for name in ("delta_lon", "q", "ax", "theta", "u")}, index=time_s)
     table["excitation"] = excitation_signal(time_s, maneuvers, "lon") / 100.0
-    record = Record(table, {c: "-" for c in table.columns}, {}, Path("octocopter"))
+    record = Record(table=table, units={c: "-" for c in table.columns}, trim={}, source=Path("octocopter"))
     return [record.between(s - 1.0, s + 36.0) for s in starts]
 
 

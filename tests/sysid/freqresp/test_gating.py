@@ -204,15 +204,15 @@ def _flight(*, gap: tuple[float, float] | None = None, seed: int = 0, excitation
         )
     table = pd.DataFrame(columns, index=t)
     units = {name: "-" for name in columns}
-    whole = Record(table, units, {}, Path("f.bin"), "piece 1 of 1")
+    whole = Record(table=table, units=units, trim={}, source=Path("f.bin"), label="piece 1 of 1")
     records = (whole,) if gap is None else (whole.between(0.0, gap[0]), whole.between(gap[1], 99.99))
     segments = (
-        Segment("lon", "sweep", 10.0, 50.0, "detected"),
-        Segment("lon", "doublet", 52.0, 54.0, "detected"),
-        Segment("lat", "sweep", 60.0, 90.0, "detected"),
-        Segment(None, "hover", 91.0, 99.0, "detected"),
+        Segment(axis="lon", kind="sweep", start_s=10.0, end_s=50.0, source="detected"),
+        Segment(axis="lon", kind="doublet", start_s=52.0, end_s=54.0, source="detected"),
+        Segment(axis="lat", kind="sweep", start_s=60.0, end_s=90.0, source="detected"),
+        Segment(axis=None, kind="hover", start_s=91.0, end_s=99.0, source="detected"),
     )
-    return ConditionedFlight(Path("f.bin"), records, segments, RATE_HZ)
+    return ConditionedFlight(source=Path("f.bin"), records=records, segments=segments, rate_hz=RATE_HZ)
 
 
 def test_maneuver_records_keep_a_margin_that_stops_at_the_next_maneuver() -> None:
@@ -360,7 +360,13 @@ def test_window_lengths_are_sorted_and_unique() -> None:
 
 def _simple(columns: dict[str, np.ndarray], rate_hz: float = RATE_HZ) -> Record:
     t = np.arange(next(iter(columns.values())).size) / rate_hz
-    return Record(pd.DataFrame(columns, index=t), {name: "-" for name in columns}, {}, Path("x.ulg"), "r")
+    return Record(
+        table=pd.DataFrame(columns, index=t),
+        units={name: "-" for name in columns},
+        trim={},
+        source=Path("x.ulg"),
+        label="r",
+    )
 
 
 @pytest.mark.parametrize(

@@ -47,19 +47,23 @@ def synthetic_log(*, ground_s: float = 6.0, seed: int = 0, motors: bool = True) 
     rng = np.random.default_rng(seed)
     signals = {
         "height_agl": Signal(
-            "height_agl",
-            time_s,
-            height + rng.normal(0, HEIGHT_NOISE_M, time_s.size),
-            "m",
-            "vehicle_local_position[0].dist_bottom",
+            name="height_agl",
+            time_s=time_s,
+            values=height + rng.normal(0, HEIGHT_NOISE_M, time_s.size),
+            unit="m",
+            source="vehicle_local_position[0].dist_bottom",
         )
     }
     for i in range(1, 5 if motors else 1):
         command = f0 / 4 / (KF * FULL) * (1 + rng.normal(0, MOTOR_NOISE, time_s.size))
         signals[f"motor_{i}"] = Signal(
-            f"motor_{i}", time_s, command, "normalised", f"actuator_motors[0].control[{i - 1}]"
+            name=f"motor_{i}",
+            time_s=time_s,
+            values=command,
+            unit="normalised",
+            source=f"actuator_motors[0].control[{i - 1}]",
         )
-    return FlightLog(Path("synthetic.ulg"), "ulog", "px4", signals)
+    return FlightLog(path=Path("synthetic.ulg"), log_format="ulog", autopilot="px4", signals=signals)
 
 
 def test_plateaus_split_a_staircase_at_its_steps() -> None:

@@ -193,9 +193,11 @@ def conditioned(flight: SimulatedFlight, name: str) -> ConditionedFlight:
     table = pd.DataFrame(columns, index=pd.Index(flight.time_s, name="time_s"))
     trim = table[hover_mask(flight.time_s, flight.maneuvers)].mean()  # over the whole hover, as conditioning does
     trim_values = {str(k): float(v) for k, v in trim.items()}
-    record = Record(table - trim, UNITS, trim_values, Path(f"{name}.ulg"), "piece 1 of 1")
-    segments = tuple(Segment(m.axis, "doublet", m.start_s, m.end_s, "user") for m in flight.maneuvers)
-    return ConditionedFlight(Path(f"{name}.ulg"), (record,), segments, 100.0)
+    record = Record(table=table - trim, units=UNITS, trim=trim_values, source=Path(f"{name}.ulg"), label="piece 1 of 1")
+    segments = tuple(
+        Segment(axis=m.axis, kind="doublet", start_s=m.start_s, end_s=m.end_s, source="user") for m in flight.maneuvers
+    )
+    return ConditionedFlight(source=Path(f"{name}.ulg"), records=(record,), segments=segments, rate_hz=100.0)
 
 
 @pytest.fixture(scope="module")
@@ -234,7 +236,9 @@ def _block(models: Mapping[str, DelayedStateSpace]) -> DelayedStateSpace:
 def _record(columns: dict[str, np.ndarray], rate_hz: float = 100.0, units: Mapping[str, str] = UNITS) -> Record:
     n = len(next(iter(columns.values())))
     table = pd.DataFrame(columns, index=pd.Index(np.arange(n) / rate_hz, name="time_s"))
-    return Record(table, {c: units.get(c, "1") for c in columns}, {}, Path("test.ulg"), "test")
+    return Record(
+        table=table, units={c: units.get(c, "1") for c in columns}, trim={}, source=Path("test.ulg"), label="test"
+    )
 
 
 # ---------------------------------------------------------------------------------------------- analytic
