@@ -68,8 +68,10 @@ def bode_figure(
     Examples
     --------
     >>> omega = np.geomspace(1.0, 10.0, 20)
-    >>> h = FrequencyResponse("delta_lon", "q", omega, 1 / (1j * omega + 1), np.full(20, 0.9), np.zeros(20),
-    ...                       np.ones(20), np.ones(20), np.ones(20, complex), (4.0,), fit_range=(1.0, 8.0))
+    >>> h = FrequencyResponse(input="delta_lon", output="q", omega=omega, response=1 / (1j * omega + 1),
+    ...                       coherence=np.full(20, 0.9), random_error=np.zeros(20),
+    ...                       input_autospectrum=np.ones(20), output_autospectrum=np.ones(20),
+    ...                       cross_spectrum=np.ones(20, complex), windows_s=(4.0,), fit_range=(1.0, 8.0))
     >>> figure = bode_figure([h], models={"q/delta_lon": lambda w: 1 / (1j * w + 1)})
     >>> len(figure.axes)
     3

@@ -86,8 +86,8 @@ def pair_response(model: DelayedStateSpace, output: str, signal: str, omega: np.
 
     Examples
     --------
-    >>> m = DelayedStateSpace(np.array([[-2.0]]), np.array([[2.0]]), np.array([[1.0]]), np.zeros((1, 1)),
-    ...                       ("p",), ("delta_lat",), ("p",), np.array([0.0]))
+    >>> m = DelayedStateSpace(a=np.array([[-2.0]]), b=np.array([[2.0]]), c=np.array([[1.0]]), d=np.zeros((1, 1)),
+    ...                       states=("p",), inputs=("delta_lat",), outputs=("p",), input_delays_s=np.array([0.0]))
     >>> np.round(np.abs(pair_response(m, "p", "delta_lat", np.array([2.0]))), 3)
     array([0.707])
     """
@@ -264,7 +264,9 @@ def pole_map_figure(found: Sequence[Mode]) -> Figure:
     Examples
     --------
     >>> from sysid.model.modes import Mode
-    >>> fig = pole_map_figure([Mode(-1.0, 2.0, 0.45, 2.24, float("inf"), 0.69, "pitch", "stable")])
+    >>> mode = Mode(real=-1.0, imag=2.0, damping=0.45, natural_frequency_rad_s=2.24,
+    ...             time_to_double_s=float("inf"), time_to_half_s=0.69, mode="pitch", stability="stable")
+    >>> fig = pole_map_figure([mode])
     >>> len(fig.axes)
     1
     """

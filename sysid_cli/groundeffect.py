@@ -173,7 +173,7 @@ def _configs(kw: dict[str, Any]) -> tuple[Any, Any]:
         rotor_offset_m=kw["rotor_offset"],
         min_hold_s=kw["min_hold"],
     )
-    return data, FitConfig(kw["models"] or MODEL_NAMES, kw["criterion"], kw["confidence"])
+    return data, FitConfig(models=kw["models"] or MODEL_NAMES, criterion=kw["criterion"], confidence=kw["confidence"])
 
 
 @click.group("ground-effect", epilog=_GROUP_EPILOG)

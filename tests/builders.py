@@ -134,7 +134,14 @@ def small_model(
         cr, ins = accuracy.get(p.name, (5.0, 2.0)) if estimated else (math.nan, math.nan)
         unit = re.sub(r"\{delta_\w+\}", NORMALISED_UNIT, p.unit)
         parameters.append(
-            ParameterEstimate(p.name, values[p.name], cr, ins, "estimated" if estimated else "dropped", unit)
+            ParameterEstimate(
+                name=p.name,
+                value=values[p.name],
+                cr_percent=cr,
+                insensitivity_percent=ins,
+                status="estimated" if estimated else "dropped",
+                unit=unit,
+            )
         )
     names = tuple(p.name for p in parameters if p.status == "estimated")
     correlation = np.eye(len(names))
@@ -142,7 +149,13 @@ def small_model(
     correlation[2, 3] = correlation[3, 2] = 0.5
     constants = {"g": 9.81, "U0": 0.0, "V0": 0.0, "W0": 0.0, "phi0": 0.0, "theta0": 0.0}
     model = IdentifiedModel(
-        "hover", text, tuple(parameters), names, correlation, CostSummary(average), constants=constants
+        structure_name="hover",
+        structure_text=text,
+        parameters=tuple(parameters),
+        correlation_names=names,
+        correlation=correlation,
+        cost=CostSummary(average=average),
+        constants=constants,
     )
     fitted = (
         synthetic_responses(model.linear_model(), PAIRS, noise_db=0.5, noise_deg=3.0, fit_range=(1.0, 40.0), seed=3)
@@ -150,17 +163,30 @@ def small_model(
         else ()
     )
     costs = dict(costs) if costs is not None else {pair: average for pair in PAIRS}
-    reduction = (ReductionStep(1, "N_r", "dropped", 0.0, -0.02, 80.0, 45.0, "I% = 45 > 10", average, average),)
+    reduction = (
+        ReductionStep(
+            step=1,
+            parameter="N_r",
+            action="dropped",
+            value=0.0,
+            estimate=-0.02,
+            cr_percent=80.0,
+            insensitivity_percent=45.0,
+            reason="I% = 45 > 10",
+            cost_average=average,
+            cost_average_after=average,
+        ),
+    )
     provenance = Provenance(
-        files,
-        {f: "ab" * 32 for f in files},
-        {"min_coherence": 0.5, "fit": {"starts": 1}},
-        {"flight-sysid": "0.1.0"},
-        "2024-05-01T12:00:00+00:00",
+        files=files,
+        sha256={f: "ab" * 32 for f in files},
+        options={"min_coherence": 0.5, "fit": {"starts": 1}},
+        versions={"flight-sysid": "0.1.0"},
+        created_utc="2024-05-01T12:00:00+00:00",
     )
     return dataclasses.replace(
         model,
-        cost=CostSummary(average, costs),
+        cost=CostSummary(average=average, responses=costs),
         responses=fitted,
         reduction=reduction,
         provenance=provenance,
@@ -183,24 +209,24 @@ def sample_verification(*, seed: int = 0) -> Verification:
     c = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [-0.4, 0.0, 0.3, 0.0], [0.0, 0.0, 0.0, 1.0]])
     d = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.5], [0.0, 0.0, 0.0]])
     with_wind = DelayedStateSpace(
-        a,
-        b,
-        c,
-        d,
-        ("q", "theta", "d_lon", "p"),
-        ("delta_lon", "delta_lat", "wind_lon"),
-        ("q", "theta", "ax", "p"),
-        np.array([0.02, 0.02, 0.015]),
+        a=a,
+        b=b,
+        c=c,
+        d=d,
+        states=("q", "theta", "d_lon", "p"),
+        inputs=("delta_lon", "delta_lat", "wind_lon"),
+        outputs=("q", "theta", "ax", "p"),
+        input_delays_s=np.array([0.02, 0.02, 0.015]),
     )
     without = DelayedStateSpace(
-        a,
-        b[:, :2],
-        c,
-        d[:, :2],
-        with_wind.states,
-        with_wind.inputs[:2],
-        with_wind.outputs,
-        with_wind.input_delays_s[:2],
+        a=a,
+        b=b[:, :2],
+        c=c,
+        d=d[:, :2],
+        states=with_wind.states,
+        inputs=with_wind.inputs[:2],
+        outputs=with_wind.outputs,
+        input_delays_s=with_wind.input_delays_s[:2],
     )
     rng = np.random.default_rng(seed)
     t = np.arange(400) * 0.01

@@ -32,7 +32,7 @@ __all__ = ["Accuracy", "accuracy"]
 _NULL = 1e-12  # eigenvalues of H below this fraction of the largest are taken as unidentifiable directions
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Accuracy:
     """Accuracy metrics of a set of estimated parameters.
 
@@ -118,7 +118,14 @@ def accuracy(jacobian: np.ndarray, values: np.ndarray, names: tuple[str, ...]) -
     with np.errstate(divide="ignore"):
         insensitivity = np.where(diagonal > 0, 1.0 / np.sqrt(np.maximum(diagonal, 1e-300)), np.inf)
     if n == 0:
-        return Accuracy(names, values, hessian, np.zeros(0), np.zeros(0), np.zeros((0, 0)))
+        return Accuracy(
+            names=names,
+            values=values,
+            hessian=hessian,
+            cramer_rao=np.zeros(0),
+            insensitivity=np.zeros(0),
+            correlation=np.zeros((0, 0)),
+        )
     # scale to unit diagonal before inverting: parameters differ by orders of magnitude
     scale = np.where(diagonal > 0, 1.0 / np.sqrt(np.maximum(diagonal, 1e-300)), 0.0)
     scaled = hessian * scale[:, None] * scale[None, :]
@@ -133,4 +140,11 @@ def accuracy(jacobian: np.ndarray, values: np.ndarray, names: tuple[str, ...]) -
         correlation = covariance / sd[:, None] / sd[None, :]
     correlation[null, :] = np.nan
     correlation[:, null] = np.nan
-    return Accuracy(names, values, hessian, cramer_rao, insensitivity, correlation)
+    return Accuracy(
+        names=names,
+        values=values,
+        hessian=hessian,
+        cramer_rao=cramer_rao,
+        insensitivity=insensitivity,
+        correlation=correlation,
+    )

@@ -93,8 +93,8 @@ def to_statespace(model: Any, *, delays: Literal["drop", "pade"] = "drop", pade_
 
     Examples
     --------
-    >>> m = DelayedStateSpace(np.array([[-1.0]]), np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1)),
-    ...                       ("x",), ("u",), ("y",), np.array([0.1]))
+    >>> m = DelayedStateSpace(a=np.array([[-1.0]]), b=np.array([[1.0]]), c=np.array([[1.0]]), d=np.zeros((1, 1)),
+    ...                       states=("x",), inputs=("u",), outputs=("y",), input_delays_s=np.array([0.1]))
     >>> sys = to_statespace(m, delays="pade", pade_order=2)
     >>> sys.nstates, sys.input_labels
     (3, ['u'])
@@ -128,12 +128,12 @@ def from_statespace(system: control.StateSpace, input_delays_s: np.ndarray | Non
     n_u = system.ninputs
     delays = np.zeros(n_u) if input_delays_s is None else np.asarray(input_delays_s, dtype=float)
     return DelayedStateSpace(
-        np.asarray(system.A),
-        np.asarray(system.B),
-        np.asarray(system.C),
-        np.asarray(system.D),
-        tuple(system.state_labels),
-        tuple(system.input_labels),
-        tuple(system.output_labels),
-        delays,
+        a=np.asarray(system.A),
+        b=np.asarray(system.B),
+        c=np.asarray(system.C),
+        d=np.asarray(system.D),
+        states=tuple(system.state_labels),
+        inputs=tuple(system.input_labels),
+        outputs=tuple(system.output_labels),
+        input_delays_s=delays,
     )

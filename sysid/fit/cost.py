@@ -32,7 +32,7 @@ _DB = 20.0 / np.log(10.0)  # dB per neper
 _DEG = 180.0 / np.pi
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class CostWeights:
     """Weights of eq. 3.9 (Tischler's standard values).
 
@@ -60,7 +60,7 @@ class CostWeights:
             raise ValueError(f"weights magnitude={self.magnitude}, phase={self.phase} must be >= 0, not both 0")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class CostSummary:
     """Cost of a fit: J_ave and the cost of each response pair.
 
@@ -84,7 +84,7 @@ class CostSummary:
         return float(sum(self.responses.values()))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FitPoints:
     """The measured responses sampled at the cost's frequency points, stacked.
 
@@ -172,13 +172,13 @@ def fit_points(responses: Sequence[FrequencyResponse], *, weights: CostWeights =
         name = fr.pair
         pairs.append(name if name not in pairs else f"{name}#{pairs.count(name) + 1}")
     return FitPoints(
-        tuple(pairs),
-        tuple(fr.input for fr in responses),
-        tuple(fr.output for fr in responses),
-        np.concatenate(omega),
-        np.concatenate(index),
-        np.concatenate(log_meas),
-        np.concatenate(weight),
+        pairs=tuple(pairs),
+        inputs=tuple(fr.input for fr in responses),
+        outputs=tuple(fr.output for fr in responses),
+        omega=np.concatenate(omega),
+        response=np.concatenate(index),
+        log_measured=np.concatenate(log_meas),
+        weight=np.concatenate(weight),
     )
 
 
@@ -326,4 +326,4 @@ class ResponseModel:
         n = self.points.omega.size
         per_point = r[:n] ** 2 + r[n:] ** 2
         per_pair = np.bincount(self.points.response, weights=per_point, minlength=len(self.points.pairs))
-        return CostSummary(float(per_pair.mean()), dict(zip(self.points.pairs, per_pair.tolist())))
+        return CostSummary(average=float(per_pair.mean()), responses=dict(zip(self.points.pairs, per_pair.tolist())))

@@ -35,7 +35,7 @@ __all__ = ["FitOptions", "FrequencyFit", "fit_frequency_responses"]
 Status = Literal["estimated", "fixed", "dropped"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FitOptions:
     """Choices of the frequency-response fit; defaults follow Tischler and the dissertation.
 
@@ -92,7 +92,7 @@ class FitOptions:
             raise ValueError(f"jacobian={self.jacobian!r} must be 'analytic' or 'numeric'")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FrequencyFit:
     """Result of :func:`fit_frequency_responses`.
 
@@ -183,15 +183,15 @@ def fit_frequency_responses(
     values, evaluations = search.first_fit(values, status)
     values, status, acc, cost, steps, spent = _reduce(search, values, status)
     return FrequencyFit(
-        structure,
-        MappingProxyType(dict(values)),
-        MappingProxyType(dict(status)),
-        acc,
-        cost,
-        tuple(steps),
-        MappingProxyType(consts),
-        used,
-        evaluations + spent,
+        structure=structure,
+        values=MappingProxyType(dict(values)),
+        status=MappingProxyType(dict(status)),
+        accuracy=acc,
+        cost=cost,
+        reduction=tuple(steps),
+        constants=MappingProxyType(consts),
+        responses=used,
+        evaluations=evaluations + spent,
     )
 
 
@@ -267,15 +267,15 @@ def _remove(
     else:
         status[name] = "fixed"
     return ReductionStep(
-        step,
-        name,
-        "dropped" if parameter.reduce == "drop" else "fixed",
-        values[name],
-        estimate,
-        float(acc.cramer_rao_percent[k]),
-        float(acc.insensitivity_percent[k]),
-        reason,
-        cost_average,
+        step=step,
+        parameter=name,
+        action="dropped" if parameter.reduce == "drop" else "fixed",
+        value=values[name],
+        estimate=estimate,
+        cr_percent=float(acc.cramer_rao_percent[k]),
+        insensitivity_percent=float(acc.insensitivity_percent[k]),
+        reason=reason,
+        cost_average=cost_average,
     )
 
 

@@ -56,7 +56,7 @@ _AXES = ("lat", "lon", "yaw", "thr")
 Progress = Callable[[str, int, int], None]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class IdentifyOptions:
     """Choices of the whole identification.
 
@@ -308,11 +308,11 @@ def _provenance(files: Sequence[str | Path], options: IdentifyOptions) -> Proven
             versions[package] = "unknown"
     paths = [str(p) for p in files]
     return Provenance(
-        tuple(paths),
-        {p: file_sha256(p) for p in paths},
-        _jsonable(options),
-        versions,
-        datetime.now(UTC).isoformat(timespec="seconds"),
+        files=tuple(paths),
+        sha256={p: file_sha256(p) for p in paths},
+        options=_jsonable(options),
+        versions=versions,
+        created_utc=datetime.now(UTC).isoformat(timespec="seconds"),
     )
 
 
@@ -365,28 +365,28 @@ def model_from_fit(
             status, value, stage = "dropped", p.drop_value, "wind"
             reduction.append(
                 ReductionStep(
-                    len(reduction) + 1,
-                    p.name,
-                    "dropped",
-                    value,
-                    math.nan,
-                    math.nan,
-                    math.nan,
-                    "no wind record to fit it",
-                    fit.cost.average,
-                    fit.cost.average,
+                    step=len(reduction) + 1,
+                    parameter=p.name,
+                    action="dropped",
+                    value=value,
+                    estimate=math.nan,
+                    cr_percent=math.nan,
+                    insensitivity_percent=math.nan,
+                    reason="no wind record to fit it",
+                    cost_average=fit.cost.average,
+                    cost_average_after=fit.cost.average,
                 )
             )
         estimated = status == "estimated"
         estimates.append(
             ParameterEstimate(
-                p.name,
-                float(value),
-                cr[p.name] if estimated else math.nan,
-                ins[p.name] if estimated else math.nan,
-                status,
-                unit,
-                stage,
+                name=p.name,
+                value=float(value),
+                cr_percent=cr[p.name] if estimated else math.nan,
+                insensitivity_percent=ins[p.name] if estimated else math.nan,
+                status=status,
+                unit=unit,
+                stage=stage,
             )
         )  # type: ignore[arg-type]
     reduction = [dataclasses.replace(step, step=k + 1) for k, step in enumerate(reduction)]
@@ -394,18 +394,18 @@ def model_from_fit(
     blocks = [fit.accuracy.correlation] + ([wind.accuracy.correlation] if wind is not None else [])
     correlation = linalg.block_diag(*blocks) if names else np.zeros((0, 0))
     return IdentifiedModel(
-        structure.name,
-        structure.text,
-        tuple(estimates),
-        names,
-        correlation.reshape(len(names), len(names)),
-        fit.cost,
-        fit.responses,
-        MappingProxyType(dict(trim or {})),
-        fit.constants,
-        tuple(reduction),
-        provenance,
-        None if wind is None else wind.fit,
-        units,
-        tuple(notes),
+        structure_name=structure.name,
+        structure_text=structure.text,
+        parameters=tuple(estimates),
+        correlation_names=names,
+        correlation=correlation.reshape(len(names), len(names)),
+        cost=fit.cost,
+        responses=fit.responses,
+        trim=MappingProxyType(dict(trim or {})),
+        constants=fit.constants,
+        reduction=tuple(reduction),
+        provenance=provenance,
+        wind=None if wind is None else wind.fit,
+        input_units=units,
+        notes=tuple(notes),
     )

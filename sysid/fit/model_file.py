@@ -195,20 +195,20 @@ def _response_from_dict(d: Mapping[str, Any], f: _Fields, where: str) -> Frequen
     windows = f.numbers(d, "windows_s", where, finite=True)
     try:
         return FrequencyResponse(
-            f.get(d, "input", where, str),
-            f.get(d, "output", where, str),
-            f.numbers(d, "omega", where),
-            f.numbers(d, "response_real", where) + 1j * f.numbers(d, "response_imag", where),
-            f.numbers(d, "coherence", where),
-            f.numbers(d, "random_error", where),
-            f.numbers(d, "input_autospectrum", where),
-            f.numbers(d, "output_autospectrum", where),
-            f.numbers(d, "cross_spectrum_real", where) + 1j * f.numbers(d, "cross_spectrum_imag", where),
-            tuple(float(v) for v in windows),
-            tuple(f.get(d, "conditioned_on", where, list, [])),
-            f.get(d, "input_unit", where, str, ""),
-            f.get(d, "output_unit", where, str, ""),
-            None if fit_range is None else (float(fit_range[0]), float(fit_range[1])),
+            input=f.get(d, "input", where, str),
+            output=f.get(d, "output", where, str),
+            omega=f.numbers(d, "omega", where),
+            response=f.numbers(d, "response_real", where) + 1j * f.numbers(d, "response_imag", where),
+            coherence=f.numbers(d, "coherence", where),
+            random_error=f.numbers(d, "random_error", where),
+            input_autospectrum=f.numbers(d, "input_autospectrum", where),
+            output_autospectrum=f.numbers(d, "output_autospectrum", where),
+            cross_spectrum=f.numbers(d, "cross_spectrum_real", where) + 1j * f.numbers(d, "cross_spectrum_imag", where),
+            windows_s=tuple(float(v) for v in windows),
+            conditioned_on=tuple(f.get(d, "conditioned_on", where, list, [])),
+            input_unit=f.get(d, "input_unit", where, str, ""),
+            output_unit=f.get(d, "output_unit", where, str, ""),
+            fit_range=None if fit_range is None else (float(fit_range[0]), float(fit_range[1])),
             reference=f.get(d, "reference", where, object, None),
             whole_record=bool(f.get(d, "whole_record", where, bool, False)),
         )
@@ -228,13 +228,13 @@ def _parameters(doc: Mapping[str, Any], f: _Fields) -> tuple[ParameterEstimate, 
             raise f.fail(f"{where}: stage is {stage!r}, not frequency or wind")
         out.append(
             ParameterEstimate(
-                name,
-                f.number(p, "value", where, finite=True),
-                f.number(p, "cr_percent", where),
-                f.number(p, "insensitivity_percent", where),
-                status,  # type: ignore[arg-type]
-                f.get(p, "unit", where, str, ""),
-                stage,
+                name=name,
+                value=f.number(p, "value", where, finite=True),
+                cr_percent=f.number(p, "cr_percent", where),
+                insensitivity_percent=f.number(p, "insensitivity_percent", where),
+                status=status,  # type: ignore[arg-type]
+                unit=f.get(p, "unit", where, str, ""),
+                stage=stage,
             )
         )  # type: ignore[arg-type]
     return tuple(out)
@@ -270,16 +270,16 @@ def _reduction(doc: Mapping[str, Any], f: _Fields) -> tuple[ReductionStep, ...]:
         }
         steps.append(
             ReductionStep(
-                f.get(s, "step", where, int),
-                f.get(s, "parameter", where, str),
-                f.get(s, "action", where, str),
-                n["value"],
-                n["estimate"],
-                n["cr_percent"],
-                n["insensitivity_percent"],
-                f.get(s, "reason", where, str),
-                n["cost_average"],
-                n["cost_average_after"],
+                step=f.get(s, "step", where, int),
+                parameter=f.get(s, "parameter", where, str),
+                action=f.get(s, "action", where, str),
+                value=n["value"],
+                estimate=n["estimate"],
+                cr_percent=n["cr_percent"],
+                insensitivity_percent=n["insensitivity_percent"],
+                reason=f.get(s, "reason", where, str),
+                cost_average=n["cost_average"],
+                cost_average_after=n["cost_average_after"],
             )
         )
     return tuple(steps)
@@ -294,7 +294,10 @@ def _wind(doc: Mapping[str, Any], f: _Fields) -> WindFit | None:
     if not len(outputs) == len(before) == len(after):
         raise f.fail("wind: outputs, rms_before and rms_after differ in length")
     return WindFit(
-        outputs, tuple(float(v) for v in before), tuple(float(v) for v in after), f.get(wind, "samples", "wind", int)
+        outputs=outputs,
+        rms_before=tuple(float(v) for v in before),
+        rms_after=tuple(float(v) for v in after),
+        samples=f.get(wind, "samples", "wind", int),
     )
 
 
@@ -332,29 +335,29 @@ def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Identi
     names, matrix = _correlation(doc, f)
     try:
         model = IdentifiedModel(
-            f.get(head, "name", "structure", str),
-            f.get(head, "text", "structure", str),
-            _parameters(doc, f),
-            names,
-            matrix,
-            CostSummary(f.number(cost, "average", "cost"), f.table(cost, "responses", "cost")),
-            tuple(
+            structure_name=f.get(head, "name", "structure", str),
+            structure_text=f.get(head, "text", "structure", str),
+            parameters=_parameters(doc, f),
+            correlation_names=names,
+            correlation=matrix,
+            cost=CostSummary(average=f.number(cost, "average", "cost"), responses=f.table(cost, "responses", "cost")),
+            responses=tuple(
                 _response_from_dict(r, f, f"response {k + 1}")
                 for k, r in enumerate(f.get(doc, "responses", "the file", list, []))
             ),
-            f.table(doc, "trim", "the file"),
-            f.table(doc, "constants", "the file", finite=True),
-            _reduction(doc, f),
-            Provenance(
-                tuple(f.get(prov, "files", "provenance", list, [])),
-                f.get(prov, "sha256", "provenance", dict, {}),
-                f.get(prov, "options", "provenance", dict, {}),
-                f.get(prov, "versions", "provenance", dict, {}),
-                f.get(prov, "created_utc", "provenance", str, ""),
+            trim=f.table(doc, "trim", "the file"),
+            constants=f.table(doc, "constants", "the file", finite=True),
+            reduction=_reduction(doc, f),
+            provenance=Provenance(
+                files=tuple(f.get(prov, "files", "provenance", list, [])),
+                sha256=f.get(prov, "sha256", "provenance", dict, {}),
+                options=f.get(prov, "options", "provenance", dict, {}),
+                versions=f.get(prov, "versions", "provenance", dict, {}),
+                created_utc=f.get(prov, "created_utc", "provenance", str, ""),
             ),
-            _wind(doc, f),
-            dict(f.get(doc, "input_units", "the file", dict, {})),
-            tuple(f.get(doc, "notes", "the file", list, [])),
+            wind=_wind(doc, f),
+            input_units=dict(f.get(doc, "input_units", "the file", dict, {})),
+            notes=tuple(f.get(doc, "notes", "the file", list, [])),
         )
     except (TypeError, ValueError) as err:
         if isinstance(err, ModelError):

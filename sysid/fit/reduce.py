@@ -33,7 +33,7 @@ from sysid.fit.accuracy import Accuracy
 __all__ = ["ReductionStep", "worst_parameter"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ReductionStep:
     """One parameter removed by structure reduction.
 

@@ -22,7 +22,7 @@ from sysid.model.toml_format import parse_structure
 __all__ = ["ParameterEstimate", "WindFit", "Provenance", "IdentifiedModel"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ParameterEstimate:
     """One parameter of an identified model.
 
@@ -77,7 +77,7 @@ class ParameterEstimate:
         return abs(self.value) * self.cr_percent / 100.0
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindFit:
     """How well the wind terms explain the one-step-prediction residual of eq. 3.14.
 
@@ -103,7 +103,7 @@ class WindFit:
             raise ValueError("outputs, rms_before and rms_after must have one entry per output")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Provenance:
     """Where an identified model came from.
 
@@ -128,7 +128,7 @@ class Provenance:
     created_utc: str = ""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class IdentifiedModel:
     """A fitted model structure with everything needed to use, judge and re-plot it.
 

@@ -58,8 +58,8 @@ def synthetic_responses(
 
     Examples
     --------
-    >>> m = DelayedStateSpace(np.array([[-2.0]]), np.array([[2.0]]), np.array([[1.0]]), np.zeros((1, 1)),
-    ...                       ("p",), ("delta_lat",), ("p",), np.array([0.0]))
+    >>> m = DelayedStateSpace(a=np.array([[-2.0]]), b=np.array([[2.0]]), c=np.array([[1.0]]), d=np.zeros((1, 1)),
+    ...                       states=("p",), inputs=("delta_lat",), outputs=("p",), input_delays_s=np.array([0.0]))
     >>> fr, = synthetic_responses(m, ["p/delta_lat"], omega=np.array([0.5, 2.0]))
     >>> np.round(np.abs(fr.response), 3)
     array([0.97 , 0.707])
@@ -84,16 +84,16 @@ def synthetic_responses(
         span = fit_range.get(pair, (1.0, 40.0)) if isinstance(fit_range, Mapping) else fit_range
         found.append(
             FrequencyResponse(
-                signal,
-                output,
-                omega,
-                response,
-                gamma2,
-                error,
-                auto,
-                np.abs(response) ** 2,
-                response,
-                (10.0,),
+                input=signal,
+                output=output,
+                omega=omega,
+                response=response,
+                coherence=gamma2,
+                random_error=error,
+                input_autospectrum=auto,
+                output_autospectrum=np.abs(response) ** 2,
+                cross_spectrum=response,
+                windows_s=(10.0,),
                 fit_range=(float(span[0]), float(span[1])),
             )
         )

@@ -46,7 +46,7 @@ __all__ = ["WindStepResult", "fit_wind"]
 _SCAN_STEP_S = 0.002
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindStepResult:
     """Wind parameters from the residual of eq. 3.14.
 
@@ -73,7 +73,7 @@ class WindStepResult:
     reduction: tuple[ReductionStep, ...] = ()
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class _Data:
     """Eq. 3.14 residuals and wind signals of the records, with output weights."""
 
@@ -110,7 +110,7 @@ def _prediction_data(
         winds.append(np.column_stack([record[s] for s in signals]))
         times.append(record.time_s)
     scale = 1.0 / np.maximum(np.vstack(residual).std(axis=0), 1e-12)
-    return _Data(residual, winds, times, rows, scale)
+    return _Data(residual=residual, winds=winds, times=times, rows=rows, scale=scale)
 
 
 def _states(
@@ -372,26 +372,30 @@ def fit_wind(
         parameter = structure.parameter(name)
         steps.append(
             ReductionStep(
-                len(steps) + 1,
-                name,
-                "dropped",
-                parameter.drop_value,
-                current[name],
-                float(acc.cramer_rao_percent[k]),
-                float(acc.insensitivity_percent[k]),
-                reason + " (wind step)",
-                cost,
+                step=len(steps) + 1,
+                parameter=name,
+                action="dropped",
+                value=parameter.drop_value,
+                estimate=current[name],
+                cr_percent=float(acc.cramer_rao_percent[k]),
+                insensitivity_percent=float(acc.insensitivity_percent[k]),
+                reason=reason + " (wind step)",
+                cost_average=cost,
             )
         )
         current[name], status[name] = parameter.drop_value, "dropped"
     rms_before = np.sqrt(np.mean(np.vstack(data.residual) ** 2, axis=0))
     rms_after = np.sqrt(np.mean(np.vstack(after) ** 2, axis=0))
     fit = WindFit(
-        tuple(outputs),
-        tuple(float(v) for v in rms_before),
-        tuple(float(v) for v in rms_after),
-        int(sum(a.shape[0] for a in after)),
+        outputs=tuple(outputs),
+        rms_before=tuple(float(v) for v in rms_before),
+        rms_after=tuple(float(v) for v in rms_after),
+        samples=int(sum(a.shape[0] for a in after)),
     )
     return WindStepResult(
-        MappingProxyType({n: current[n] for n in names}), MappingProxyType(status), acc, fit, tuple(steps)
+        values=MappingProxyType({n: current[n] for n in names}),
+        status=MappingProxyType(status),
+        accuracy=acc,
+        fit=fit,
+        reduction=tuple(steps),
     )

@@ -40,7 +40,7 @@ from sysid.freqresp._whole import significance_threshold
 __all__: list[str] = []
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class PairEstimate:
     """Composite estimate of one output's response to one input, arrays of shape (n_freq,)."""
 

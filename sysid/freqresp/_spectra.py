@@ -24,7 +24,7 @@ from scipy import signal as sps
 __all__: list[str] = []
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindowSpectra:
     """Spectral matrix of all channels for one window length.
 
@@ -96,7 +96,9 @@ def window_spectra(
     spectra = np.zeros((omega.size, n_channels, n_channels), dtype=complex)
     spectra[used] = np.conj(x) @ x.transpose(0, 2, 1)
     spectra *= dt / (np.pi * float(np.sum(taper_values**2)) * n_windows)
-    return WindowSpectra(window_s, spectra, n_windows, n_effective, omega_low)
+    return WindowSpectra(
+        window_s=window_s, spectra=spectra, n_windows=n_windows, n_effective=n_effective, omega_low=omega_low
+    )
 
 
 def _matrix_dft(flat: np.ndarray, dt: float, taper: np.ndarray, omega: np.ndarray) -> np.ndarray:

@@ -97,7 +97,14 @@ def whole_record_spectra(
     bin_rad_s = 2.0 * np.pi / min(lengths_s)
     dof = _smooth_noise(spectra, omega, valid, inputs, outputs, instrument, n_records, bin_rad_s)
     spectra[~valid] = 0.0
-    return WindowSpectra(max(lengths_s), spectra, n_records, float(n_records), omega_low, noise_dof=dof)
+    return WindowSpectra(
+        window_s=max(lengths_s),
+        spectra=spectra,
+        n_windows=n_records,
+        n_effective=float(n_records),
+        omega_low=omega_low,
+        noise_dof=dof,
+    )
 
 
 def significance_threshold(noise_dof: np.ndarray, level: float = SIGNIFICANCE) -> np.ndarray:

@@ -15,7 +15,7 @@ __all__ = ["DroppedResponse", "GatingResult", "gate_responses", "fit_range"]
 BRIDGE_DECADES = 0.05
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class DroppedResponse:
     """A response left out of the fit, and why.
 
@@ -39,7 +39,7 @@ class DroppedResponse:
         return f"{self.output}/{self.input}"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class GatingResult:
     """Responses kept (with their fit range set) and those dropped.
 
@@ -120,8 +120,10 @@ def gate_responses(
     --------
     >>> omega = np.geomspace(1.0, 10.0, 11)
     >>> gamma2 = np.where(omega < 4.0, 0.9, 0.2)
-    >>> h = FrequencyResponse("delta_lon", "q", omega, np.ones(11, complex), gamma2, np.zeros(11),
-    ...                       np.ones(11), np.ones(11), np.ones(11, complex), (2.0,))
+    >>> h = FrequencyResponse(input="delta_lon", output="q", omega=omega, response=np.ones(11, complex),
+    ...                       coherence=gamma2, random_error=np.zeros(11),
+    ...                       input_autospectrum=np.ones(11), output_autospectrum=np.ones(11),
+    ...                       cross_spectrum=np.ones(11, complex), windows_s=(2.0,))
     >>> result = gate_responses([h])
     >>> result.kept[0].fit_range
     (1.0, 3.981071705534973)
@@ -140,9 +142,9 @@ def gate_responses(
             best = float(np.nanmax(response.coherence)) if np.any(np.isfinite(response.coherence)) else 0.0
             dropped.append(
                 DroppedResponse(
-                    response.input,
-                    response.output,
-                    f"{response.pair}: coherence never reaches {min_coherence:g} (at most {best:.2f}).",
+                    input=response.input,
+                    output=response.output,
+                    reason=f"{response.pair}: coherence never reaches {min_coherence:g} (at most {best:.2f}).",
                 )
             )
             continue
@@ -150,13 +152,13 @@ def gate_responses(
         if decades < min_decades:
             dropped.append(
                 DroppedResponse(
-                    response.input,
-                    response.output,
-                    f"{response.pair}: coherence reaches {min_coherence:g} over only "
+                    input=response.input,
+                    output=response.output,
+                    reason=f"{response.pair}: coherence reaches {min_coherence:g} over only "
                     f"{decades:.2f} decade ({span[0]:.3g}-{span[1]:.3g} rad/s), less than "
                     f"the {min_decades:g} decade required.",
                 )
             )
             continue
         kept.append(replace(response, fit_range=span))
-    return GatingResult(tuple(kept), tuple(dropped))
+    return GatingResult(kept=tuple(kept), dropped=tuple(dropped))

@@ -63,8 +63,10 @@ def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) ->
     --------
     >>> import tempfile
     >>> omega = np.array([1.0, 2.0])
-    >>> h = FrequencyResponse("delta_lon", "q", omega, np.array([1 + 1j, 2j]), np.array([0.9, 0.8]),
-    ...                       np.array([0.01, 0.02]), np.ones(2), np.ones(2), np.ones(2, complex), (4.0,),
+    >>> h = FrequencyResponse(input="delta_lon", output="q", omega=omega, response=np.array([1 + 1j, 2j]),
+    ...                       coherence=np.array([0.9, 0.8]), random_error=np.array([0.01, 0.02]),
+    ...                       input_autospectrum=np.ones(2), output_autospectrum=np.ones(2),
+    ...                       cross_spectrum=np.ones(2, complex), windows_s=(4.0,),
     ...                       input_unit="%", output_unit="rad/s")
     >>> target = Path(tempfile.mkdtemp()) / "fr.h5"
     >>> write_responses(target, [h])

@@ -11,7 +11,7 @@ from scipy import signal as sps
 __all__ = ["ResponseOptions"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ResponseOptions:
     """How :func:`~sysid.freqresp.frequency_responses` computes and gates responses.
 

@@ -154,7 +154,7 @@ def default_pairs(flights: Sequence[ConditionedFlight], *, kind: str = "sweep") 
     return tuple(pairs)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FlightResponses:
     """Responses computed from flights, with what they were computed on.
 
@@ -248,7 +248,9 @@ def flight_responses(
         for response in frequency_responses(records, inputs, outputs, chosen_options):
             found[(response.output, response.input)] = response
         pieces[group_axis] = len(records)
-    return FlightResponses(tuple(found[pair] for pair in chosen), MappingProxyType(pieces), tuple(notes))
+    return FlightResponses(
+        responses=tuple(found[pair] for pair in chosen), pieces=MappingProxyType(pieces), notes=tuple(notes)
+    )
 
 
 def reference_options(

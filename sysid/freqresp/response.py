@@ -9,7 +9,7 @@ import numpy as np
 __all__ = ["FrequencyResponse"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FrequencyResponse:
     """One input-to-output frequency response with its quality measures.
 

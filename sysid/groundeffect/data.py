@@ -95,7 +95,9 @@ def rig_thrust_ratio(
             f"{median:.3g}, far from 1 out of ground effect; check F0 (--f0) and the thrust unit "
             f"(median thrust {float(np.median(thrust)):.4g} N)"
         )
-    return ThrustRatioData(x, ratio, rotor_radius_m, source, how, f0)
+    return ThrustRatioData(
+        height_ratio=x, thrust_ratio=ratio, rotor_radius_m=rotor_radius_m, source=source, f0_source=how, f0_n=f0
+    )
 
 
 def load_thrust_ratio(

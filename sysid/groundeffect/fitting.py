@@ -57,7 +57,7 @@ __all__ = ["FitConfig", "fit_ground_effect", "fit_model"]
 _GRID = 400
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FitConfig:
     """Which families to fit and how to choose among them.
 
@@ -108,7 +108,7 @@ def fit_ground_effect(data: ThrustRatioData, config: FitConfig | None = None) ->
     --------
     >>> x = np.linspace(1.2, 9.0, 30)
     >>> y = formulas.piecewise_linear(x, -0.0373, 1.1651, 4.42) + 0.002 * np.sin(7 * x)
-    >>> fit = fit_ground_effect(ThrustRatioData(x, y, rotor_radius_m=0.0225))
+    >>> fit = fit_ground_effect(ThrustRatioData(height_ratio=x, thrust_ratio=y, rotor_radius_m=0.0225))
     >>> fit.best, round(fit.model("piecewise_linear").params["slope"], 3)
     ('piecewise_linear', -0.037)
     """
@@ -129,7 +129,7 @@ def fit_ground_effect(data: ThrustRatioData, config: FitConfig | None = None) ->
             f"to compare {', '.join(config.models)}"
         )
     best = fits[int(np.argmin(scores))].name
-    return GroundEffectFit(data, fits, best, config.criterion, config.confidence)
+    return GroundEffectFit(data=data, models=fits, best=best, criterion=config.criterion, confidence=config.confidence)
 
 
 def fit_model(name: str, height_ratio: np.ndarray, thrust_ratio: np.ndarray, *, confidence: float = 0.95) -> ModelFit:

@@ -82,11 +82,19 @@ def flight_thrust_ratio(log: FlightLog, config: GroundEffectDataConfig) -> Thrus
     ]
     if not kept:
         raise DataError(f"{log.path.name}: no hover step with plausible F/F0 ({'; '.join(dropped)})")
-    found = HoverSteps(block_t, block_z, tuple(kept), tuple(dropped))
+    found = HoverSteps(time_s=block_t, height_m=block_z, steps=tuple(kept), dropped=tuple(dropped))
     x = np.array([s.height_m for s in kept]) / config.rotor_radius_m
     ratio = np.array([s.thrust_ratio for s in kept])
     f0_source = f"eq. 2.6 with k_f = {config.kf_n_per_count:.4g} N per count{unit_note}; F = {how}"
-    return ThrustRatioData(x, ratio, config.rotor_radius_m, log.path.name, f0_source, None, found)
+    return ThrustRatioData(
+        height_ratio=x,
+        thrust_ratio=ratio,
+        rotor_radius_m=config.rotor_radius_m,
+        source=log.path.name,
+        f0_source=f0_source,
+        f0_n=None,
+        steps=found,
+    )
 
 
 def plateaus(
@@ -218,7 +226,15 @@ def _steps(
         rate = float(np.polyfit(t - t.mean(), h, 1)[0])
         steps.append(
             HoverStep(
-                start, end, middle, float(np.mean(h)), float(np.std(h)), rate, float(np.mean(f)), math.nan, int(t.size)
+                start_s=start,
+                end_s=end,
+                steady_start_s=middle,
+                height_m=float(np.mean(h)),
+                height_std_m=float(np.std(h)),
+                climb_rate_m_s=rate,
+                f0_n=float(np.mean(f)),
+                thrust_ratio=math.nan,
+                samples=int(t.size),
             )
         )
     return steps, dropped
@@ -241,13 +257,13 @@ def _weight(log: FlightLog, steps: list[HoverStep], config: GroundEffectDataConf
 
 def _with_ratio(step: HoverStep, weight_n: float) -> HoverStep:
     return HoverStep(
-        step.start_s,
-        step.end_s,
-        step.steady_start_s,
-        step.height_m,
-        step.height_std_m,
-        step.climb_rate_m_s,
-        step.f0_n,
-        weight_n / step.f0_n,
-        step.samples,
+        start_s=step.start_s,
+        end_s=step.end_s,
+        steady_start_s=step.steady_start_s,
+        height_m=step.height_m,
+        height_std_m=step.height_std_m,
+        climb_rate_m_s=step.climb_rate_m_s,
+        f0_n=step.f0_n,
+        thrust_ratio=weight_n / step.f0_n,
+        samples=step.samples,
     )

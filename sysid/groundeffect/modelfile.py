@@ -31,7 +31,7 @@ MODEL_FILE_FORMAT = "flight-sysid ground-effect model"
 _VERSION = 1
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FittedGroundEffect:
     """A ground-effect law with fitted values: F/F0 as a function of Z/R.
 
@@ -110,12 +110,12 @@ class FittedGroundEffect:
         """
         best = fit.model(fit.best)
         return cls(
-            best.name,
-            best.param_names,
-            best.values,
-            fit.data.rotor_radius_m,
-            float(fit.data.height_ratio.min()),
-            fit.data.source,
+            model=best.name,
+            param_names=best.param_names,
+            values=best.values,
+            rotor_radius_m=fit.data.rotor_radius_m,
+            min_height_ratio=float(fit.data.height_ratio.min()),
+            source=fit.data.source,
         )
 
 
@@ -230,7 +230,8 @@ def read_ground_effect_model(path: str | Path) -> FittedGroundEffect:
     >>> import tempfile, pathlib
     >>> from sysid.groundeffect import ThrustRatioData, fit_ground_effect
     >>> x = np.linspace(1.2, 9.0, 20)
-    >>> fit = fit_ground_effect(ThrustRatioData(x, evaluate_model("corrected", [3.0], x), 0.0225))
+    >>> data = ThrustRatioData(height_ratio=x, thrust_ratio=evaluate_model("corrected", [3.0], x), rotor_radius_m=0.0225)
+    >>> fit = fit_ground_effect(data)
     >>> target = write_ground_effect_model(fit, pathlib.Path(tempfile.mkdtemp()) / "ge.json")
     >>> model = read_ground_effect_model(target)
     >>> model.model, round(float(model.ratio(np.array(2.0))), 4)
@@ -270,7 +271,12 @@ def read_ground_effect_model(path: str | Path) -> FittedGroundEffect:
     lowest = _number(path, document, "min_height_ratio", "", default=0.0)
     try:
         return FittedGroundEffect(
-            model, PARAMETER_NAMES[model], np.array(values), radius, lowest, str(document.get("source", ""))
+            model=model,
+            param_names=PARAMETER_NAMES[model],
+            values=np.array(values),
+            rotor_radius_m=radius,
+            min_height_ratio=lowest,
+            source=str(document.get("source", "")),
         )
     except ModelError as err:
         raise ModelError(f"{path}: {err}") from None

@@ -73,7 +73,7 @@ def evaluate_model(name: str, values: Sequence[float] | np.ndarray, height_ratio
     return _LAWS[name](np.asarray(height_ratio, dtype=np.float64), *p)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ModelFit:
     """One family fitted to F/F0 against Z/R.
 
@@ -169,7 +169,7 @@ class ModelFit:
         return self.aicc if which == "aicc" else self.bic
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class GroundEffectFit:
     """Every family fitted to one data set, and the one chosen.
 

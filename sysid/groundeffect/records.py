@@ -16,7 +16,7 @@ from flightlogs.errors import DataError
 __all__ = ["HoverStep", "HoverSteps", "ThrustRatioData", "GroundEffectDataConfig"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class HoverStep:
     """One hover step of a flight log, and F/F0 over its steady (second) half.
 
@@ -55,7 +55,7 @@ class HoverStep:
             raise ValueError(f"step times {self.start_s} <= {self.steady_start_s} < {self.end_s} violated")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class HoverSteps:
     """Hover steps found in a flight log, with the height trace they were found on.
 
@@ -87,7 +87,7 @@ class HoverSteps:
         object.__setattr__(self, "dropped", tuple(self.dropped))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ThrustRatioData:
     """Points of thrust ratio F/F0 against height ratio Z/R, ready to fit.
 
@@ -137,7 +137,7 @@ class ThrustRatioData:
         return int(self.height_ratio.size)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class GroundEffectDataConfig:
     """How to turn a rig CSV or a flight log into F/F0 against Z/R.
 

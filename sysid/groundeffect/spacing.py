@@ -44,7 +44,7 @@ def default_families(rotors: int) -> tuple[ModelName, ...]:
     return ("corrected",) if rotors <= 2 else ("piecewise_linear", "corrected")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class SpacingStudy:
     """Fits over a series of rotor spacings, the family chosen at each and the transition.
 
@@ -180,7 +180,7 @@ def spacing_study(
     compared = families or default_families(rotors)
     base = config or FitConfig()
     models = tuple(m for m in MODEL_NAMES if m in base.models or m in compared)
-    fit_config = FitConfig(models, base.criterion, base.confidence)
+    fit_config = FitConfig(models=models, criterion=base.criterion, confidence=base.confidence)
     order = np.argsort(spacings)
     fits = []
     for done, i in enumerate(order, 1):
@@ -189,7 +189,12 @@ def spacing_study(
             progress(done, len(order))
     chosen = tuple(min(compared, key=lambda name: fit.model(name).criterion(fit_config.criterion)) for fit in fits)
     return SpacingStudy(
-        spacings[order], tuple(fits), tuple(compared), chosen, _transition(spacings[order], chosen, compared), rotors
+        spacings_m=spacings[order],
+        fits=tuple(fits),
+        families=tuple(compared),
+        chosen=chosen,
+        transition_m=_transition(spacings[order], chosen, compared),
+        rotors=rotors,
     )
 
 

@@ -24,7 +24,7 @@ __all__ = ["SystemMatrices", "Assembler", "structure_model"]
 _STEP = 1e-30  # complex step
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class SystemMatrices:
     """``A, B, C, D`` and input delays, or their derivatives stacked on a leading parameter axis.
 
@@ -166,7 +166,7 @@ class Assembler:
         env = self.environment(theta)
         delays = np.array([float(np.real(c.delay(env))) for c in self.channels])
         a, b = self._solve_m(raw["M"], raw["F"]), self._solve_m(raw["M"], raw["G"])
-        return SystemMatrices(a, b, raw["H0"] + raw["H1"] @ a, raw["H1"] @ b, delays)
+        return SystemMatrices(a=a, b=b, c=raw["H0"] + raw["H1"] @ a, d=raw["H1"] @ b, delays=delays)
 
     def derivatives(self, theta: np.ndarray, base: SystemMatrices | None = None) -> SystemMatrices:
         """Derivatives of ``A, B, C, D`` and delays with respect to each free parameter.
@@ -202,7 +202,7 @@ class Assembler:
             d_b[k] = self._solve_m(raw["M"], dm["G"] - dm["M"] @ base.b)
             d_c[k] = dm["H0"] + dm["H1"] @ base.a + raw["H1"] @ d_a[k]
             d_d[k] = dm["H1"] @ base.b + raw["H1"] @ d_b[k]
-        return SystemMatrices(d_a, d_b, d_c, d_d, d_tau)
+        return SystemMatrices(a=d_a, b=d_b, c=d_c, d=d_d, delays=d_tau)
 
     def state_space(self, theta: np.ndarray, *, trim: Mapping[str, float] | None = None) -> DelayedStateSpace:
         """The model at `theta` as a :class:`DelayedStateSpace` (inputs named by their signals).
@@ -224,15 +224,15 @@ class Assembler:
             bad = self.channels[int(np.argmin(m.delays))]
             raise ModelError(f"structure {self.structure.name}: delay of input {bad.name} is negative")
         return DelayedStateSpace(
-            m.a,
-            m.b,
-            m.c,
-            m.d,
-            self.structure.states,
-            tuple(c.signal for c in self.channels),
-            self.structure.outputs,
-            m.delays,
-            MappingProxyType(dict(trim or {})),
+            a=m.a,
+            b=m.b,
+            c=m.c,
+            d=m.d,
+            states=self.structure.states,
+            inputs=tuple(c.signal for c in self.channels),
+            outputs=self.structure.outputs,
+            input_delays_s=m.delays,
+            trim=MappingProxyType(dict(trim or {})),
         )
 
     def _place(self, mats: dict[str, np.ndarray], entry: Entry, value: float) -> None:

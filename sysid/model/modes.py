@@ -38,7 +38,7 @@ STATE_GROUPS: dict[str, str] = {
 _NEUTRAL = 1e-9  # |real part| below this (1/s) is neutral
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Mode:
     """One eigenvalue (a complex pair is reported once, with ``imag > 0``).
 
@@ -130,8 +130,8 @@ def modes(model: Any) -> tuple[Mode, ...]:
     Examples
     --------
     >>> a = np.array([[-0.3172, 0.0, -9.81], [0.769, 0.0, 0.0], [0.0, 1.0, 0.0]])
-    >>> m = DelayedStateSpace(a, np.zeros((3, 1)), np.eye(3), np.zeros((3, 1)), ("u", "q", "theta"),
-    ...                       ("delta_lon",), ("u", "q", "theta"), np.zeros(1))
+    >>> m = DelayedStateSpace(a=a, b=np.zeros((3, 1)), c=np.eye(3), d=np.zeros((3, 1)), states=("u", "q", "theta"),
+    ...                       inputs=("delta_lon",), outputs=("u", "q", "theta"), input_delays_s=np.zeros(1))
     >>> [(round(x.real, 3), round(x.imag, 3), x.mode, x.stability) for x in modes(m)]
     [(0.878, 1.694, 'pitch', 'unstable'), (-2.073, 0.0, 'pitch', 'stable')]
     """
@@ -177,4 +177,13 @@ def _mode(value: complex, label: str) -> Mode:
     damping = -sigma / omega_n if omega_n > 0 else math.nan
     double = math.log(2.0) / sigma if stability == "unstable" else math.inf
     half = math.log(2.0) / -sigma if stability == "stable" else math.inf
-    return Mode(float(sigma), float(value.imag), float(damping), float(omega_n), double, half, label, stability)
+    return Mode(
+        real=float(sigma),
+        imag=float(value.imag),
+        damping=float(damping),
+        natural_frequency_rad_s=float(omega_n),
+        time_to_double_s=double,
+        time_to_half_s=half,
+        mode=label,
+        stability=stability,
+    )

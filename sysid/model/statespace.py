@@ -11,7 +11,7 @@ import numpy as np
 __all__ = ["DelayedStateSpace"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class DelayedStateSpace:
     """``x' = A x + B u(t - tau)``, ``y = C x + D u(t - tau)`` with named signals.
 
@@ -61,8 +61,9 @@ class DelayedStateSpace:
 
         Examples
         --------
-        >>> model = DelayedStateSpace(np.array([[-1.0]]), np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1)),
-        ...                           ("x",), ("u",), ("y",), np.array([0.1]))
+        >>> model = DelayedStateSpace(a=np.array([[-1.0]]), b=np.array([[1.0]]), c=np.array([[1.0]]),
+        ...                           d=np.zeros((1, 1)), states=("x",), inputs=("u",), outputs=("y",),
+        ...                           input_delays_s=np.array([0.1]))
         >>> h = model.frequency_response(np.array([1.0]))[0, 0, 0]
         >>> round(float(abs(h)), 4), round(float(np.angle(h)), 4)
         (0.7071, -0.8854)

@@ -27,7 +27,7 @@ __all__ = ["Parameter", "Constant", "InputChannel", "Entry", "ModelStructure", "
 MATRICES = ("M", "F", "G_u", "G_w", "H0", "H1")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Parameter:
     """A named parameter of a structure.
 
@@ -99,7 +99,7 @@ class Constant:
     trim: str | None = None
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class InputChannel:
     """One column of ``[G_u G_w]``: a signal entering with its own delay.
 
@@ -122,7 +122,7 @@ class InputChannel:
     wind: bool = False
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Entry:
     """One non-zero matrix entry.
 
@@ -144,7 +144,7 @@ class Entry:
     expression: Expression
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ModelStructure:
     """A linear model structure of eq. 3.4 with named, bounded parameters.
 

@@ -112,7 +112,15 @@ def parse_structure(text: str, *, source: str = "<text>") -> ModelStructure:
                 "which is not an input of the structure"
             )
     structure = ModelStructure(
-        name, str(doc.get("description", "")), states, inputs, outputs, parameters, constants, entries, text
+        name=name,
+        description=str(doc.get("description", "")),
+        states=states,
+        inputs=inputs,
+        outputs=outputs,
+        parameters=parameters,
+        constants=constants,
+        entries=entries,
+        text=text,
     )
     _check_outputs(structure, source)
     return structure
@@ -212,7 +220,9 @@ def _input(item: Mapping[str, Any], source: str) -> InputChannel:
         )
     name = item["name"]
     delay = parse_expression(item.get("delay", 0.0), where=f"{source}: delay of {name}")
-    return InputChannel(name, str(item.get("signal", name)), delay, bool(item.get("wind", False)))
+    return InputChannel(
+        name=name, signal=str(item.get("signal", name)), delay=delay, wind=bool(item.get("wind", False))
+    )
 
 
 def _parameter(name: str, spec: Any, source: str) -> Parameter:
@@ -226,15 +236,15 @@ def _parameter(name: str, spec: Any, source: str) -> Parameter:
     lower, upper = spec.get("bounds", [-math.inf, math.inf])
     try:
         return Parameter(
-            name,
-            float(spec["value"]),
-            float(lower),
-            float(upper),
-            bool(spec.get("free", True)),
-            str(spec.get("unit", "")),
-            spec.get("reduce", "drop"),
-            float(spec.get("drop_value", 0.0)),
-            spec.get("input"),
+            name=name,
+            value=float(spec["value"]),
+            lower=float(lower),
+            upper=float(upper),
+            free=bool(spec.get("free", True)),
+            unit=str(spec.get("unit", "")),
+            reduce=spec.get("reduce", "drop"),
+            drop_value=float(spec.get("drop_value", 0.0)),
+            input=spec.get("input"),
         )
     except (TypeError, ValueError) as err:
         raise ModelError(f"{source}: parameter {name}: {err}") from None
@@ -281,7 +291,7 @@ def _entries(
                         f"{', '.join(columns) or 'nothing'}"
                     )
                 expression = parse_expression(text, where=f"{source}: {matrix}[{row}, {column}]")
-                entries.append(Entry(matrix, rows[row], columns[column], expression))
+                entries.append(Entry(matrix=matrix, row=rows[row], column=columns[column], expression=expression))
     return tuple(entries)
 
 

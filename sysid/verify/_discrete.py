@@ -21,7 +21,7 @@ from scipy import linalg
 from sysid.model.statespace import DelayedStateSpace
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class DiscreteModel:
     """A delayed state space discretised at one sample interval (ZOH, modified z-transform).
 
@@ -79,14 +79,14 @@ def discretize(model: DelayedStateSpace, dt_s: float) -> DiscreteModel:
             _, gamma_first = _phi_gamma(a, b[:, [j]], f * dt_s)
             gamma_prev[:, j] = (phi_rest @ gamma_first)[:, 0]
     return DiscreteModel(
-        ad,
-        gamma_now,
-        gamma_prev,
-        np.asarray(model.c, dtype=float),
-        np.asarray(model.d, dtype=float),
-        whole,
-        fraction,
-        float(dt_s),
+        ad=ad,
+        gamma_now=gamma_now,
+        gamma_prev=gamma_prev,
+        c=np.asarray(model.c, dtype=float),
+        d=np.asarray(model.d, dtype=float),
+        whole=whole,
+        fraction=fraction,
+        dt_s=float(dt_s),
     )
 
 

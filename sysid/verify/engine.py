@@ -68,7 +68,7 @@ __all__ = ["VerificationOptions", "verify_record", "verify"]
 _ANGULAR_UNITS = ("rad", "rad/s", "rad/s^2", "rad/s²")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class VerificationOptions:
     """Choices for :func:`verify_record` and :func:`verify`.
 
@@ -251,8 +251,8 @@ def verify_record(
 
     >>> import pandas as pd
     >>> from pathlib import Path
-    >>> model = DelayedStateSpace(np.array([[-2.0]]), np.array([[2.0]]), np.array([[1.0]]), np.zeros((1, 1)),
-    ...                           ("q",), ("delta_lon",), ("q",), np.array([0.0]))
+    >>> model = DelayedStateSpace(a=np.array([[-2.0]]), b=np.array([[2.0]]), c=np.array([[1.0]]), d=np.zeros((1, 1)),
+    ...                           states=("q",), inputs=("delta_lon",), outputs=("q",), input_delays_s=np.array([0.0]))
     >>> t = np.arange(200) * 0.01
     >>> step = (t >= 0.5).astype(float)
     >>> table = pd.DataFrame({"delta_lon": step, "q": 0.1 + step * (1 - np.exp(-2 * (t - 0.5)))}, index=t)
@@ -304,20 +304,20 @@ def verify_record(
         )
     off_axis = tuple(o.name for j, o in enumerate(results) if j not in judged)
     return RecordVerification(
-        record.label,
-        record.source,
-        record.time_s,
-        tuple(model.inputs),
-        results,
-        shifts,
-        rmse,
-        tic,
-        growth,
-        unstable,
-        notice,
-        excited,
-        off_axis,
-        unstable_modes,
+        label=record.label,
+        source=record.source,
+        time_s=record.time_s,
+        inputs=tuple(model.inputs),
+        outputs=results,
+        reference_shifts=shifts,
+        rmse=rmse,
+        tic=tic,
+        growth=growth,
+        unstable=unstable,
+        notice=notice,
+        excited=excited,
+        off_axis=off_axis,
+        unstable_modes=unstable_modes,
     )
 
 
@@ -362,16 +362,16 @@ def _output(
     name: str, unit: str, measured: np.ndarray, simulated: np.ndarray, bias: float, predicted: np.ndarray | None
 ) -> OutputVerification:
     return OutputVerification(
-        name,
-        unit,
-        measured,
-        simulated,
-        bias,
-        rms_error(measured, simulated),
-        theil_inequality(measured, simulated),
-        predicted,
-        None if predicted is None else rms_error(measured, predicted),
-        None if predicted is None else theil_inequality(measured, predicted),
+        name=name,
+        unit=unit,
+        measured=measured,
+        simulated=simulated,
+        bias=bias,
+        rmse=rms_error(measured, simulated),
+        tic=theil_inequality(measured, simulated),
+        predicted=predicted,
+        prediction_rmse=None if predicted is None else rms_error(measured, predicted),
+        prediction_tic=None if predicted is None else theil_inequality(measured, predicted),
     )
 
 
@@ -394,14 +394,14 @@ def _pooled(records: Sequence[RecordVerification], *, judged: bool = True) -> tu
             prediction_rmse, prediction_tic = rms_error(m, s), theil_inequality(m, s)
         summaries.append(
             OutputSummary(
-                name,
-                pieces[0].unit,
-                rms_error(measured, simulated),
-                theil_inequality(measured, simulated),
-                len(pieces),
-                int(measured.size),
-                prediction_rmse,
-                prediction_tic,
+                name=name,
+                unit=pieces[0].unit,
+                rmse=rms_error(measured, simulated),
+                tic=theil_inequality(measured, simulated),
+                n_records=len(pieces),
+                n_samples=int(measured.size),
+                prediction_rmse=prediction_rmse,
+                prediction_tic=prediction_tic,
             )
         )
     return tuple(summaries)
@@ -481,9 +481,19 @@ def verify(
     off_axis = _pooled(final, judged=False)
     rmse, tic = _overall_pooled(final)
     if wind_model is None:
-        return Verification(final, summary, rmse, tic, off_axis=off_axis)
+        return Verification(records=final, summary=summary, rmse=rmse, tic=tic, off_axis=off_axis)
     before = {s.name: s for s in _pooled(without)}
     corrections = tuple(
-        WindCorrection(s.name, s.unit, before[s.name].rmse, s.rmse) for s in summary if s.name in before
+        WindCorrection(name=s.name, unit=s.unit, rmse_without=before[s.name].rmse, rmse_with=s.rmse)
+        for s in summary
+        if s.name in before
     )
-    return Verification(final, summary, rmse, tic, without, corrections, off_axis)
+    return Verification(
+        records=final,
+        summary=summary,
+        rmse=rmse,
+        tic=tic,
+        without_wind=without,
+        wind_correction=corrections,
+        off_axis=off_axis,
+    )

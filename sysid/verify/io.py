@@ -39,7 +39,7 @@ VERIFICATION_SCHEMA_VERSION = 2
 _READABLE_VERSIONS = (1, 2)  # version 1 had no excited input, off-axis outputs or off-axis summary
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class SavedVerification:
     """A verification with what it was run on and with.
 
@@ -163,48 +163,48 @@ def verification_to_dict(
 def _output_from_dict(d: Mapping[str, Any]) -> OutputVerification:
     predicted = d.get("predicted")
     return OutputVerification(
-        d["name"],
-        d["unit"],
-        _array(d["measured"]),
-        _array(d["simulated"]),
-        _float(d["bias"]),
-        _float(d["rmse"]),
-        _float(d["tic"]),
-        None if predicted is None else _array(predicted),
-        _optional(d.get("prediction_rmse")),
-        _optional(d.get("prediction_tic")),
+        name=d["name"],
+        unit=d["unit"],
+        measured=_array(d["measured"]),
+        simulated=_array(d["simulated"]),
+        bias=_float(d["bias"]),
+        rmse=_float(d["rmse"]),
+        tic=_float(d["tic"]),
+        predicted=None if predicted is None else _array(predicted),
+        prediction_rmse=_optional(d.get("prediction_rmse")),
+        prediction_tic=_optional(d.get("prediction_tic")),
     )
 
 
 def _record_from_dict(d: Mapping[str, Any]) -> RecordVerification:
     return RecordVerification(
-        d["label"],
-        Path(d["source"]),
-        _array(d["time_s"]),
-        tuple(d["inputs"]),
-        tuple(_output_from_dict(o) for o in d["outputs"]),
-        {k: _float(v) for k, v in d["reference_shifts"].items()},
-        _float(d["rmse"]),
-        _float(d["tic"]),
-        _float(d["growth"]),
-        bool(d["unstable"]),
-        d.get("notice", ""),
-        d.get("excited"),
-        tuple(d.get("off_axis", ())),
-        tuple(d.get("unstable_modes", ())),
+        label=d["label"],
+        source=Path(d["source"]),
+        time_s=_array(d["time_s"]),
+        inputs=tuple(d["inputs"]),
+        outputs=tuple(_output_from_dict(o) for o in d["outputs"]),
+        reference_shifts={k: _float(v) for k, v in d["reference_shifts"].items()},
+        rmse=_float(d["rmse"]),
+        tic=_float(d["tic"]),
+        growth=_float(d["growth"]),
+        unstable=bool(d["unstable"]),
+        notice=d.get("notice", ""),
+        excited=d.get("excited"),
+        off_axis=tuple(d.get("off_axis", ())),
+        unstable_modes=tuple(d.get("unstable_modes", ())),
     )
 
 
 def _summary_from_dict(s: Mapping[str, Any]) -> OutputSummary:
     return OutputSummary(
-        s["name"],
-        s["unit"],
-        _float(s["rmse"]),
-        _float(s["tic"]),
-        int(s["n_records"]),
-        int(s["n_samples"]),
-        _optional(s.get("prediction_rmse")),
-        _optional(s.get("prediction_tic")),
+        name=s["name"],
+        unit=s["unit"],
+        rmse=_float(s["rmse"]),
+        tic=_float(s["tic"]),
+        n_records=int(s["n_records"]),
+        n_samples=int(s["n_samples"]),
+        prediction_rmse=_optional(s.get("prediction_rmse")),
+        prediction_tic=_optional(s.get("prediction_tic")),
     )
 
 
@@ -242,19 +242,27 @@ def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") ->
         )
     try:
         verification = Verification(
-            tuple(_record_from_dict(r) for r in doc["records"]),
-            tuple(_summary_from_dict(s) for s in doc["summary"]),
-            _float(doc["rmse"]),
-            _float(doc["tic"]),
-            tuple(_record_from_dict(r) for r in doc.get("without_wind", [])),
-            tuple(
-                WindCorrection(c["name"], c["unit"], _float(c["rmse_without"]), _float(c["rmse_with"]))
+            records=tuple(_record_from_dict(r) for r in doc["records"]),
+            summary=tuple(_summary_from_dict(s) for s in doc["summary"]),
+            rmse=_float(doc["rmse"]),
+            tic=_float(doc["tic"]),
+            without_wind=tuple(_record_from_dict(r) for r in doc.get("without_wind", [])),
+            wind_correction=tuple(
+                WindCorrection(
+                    name=c["name"],
+                    unit=c["unit"],
+                    rmse_without=_float(c["rmse_without"]),
+                    rmse_with=_float(c["rmse_with"]),
+                )
                 for c in doc.get("wind_correction", [])
             ),
-            tuple(_summary_from_dict(s) for s in doc.get("off_axis", [])),
+            off_axis=tuple(_summary_from_dict(s) for s in doc.get("off_axis", [])),
         )
         return SavedVerification(
-            verification, str(doc.get("model", "")), dict(doc.get("options") or {}), str(doc.get("created_utc", ""))
+            verification=verification,
+            model=str(doc.get("model", "")),
+            options=dict(doc.get("options") or {}),
+            created_utc=str(doc.get("created_utc", "")),
         )
     except (KeyError, TypeError, ValueError, AttributeError) as err:
         raise DataError(f"{source}: verification file is incomplete or damaged ({type(err).__name__}: {err})") from None
@@ -293,9 +301,13 @@ def write_verification(
     >>> import tempfile
     >>> import numpy as np
     >>> t = np.arange(3) * 0.01
-    >>> out = OutputVerification("q", "rad/s", np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.9, 0.1]), 0.0, 0.08, 0.05)
-    >>> record = RecordVerification("lon doublet", Path("f.bin"), t, ("delta_lon",), (out,), {}, 4.6, 0.05, 1.0, False)
-    >>> path = write_verification(Path(tempfile.mkdtemp()) / "v.json", Verification((record,), (), 4.6, 0.05))
+    >>> out = OutputVerification(name="q", unit="rad/s", measured=np.array([0.0, 1.0, 0.0]),
+    ...                          simulated=np.array([0.0, 0.9, 0.1]), bias=0.0, rmse=0.08, tic=0.05)
+    >>> record = RecordVerification(label="lon doublet", source=Path("f.bin"), time_s=t, inputs=("delta_lon",),
+    ...                             outputs=(out,), reference_shifts={}, rmse=4.6, tic=0.05, growth=1.0,
+    ...                             unstable=False)
+    >>> verification = Verification(records=(record,), summary=(), rmse=4.6, tic=0.05)
+    >>> path = write_verification(Path(tempfile.mkdtemp()) / "v.json", verification)
     >>> read_verification(path).verification.records[0].output("q").simulated.tolist()
     [0.0, 0.9, 0.1]
     """

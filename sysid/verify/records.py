@@ -14,7 +14,7 @@ __all__ = ["DoubletRecords", "doublet_records", "MIXER_INPUTS"]
 MIXER_INPUTS = {"lat": "delta_lat", "lon": "delta_lon", "yaw": "delta_yaw", "thr": "delta_thr"}
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class DoubletRecords:
     """Doublet records and the mixer input each excites.
 
@@ -74,4 +74,4 @@ def doublet_records(
                     records.append(record.between(start, end, label=label))
                     excited.append(MIXER_INPUTS[segment.axis])
                     break
-    return DoubletRecords(tuple(records), tuple(excited))
+    return DoubletRecords(records=tuple(records), excited=tuple(excited))

@@ -118,7 +118,7 @@ def mode_names(labels: Sequence[str]) -> str:
     return f"{', '.join(labels[:-1])} and {labels[-1]} modes"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class OutputVerification:
     """One output of one record: measured against the model's simulation.
 
@@ -165,7 +165,7 @@ class OutputVerification:
             object.__setattr__(self, "predicted", _vector(self.predicted, "predicted", n))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class RecordVerification:
     """A model simulated over one record.
 
@@ -270,7 +270,7 @@ class RecordVerification:
         return tuple(o for o in self.outputs if o.name in self.off_axis)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class OutputSummary:
     """One output pooled over every record that verified it.
 
@@ -302,7 +302,7 @@ class OutputSummary:
     prediction_tic: float | None = None
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindCorrection:
     """What the wind term G_w buys on one output (dissertation Table 3.6).
 
@@ -325,7 +325,8 @@ class WindCorrection:
 
     Examples
     --------
-    >>> round(WindCorrection("ax", "m/s^2", 0.4129, 0.3480).reduction_percent, 1)  # Table 3.6, strong wind
+    >>> strong = WindCorrection(name="ax", unit="m/s^2", rmse_without=0.4129, rmse_with=0.3480)  # Table 3.6, strong wind
+    >>> round(strong.reduction_percent, 1)
     15.7
     """
 
@@ -340,7 +341,7 @@ class WindCorrection:
         object.__setattr__(self, "reduction_percent", reduction)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Verification:
     """A model verified on records it was not fitted to.
 

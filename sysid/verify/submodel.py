@@ -73,15 +73,15 @@ def driven_part(model: DelayedStateSpace, excited: str) -> DelayedStateSpace:
     keep_inputs = np.any(b[reached] != 0, axis=0) | np.any(d[rows] != 0, axis=0)
     x, u, y = np.flatnonzero(reached), np.flatnonzero(keep_inputs), np.flatnonzero(rows)
     return DelayedStateSpace(
-        a[np.ix_(x, x)],
-        b[np.ix_(x, u)],
-        c[np.ix_(y, x)],
-        d[np.ix_(y, u)],
-        tuple(model.states[i] for i in x),
-        tuple(model.inputs[j] for j in u),
-        tuple(model.outputs[i] for i in y),
-        np.asarray(model.input_delays_s, dtype=float)[u],
-        model.trim,
+        a=a[np.ix_(x, x)],
+        b=b[np.ix_(x, u)],
+        c=c[np.ix_(y, x)],
+        d=d[np.ix_(y, u)],
+        states=tuple(model.states[i] for i in x),
+        inputs=tuple(model.inputs[j] for j in u),
+        outputs=tuple(model.outputs[i] for i in y),
+        input_delays_s=np.asarray(model.input_delays_s, dtype=float)[u],
+        trim=model.trim,
     )
 
 
@@ -111,8 +111,9 @@ def axis_outputs(model: IdentifiedModel) -> dict[str, tuple[str, ...]]:
     >>> from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate
     >>> from sysid.model import parse_structure
     >>> text = (resources.files("sysid.model") / "builtin" / "hover.toml").read_text()
-    >>> parameters = tuple(ParameterEstimate(p.name, p.value) for p in parse_structure(text).parameters)
-    >>> hover = IdentifiedModel("hover", text, parameters, (), np.zeros((0, 0)), CostSummary(1.0),
+    >>> parameters = tuple(ParameterEstimate(name=p.name, value=p.value) for p in parse_structure(text).parameters)
+    >>> hover = IdentifiedModel(structure_name="hover", structure_text=text, parameters=parameters,
+    ...                         correlation_names=(), correlation=np.zeros((0, 0)), cost=CostSummary(average=1.0),
     ...                         constants={"g": 9.81, "U0": 1.4, "V0": -2.3, "W0": 0.1, "phi0": 0.0, "theta0": 0.0})
     >>> axis_outputs(hover)["delta_yaw"], axis_outputs(hover)["delta_thr"]
     (('r',), ('w', 'az'))

@@ -63,7 +63,9 @@ def test_a_fitted_ground_effect_model_drives_the_vehicle(runner: CliRunner, tmp_
     from sysid.groundeffect import ThrustRatioData, fit_ground_effect, write_ground_effect_model
 
     x = np.linspace(1.1, 8.0, 40)
-    fit = fit_ground_effect(ThrustRatioData(x, thrust_ratio(x, "fitted_4rotor"), 0.0225))
+    fit = fit_ground_effect(
+        ThrustRatioData(height_ratio=x, thrust_ratio=thrust_ratio(x, "fitted_4rotor"), rotor_radius_m=0.0225)
+    )
     model = write_ground_effect_model(fit, tmp_path / "ge.json")
     args = [
         "mrac",

@@ -60,10 +60,16 @@ def _truth_model_file(path: Path) -> Path:
     for name in ("X_lon", "M_lon", "Y_lat", "L_lat", "N_yaw", "Z_thr"):
         values[name] *= 100.0  # the ArduPilot log holds the mixer input normalised to -1..1
     structure = parse_structure(text, source="hover-wind")
-    parameters = tuple(ParameterEstimate(p.name, values[p.name]) for p in structure.parameters)
+    parameters = tuple(ParameterEstimate(name=p.name, value=values[p.name]) for p in structure.parameters)
     constants = {"g": 9.81, "U0": 0.0, "V0": 0.0, "W0": 0.0, "phi0": 0.0, "theta0": 0.0}
     model = IdentifiedModel(
-        "hover-wind", text, parameters, (), np.zeros((0, 0)), CostSummary(50.0), constants=constants
+        structure_name="hover-wind",
+        structure_text=text,
+        parameters=parameters,
+        correlation_names=(),
+        correlation=np.zeros((0, 0)),
+        cost=CostSummary(average=50.0),
+        constants=constants,
     )
     return write_model(path, model)
 

@@ -26,7 +26,9 @@ def _data(seed: int, w: float = 1.0, source: str = "rig.csv", steps: HoverSteps 
     x = np.repeat(np.arange(0.025, 0.2051, 0.01) / R, 2)
     rng = np.random.default_rng(seed)
     y = w * laws.piecewise_linear(x, *EQ_2_5) + (1 - w) * laws.corrected(x, 3.0) + rng.normal(0, 0.005, x.size)
-    return ThrustRatioData(x, y, R, source, "given", 0.374, steps)
+    return ThrustRatioData(
+        height_ratio=x, thrust_ratio=y, rotor_radius_m=R, source=source, f0_source="given", f0_n=0.374, steps=steps
+    )
 
 
 def _self_contained(page: str) -> bool:
@@ -48,8 +50,23 @@ def test_fit_report_has_every_model_its_parameters_and_the_choice(tmp_path: Path
 
 
 def test_flight_report_shows_the_hover_steps() -> None:
-    step = HoverStep(10.0, 20.0, 15.0, 0.069, 0.01, -0.001, 0.356, 1.05, 500)
-    steps = HoverSteps(np.arange(0.0, 30.0, 0.5), np.full(60, 0.069), (step,), ("0.0-6.0 s: F/F0 = 5 implausible",))
+    step = HoverStep(
+        start_s=10.0,
+        end_s=20.0,
+        steady_start_s=15.0,
+        height_m=0.069,
+        height_std_m=0.01,
+        climb_rate_m_s=-0.001,
+        f0_n=0.356,
+        thrust_ratio=1.05,
+        samples=500,
+    )
+    steps = HoverSteps(
+        time_s=np.arange(0.0, 30.0, 0.5),
+        height_m=np.full(60, 0.069),
+        steps=(step,),
+        dropped=("0.0-6.0 s: F/F0 = 5 implausible",),
+    )
     page = render_groundeffect_report(fit_ground_effect(_data(2, steps=steps)))
     assert "Hover steps" in page and page.count("<svg") == 3
     assert "implausible" in page

@@ -19,14 +19,14 @@ import builders
 
 def _first_order(delay_s: float = 0.0) -> DelayedStateSpace:
     return DelayedStateSpace(
-        np.array([[-2.0]]),
-        np.array([[2.0]]),
-        np.array([[1.0]]),
-        np.zeros((1, 1)),
-        ("p",),
-        ("delta_lat",),
-        ("p",),
-        np.array([delay_s]),
+        a=np.array([[-2.0]]),
+        b=np.array([[2.0]]),
+        c=np.array([[1.0]]),
+        d=np.zeros((1, 1)),
+        states=("p",),
+        inputs=("delta_lat",),
+        outputs=("p",),
+        input_delays_s=np.array([delay_s]),
     )
 
 
@@ -41,14 +41,14 @@ def test_pair_response_is_the_analytic_lag_with_its_delay() -> None:
 def test_a_signal_entering_twice_is_summed() -> None:
     """A wind signal with two delays (u and w) acts as one input: its response is the sum of both paths."""
     model = DelayedStateSpace(
-        -np.eye(2),
-        np.eye(2),
-        np.ones((1, 2)),
-        np.zeros((1, 2)),
-        ("u", "w"),
-        ("wind_lon", "wind_lon"),
-        ("ax",),
-        np.array([0.0, 0.1]),
+        a=-np.eye(2),
+        b=np.eye(2),
+        c=np.ones((1, 2)),
+        d=np.zeros((1, 2)),
+        states=("u", "w"),
+        inputs=("wind_lon", "wind_lon"),
+        outputs=("ax",),
+        input_delays_s=np.array([0.0, 0.1]),
     )
     omega = np.array([1.0, 3.0])
     expected = 1.0 / (1j * omega + 1.0) * (1.0 + np.exp(-0.1j * omega))
@@ -107,7 +107,16 @@ def test_a_dollar_in_a_name_is_drawn_as_it_is() -> None:
 def _mode(real: float, imag: float, label: str) -> Mode:
     omega_n = math.hypot(real, imag)
     stability = "unstable" if real > 0 else "stable"
-    return Mode(real, imag, -real / omega_n, omega_n, math.inf, math.inf, label, stability)  # type: ignore[arg-type]
+    return Mode(
+        real=real,
+        imag=imag,
+        damping=-real / omega_n,
+        natural_frequency_rad_s=omega_n,
+        time_to_double_s=math.inf,
+        time_to_half_s=math.inf,
+        mode=label,
+        stability=stability,  # type: ignore[arg-type]
+    )
 
 
 def test_pole_map_draws_conjugates_and_zooms_past_fast_actuators() -> None:

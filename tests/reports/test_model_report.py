@@ -36,8 +36,11 @@ HOSTILE = '<script>alert("x")</script><img src=x onerror=alert(1)>'
 
 def verification_with(tics: Mapping[str, float]) -> Verification:
     """A verification whose pooled outputs have these TICs (no records: for the verdict only)."""
-    summary = tuple(OutputSummary(name, "rad/s", 0.1, tic, 1, 100) for name, tic in tics.items())
-    return Verification((), summary, 1.0, max(tics.values()))
+    summary = tuple(
+        OutputSummary(name=name, unit="rad/s", rmse=0.1, tic=tic, n_records=1, n_samples=100)
+        for name, tic in tics.items()
+    )
+    return Verification(records=(), summary=summary, rmse=1.0, tic=max(tics.values()))
 
 
 @pytest.fixture(scope="module")

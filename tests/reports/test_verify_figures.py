@@ -57,9 +57,9 @@ def test_a_dollar_in_a_record_label_is_drawn_as_it_is(verification: Verification
 def test_wind_correction_figure_annotates_the_change() -> None:
     svg = wind_correction_figure(
         [
-            WindCorrection("ax", "m/s^2", 0.4129, 0.3480),
-            WindCorrection("p", "rad/s", 0.1, 0.1),
-            WindCorrection("az", "m/s^2", 0.187, 0.295),
+            WindCorrection(name="ax", unit="m/s^2", rmse_without=0.4129, rmse_with=0.3480),
+            WindCorrection(name="p", unit="rad/s", rmse_without=0.1, rmse_with=0.1),
+            WindCorrection(name="az", unit="m/s^2", rmse_without=0.187, rmse_with=0.295),
         ]
     )
     assert "−16 %" in svg and "+58 %" in svg  # Table 3.6, strong wind: 0.4129 -> 0.3480; a worse az
@@ -82,9 +82,9 @@ def test_the_legend_never_covers_a_bar_even_beyond_the_old_axis_limit() -> None:
     """An output made 58 % worse (ratio 1.58 > 1.2) still fits, and the legend sits outside every bar."""
     ax, renderer = _wind_axes(
         [
-            WindCorrection("ax", "m/s^2", 0.0675, 0.0585),
-            WindCorrection("az", "m/s^2", 0.187, 0.295),
-            WindCorrection("w", "m/s", 0.135, 0.141),
+            WindCorrection(name="ax", unit="m/s^2", rmse_without=0.0675, rmse_with=0.0585),
+            WindCorrection(name="az", unit="m/s^2", rmse_without=0.187, rmse_with=0.295),
+            WindCorrection(name="w", unit="m/s", rmse_without=0.135, rmse_with=0.141),
         ]
     )
     assert ax.get_ylim()[1] > 0.295 / 0.187

@@ -43,7 +43,13 @@ def model() -> IdentifiedModel:
     return model_from_fit(
         fit,
         trim={"u": 2.2, "theta": -0.04},
-        provenance=Provenance(("a.bin",), {"a.bin": "0" * 64}, {"starts": 1}, {"numpy": "2"}, "now"),
+        provenance=Provenance(
+            files=("a.bin",),
+            sha256={"a.bin": "0" * 64},
+            options={"starts": 1},
+            versions={"numpy": "2"},
+            created_utc="now",
+        ),
         notes=("u/delta_lon: dropped by gating",),
     )
 
@@ -130,14 +136,14 @@ def test_control_statespace_reproduces_the_response(model: IdentifiedModel) -> N
     linear = model.linear_model(include_wind=False)
     omega = np.geomspace(0.5, 30.0, 25)
     undelayed = DelayedStateSpace(
-        linear.a,
-        linear.b,
-        linear.c,
-        linear.d,
-        linear.states,
-        linear.inputs,
-        linear.outputs,
-        np.zeros(len(linear.inputs)),
+        a=linear.a,
+        b=linear.b,
+        c=linear.c,
+        d=linear.d,
+        states=linear.states,
+        inputs=linear.inputs,
+        outputs=linear.outputs,
+        input_delays_s=np.zeros(len(linear.inputs)),
     )
     system = to_statespace(undelayed)
     ours = from_control_layout(system.frequency_response(omega).complex)

@@ -101,7 +101,14 @@ def test_an_input_that_copies_another_has_no_partial_coherence() -> None:
 
 def _lag_sweeps(noise: float, seed: int) -> tuple[list[Record], DelayedStateSpace]:
     model = DelayedStateSpace(
-        np.array([[-5.0]]), np.array([[5.0]]), np.eye(1), np.zeros((1, 1)), ("x1",), ("x",), ("y",), np.array([0.05])
+        a=np.array([[-5.0]]),
+        b=np.array([[5.0]]),
+        c=np.eye(1),
+        d=np.zeros((1, 1)),
+        states=("x1",),
+        inputs=("x",),
+        outputs=("y",),
+        input_delays_s=np.array([0.05]),
     )
     rng = np.random.default_rng(seed)
     maneuver = Maneuver("lon", "sweep", 2.0, 1.0, 34.0, f_start_hz=0.1, f_stop_hz=12.0)

@@ -122,14 +122,14 @@ def _fails_tolerance(response, truth: np.ndarray, **kwargs: float) -> bool:  # t
 def test_first_order_lag_with_delay() -> None:
     lag_s, delay_s = 0.2, 0.05
     model = DelayedStateSpace(
-        np.array([[-1 / lag_s]]),
-        np.array([[1 / lag_s]]),
-        np.eye(1),
-        np.zeros((1, 1)),
-        ("x1",),
-        ("x",),
-        ("y",),
-        np.array([delay_s]),
+        a=np.array([[-1 / lag_s]]),
+        b=np.array([[1 / lag_s]]),
+        c=np.eye(1),
+        d=np.zeros((1, 1)),
+        states=("x1",),
+        inputs=("x",),
+        outputs=("y",),
+        input_delays_s=np.array([delay_s]),
     )
     for seed, noise in ((1, 0.03), (2, 0.1)):
         (response,) = frequency_responses(_open_loop_records(model, noise=noise, seed=seed), ["x"], ["y"])
@@ -142,7 +142,14 @@ def test_random_error_estimate_matches_the_scatter() -> None:
     """With heavy noise the errors are random: ln(H_est/H), real (log magnitude) and imaginary (phase, rad)
     parts, scatters with the standard deviation eps_r the estimate reports (Bendat & Piersol)."""
     model = DelayedStateSpace(
-        np.array([[-5.0]]), np.array([[5.0]]), np.eye(1), np.zeros((1, 1)), ("x1",), ("x",), ("y",), np.array([0.05])
+        a=np.array([[-5.0]]),
+        b=np.array([[5.0]]),
+        c=np.eye(1),
+        d=np.zeros((1, 1)),
+        states=("x1",),
+        inputs=("x",),
+        outputs=("y",),
+        input_delays_s=np.array([0.05]),
     )
     z = []
     for seed in range(3):
@@ -237,14 +244,14 @@ def _closed_loop_unstable(
 
 def _unstable_plant_truth(omega: np.ndarray) -> np.ndarray:
     plant = DelayedStateSpace(
-        np.array([[0.0, 1.0], [-3.641, 1.756]]),
-        np.array([[0.0], [2.0]]),
-        np.array([[1.0, 0.0]]),
-        np.zeros((1, 1)),
-        ("y", "y_dot"),
-        ("u",),
-        ("y",),
-        np.array([0.02 + 0.0005]),
+        a=np.array([[0.0, 1.0], [-3.641, 1.756]]),
+        b=np.array([[0.0], [2.0]]),
+        c=np.array([[1.0, 0.0]]),
+        d=np.zeros((1, 1)),
+        states=("y", "y_dot"),
+        inputs=("u",),
+        outputs=("y",),
+        input_delays_s=np.array([0.02 + 0.0005]),
     )  # + half a 1 ms hold
     return plant.frequency_response(omega)[:, 0, 0]
 
@@ -317,14 +324,14 @@ def _bare_airframe_lon(p: dict[str, float], delay_s: float) -> DelayedStateSpace
     b = np.array([[0.0], [0.0], [0.0], [1.0 / p["T_a"]]])
     c = np.array([[0.0, 1.0, 0.0, 0.0], a[0] + np.array([0.0, 0.0, G, 0.0]), [0.0, 0.0, 1.0, 0.0], [1.0, 0, 0, 0]])
     return DelayedStateSpace(
-        a,
-        b,
-        c,
-        np.zeros((4, 1)),
-        ("u", "q", "theta", "d_lon"),
-        ("delta_lon",),
-        ("q", "ax", "theta", "u"),
-        np.array([delay_s]),
+        a=a,
+        b=b,
+        c=c,
+        d=np.zeros((4, 1)),
+        states=("u", "q", "theta", "d_lon"),
+        inputs=("delta_lon",),
+        outputs=("q", "ax", "theta", "u"),
+        input_delays_s=np.array([delay_s]),
     )
 
 

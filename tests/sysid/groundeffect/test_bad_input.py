@@ -33,7 +33,9 @@ R = 0.0225
 def exponential_doc(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     x = np.linspace(1.2, 9.0, 20)
     y = evaluate_model("exponential", [0.26, 0.68], x) * (1 + 0.002 * np.sin(5 * x))
-    fit = fit_ground_effect(ThrustRatioData(x, y, R), FitConfig(models=("exponential",)))
+    fit = fit_ground_effect(
+        ThrustRatioData(height_ratio=x, thrust_ratio=y, rotor_radius_m=R), FitConfig(models=("exponential",))
+    )
     path = write_ground_effect_model(fit, tmp_path_factory.mktemp("ge") / "ge.json")
     return dict(json.loads(path.read_text()))
 
@@ -83,19 +85,33 @@ def test_an_f0_that_puts_the_readings_far_from_one_is_refused() -> None:
 def test_too_few_points_says_what_was_found() -> None:
     x, y = np.array([1.5, 3.0]), np.array([1.05, 1.01])
     with pytest.raises(FitError, match=r"^rig\.csv: 2 points were given; at least 3 are needed to fit$"):
-        fit_ground_effect(ThrustRatioData(x, y, R, "rig.csv"))
+        fit_ground_effect(ThrustRatioData(height_ratio=x, thrust_ratio=y, rotor_radius_m=R, source="rig.csv"))
     steps = HoverSteps(
-        np.array([0.0, 1.0]),
-        np.array([0.03, 0.07]),
-        tuple(
-            HoverStep(10.0 * k, 10.0 * k + 10, 10.0 * k + 5, h, 0.001, 0.0, 0.4, r, 50)
+        time_s=np.array([0.0, 1.0]),
+        height_m=np.array([0.03, 0.07]),
+        steps=tuple(
+            HoverStep(
+                start_s=10.0 * k,
+                end_s=10.0 * k + 10,
+                steady_start_s=10.0 * k + 5,
+                height_m=h,
+                height_std_m=0.001,
+                climb_rate_m_s=0.0,
+                f0_n=0.4,
+                thrust_ratio=r,
+                samples=50,
+            )
             for k, (h, r) in enumerate(zip(x * R, y))
         ),
     )
     with pytest.raises(FitError, match=r"^f\.ulg: 2 hover steps near the ground were found; at least 3 are needed"):
-        fit_ground_effect(ThrustRatioData(x, y, R, "f.ulg", steps=steps))
+        fit_ground_effect(
+            ThrustRatioData(height_ratio=x, thrust_ratio=y, rotor_radius_m=R, source="f.ulg", steps=steps)
+        )
     with pytest.raises(FitError, match=r"^f\.ulg: 1 hover step near the ground was found;"):
-        fit_ground_effect(ThrustRatioData(x[:1], y[:1], R, "f.ulg", steps=steps))
+        fit_ground_effect(
+            ThrustRatioData(height_ratio=x[:1], thrust_ratio=y[:1], rotor_radius_m=R, source="f.ulg", steps=steps)
+        )
 
 
 @pytest.mark.parametrize("suffix", [".ulg", ".bin", ".tlog"])

@@ -92,7 +92,13 @@ def test_four_rotor_data_of_eq_2_5_pick_piecewise_linear_and_recover_it_within_5
     se = np.array([se_slope, se_intercept, se_bp])
     assert np.all(4 * se <= 0.05 * np.abs(EQ_2_5)), "design: 5 % must be at least 4 standard errors"
     rng = np.random.default_rng(25)
-    fit = fit_ground_effect(ThrustRatioData(x, laws.piecewise_linear(x, *EQ_2_5) + rng.normal(0, sigma, x.size), R))
+    fit = fit_ground_effect(
+        ThrustRatioData(
+            height_ratio=x,
+            thrust_ratio=laws.piecewise_linear(x, *EQ_2_5) + rng.normal(0, sigma, x.size),
+            rotor_radius_m=R,
+        )
+    )
     assert fit.best == "piecewise_linear"
     pl = fit.model("piecewise_linear")
     np.testing.assert_allclose(pl.values, EQ_2_5, rtol=0.05)
@@ -108,7 +114,11 @@ def test_two_rotor_data_of_eq_2_4_pick_the_corrected_law_and_recover_rho_within_
     (se_rho,) = _stderr((laws.corrected(x, rho) ** 2 / (16 * x * x))[:, None], sigma)
     assert 4 * se_rho <= 0.05 * rho
     rng = np.random.default_rng(24)
-    fit = fit_ground_effect(ThrustRatioData(x, laws.corrected(x, rho) + rng.normal(0, sigma, x.size), R))
+    fit = fit_ground_effect(
+        ThrustRatioData(
+            height_ratio=x, thrust_ratio=laws.corrected(x, rho) + rng.normal(0, sigma, x.size), rotor_radius_m=R
+        )
+    )
     assert fit.best == "corrected"
     assert fit.model("corrected").params["rho"] == pytest.approx(rho, rel=0.05)
     assert fit.model("corrected").stderr[0] == pytest.approx(se_rho, rel=0.25)
@@ -118,7 +128,12 @@ def test_table_2_2_rho_series_is_recovered_by_the_two_rotor_spacing_study() -> N
     x = _design(30)
     rng = np.random.default_rng(22)
     datasets = [
-        ThrustRatioData(x, laws.corrected(x, rho) + rng.normal(0, rmse, x.size), R, source=f"{10 * i} mm")
+        ThrustRatioData(
+            height_ratio=x,
+            thrust_ratio=laws.corrected(x, rho) + rng.normal(0, rmse, x.size),
+            rotor_radius_m=R,
+            source=f"{10 * i} mm",
+        )
         for i, (rho, rmse, _) in enumerate(TABLE_2_2)
     ]
     study = spacing_study(datasets, np.arange(6) * 0.010, rotors=2)
@@ -169,7 +184,8 @@ def test_selection_counts_parameters_bic_and_aicc() -> None:
     rng = np.random.default_rng(3)
     y = laws.corrected(x, 1.0) + rng.normal(0, 0.002, x.size)  # eq. 2.1 exactly: rho = 1 adds nothing
     for criterion in ("aicc", "bic"):
-        fit = fit_ground_effect(ThrustRatioData(x, y, R), FitConfig(criterion=criterion))  # type: ignore[arg-type]
+        data = ThrustRatioData(height_ratio=x, thrust_ratio=y, rotor_radius_m=R)
+        fit = fit_ground_effect(data, FitConfig(criterion=criterion))  # type: ignore[arg-type]
         assert fit.best == "cheeseman_bennett"
         assert fit.model("corrected").rss <= fit.model("cheeseman_bennett").rss  # fits better, yet not chosen
         assert fit.delta("cheeseman_bennett") == 0.0
@@ -182,7 +198,9 @@ def test_selection_counts_parameters_bic_and_aicc() -> None:
 
 def test_too_few_points_and_an_unreachable_breakpoint_are_reported() -> None:
     with pytest.raises(FitError, match="at least 3"):
-        fit_ground_effect(ThrustRatioData(np.array([1.5, 3.0]), np.array([1.1, 1.0]), R))
+        fit_ground_effect(
+            ThrustRatioData(height_ratio=np.array([1.5, 3.0]), thrust_ratio=np.array([1.1, 1.0]), rotor_radius_m=R)
+        )
     x = np.linspace(1.2, 3.0, 12)  # all inside ground effect: no plateau, the breakpoint is extrapolated
     fit = fit_model("piecewise_linear", x, laws.piecewise_linear(x, -0.04, 1.18, 4.5))
     np.testing.assert_allclose(fit.values, [-0.04, 1.18, 4.5], rtol=1e-6)
@@ -209,7 +227,13 @@ def test_rig_f0_from_the_rows_out_of_ground_effect() -> None:
 def test_model_file_round_trips_and_rejects_foreign_files(tmp_path: Path) -> None:
     x = _design(2)
     rng = np.random.default_rng(7)
-    fit = fit_ground_effect(ThrustRatioData(x, laws.piecewise_linear(x, *EQ_2_5) + rng.normal(0, 0.005, x.size), R))
+    fit = fit_ground_effect(
+        ThrustRatioData(
+            height_ratio=x,
+            thrust_ratio=laws.piecewise_linear(x, *EQ_2_5) + rng.normal(0, 0.005, x.size),
+            rotor_radius_m=R,
+        )
+    )
     path = write_ground_effect_model(fit, tmp_path / "ge.json")
     model = read_ground_effect_model(path)
     assert model.model == fit.best and model.rotor_radius_m == R
@@ -239,9 +263,11 @@ def spacing_series(seed: int, *, readings: int = 3) -> tuple[list[ThrustRatioDat
     rng = np.random.default_rng(seed)
     datasets = [
         ThrustRatioData(
-            x,
-            w * laws.piecewise_linear(x, *EQ_2_5) + (1 - w) * laws.corrected(x, 3.0) + rng.normal(0, 0.0103, x.size),
-            R,
+            height_ratio=x,
+            thrust_ratio=w * laws.piecewise_linear(x, *EQ_2_5)
+            + (1 - w) * laws.corrected(x, 3.0)
+            + rng.normal(0, 0.0103, x.size),
+            rotor_radius_m=R,
             source=f"rig_{10 * i}mm.csv",
         )
         for i, w in enumerate(weights)

@@ -60,14 +60,14 @@ def test_second_order_damping_and_frequency_are_analytic() -> None:
     zeta, omega_n = 0.3, 4.0
     a = np.array([[0.0, 1.0], [-(omega_n**2), -2 * zeta * omega_n]])
     model = DelayedStateSpace(
-        a,
-        np.array([[0.0], [1.0]]),
-        np.eye(2),
-        np.zeros((2, 1)),
-        ("theta", "q"),
-        ("delta_lon",),
-        ("theta", "q"),
-        np.zeros(1),
+        a=a,
+        b=np.array([[0.0], [1.0]]),
+        c=np.eye(2),
+        d=np.zeros((2, 1)),
+        states=("theta", "q"),
+        inputs=("delta_lon",),
+        outputs=("theta", "q"),
+        input_delays_s=np.zeros(1),
     )
     (mode,) = modes(model)
     assert mode.damping == pytest.approx(zeta) and mode.natural_frequency_rad_s == pytest.approx(omega_n)
@@ -81,14 +81,14 @@ def test_labels_do_not_depend_on_state_units() -> None:
     model, _ = structure_model(load_structure("hover"), TABLE_3_3_CALM)
     scale = np.diag([100.0 if s.startswith("d_") else 1.0 for s in model.states])
     scaled = DelayedStateSpace(
-        scale @ model.a @ np.linalg.inv(scale),
-        scale @ model.b,
-        model.c @ np.linalg.inv(scale),
-        model.d,
-        model.states,
-        model.inputs,
-        model.outputs,
-        model.input_delays_s,
+        a=scale @ model.a @ np.linalg.inv(scale),
+        b=scale @ model.b,
+        c=model.c @ np.linalg.inv(scale),
+        d=model.d,
+        states=model.states,
+        inputs=model.inputs,
+        outputs=model.outputs,
+        input_delays_s=model.input_delays_s,
     )
     assert [(m.mode, round(m.real, 6)) for m in modes(scaled)] == [(m.mode, round(m.real, 6)) for m in modes(model)]
 

@@ -71,14 +71,14 @@ def _with_wind(model: DelayedStateSpace, state: str, output: str, gain: float, d
     d = np.zeros((len(model.outputs), 1))
     d[model.outputs.index(output), 0] = gain
     return DelayedStateSpace(
-        model.a,
-        np.hstack([model.b, b]),
-        model.c,
-        np.hstack([model.d, d]),
-        model.states,
-        (*model.inputs, "wind_lon"),
-        model.outputs,
-        np.append(model.input_delays_s, delay_s),
+        a=model.a,
+        b=np.hstack([model.b, b]),
+        c=model.c,
+        d=np.hstack([model.d, d]),
+        states=model.states,
+        inputs=(*model.inputs, "wind_lon"),
+        outputs=model.outputs,
+        input_delays_s=np.append(model.input_delays_s, delay_s),
     )
 
 
@@ -94,44 +94,44 @@ def truth_models(
     wind = flown(wind) if wind is not None else None
     lag = 1.0 / p["T_a"]
     lon = DelayedStateSpace(
-        np.array([[p["X_u"], 0, -G, p["X_lon"]], [p["M_u"], 0, 0, p["M_lon"]], [0, 1, 0, 0], [0, 0, 0, -lag]]),
-        np.array([[0], [0], [0], [lag]]),
-        np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [p["X_u"], 0, 0, p["X_lon"]]]),
-        np.zeros((4, 1)),
-        ("u", "q", "theta", "d_lon"),
-        ("delta_lon",),
-        ("u", "q", "theta", "ax"),
-        np.array([p["tau_lon"]]),
+        a=np.array([[p["X_u"], 0, -G, p["X_lon"]], [p["M_u"], 0, 0, p["M_lon"]], [0, 1, 0, 0], [0, 0, 0, -lag]]),
+        b=np.array([[0], [0], [0], [lag]]),
+        c=np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [p["X_u"], 0, 0, p["X_lon"]]]),
+        d=np.zeros((4, 1)),
+        states=("u", "q", "theta", "d_lon"),
+        inputs=("delta_lon",),
+        outputs=("u", "q", "theta", "ax"),
+        input_delays_s=np.array([p["tau_lon"]]),
     )
     lat = DelayedStateSpace(
-        np.array([[p["Y_v"], 0, G, p["Y_lat"]], [p["L_v"], 0, 0, p["L_lat"]], [0, 1, 0, 0], [0, 0, 0, -lag]]),
-        np.array([[0], [0], [0], [lag]]),
-        np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [p["Y_v"], 0, 0, p["Y_lat"]]]),
-        np.zeros((4, 1)),
-        ("v", "p", "phi", "d_lat"),
-        ("delta_lat",),
-        ("v", "p", "phi", "ay"),
-        np.array([p["tau_lat"]]),
+        a=np.array([[p["Y_v"], 0, G, p["Y_lat"]], [p["L_v"], 0, 0, p["L_lat"]], [0, 1, 0, 0], [0, 0, 0, -lag]]),
+        b=np.array([[0], [0], [0], [lag]]),
+        c=np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [p["Y_v"], 0, 0, p["Y_lat"]]]),
+        d=np.zeros((4, 1)),
+        states=("v", "p", "phi", "d_lat"),
+        inputs=("delta_lat",),
+        outputs=("v", "p", "phi", "ay"),
+        input_delays_s=np.array([p["tau_lat"]]),
     )
     yaw = DelayedStateSpace(
-        np.array([[0.0, 0], [1, 0]]),
-        np.array([[p["N_yaw"]], [0]]),
-        np.eye(2),
-        np.zeros((2, 1)),
-        ("r", "psi"),
-        ("delta_yaw",),
-        ("r", "psi"),
-        np.array([p["tau_yaw"]]),
+        a=np.array([[0.0, 0], [1, 0]]),
+        b=np.array([[p["N_yaw"]], [0]]),
+        c=np.eye(2),
+        d=np.zeros((2, 1)),
+        states=("r", "psi"),
+        inputs=("delta_yaw",),
+        outputs=("r", "psi"),
+        input_delays_s=np.array([p["tau_yaw"]]),
     )
     thr = DelayedStateSpace(
-        np.array([[0, 0, p["Z_thr"]], [-1.0, 0, 0], [0, 0, -lag]]),
-        np.array([[0], [0], [lag]]),
-        np.array([[1, 0, 0], [0, 0, p["Z_thr"]]]),
-        np.zeros((2, 1)),
-        ("w", "height_agl", "d_thr"),
-        ("delta_thr",),
-        ("w", "az"),
-        np.array([p["tau_thr"]]),
+        a=np.array([[0, 0, p["Z_thr"]], [-1.0, 0, 0], [0, 0, -lag]]),
+        b=np.array([[0], [0], [lag]]),
+        c=np.array([[1, 0, 0], [0, 0, p["Z_thr"]]]),
+        d=np.zeros((2, 1)),
+        states=("w", "height_agl", "d_thr"),
+        inputs=("delta_thr",),
+        outputs=("w", "az"),
+        input_delays_s=np.array([p["tau_thr"]]),
     )
     if wind is not None:
         lon = _with_wind(lon, "u", "ax", wind["X_w_lon"], wind["tau_w_lon"])
@@ -222,14 +222,14 @@ def _block(models: Mapping[str, DelayedStateSpace]) -> DelayedStateSpace:
 
     ms = list(models.values())
     return DelayedStateSpace(
-        block_diag(*[m.a for m in ms]),
-        block_diag(*[m.b for m in ms]),
-        block_diag(*[m.c for m in ms]),
-        block_diag(*[m.d for m in ms]),
-        sum((m.states for m in ms), ()),
-        sum((m.inputs for m in ms), ()),
-        sum((m.outputs for m in ms), ()),
-        np.concatenate([m.input_delays_s for m in ms]),
+        a=block_diag(*[m.a for m in ms]),
+        b=block_diag(*[m.b for m in ms]),
+        c=block_diag(*[m.c for m in ms]),
+        d=block_diag(*[m.d for m in ms]),
+        states=sum((m.states for m in ms), ()),
+        inputs=sum((m.inputs for m in ms), ()),
+        outputs=sum((m.outputs for m in ms), ()),
+        input_delays_s=np.concatenate([m.input_delays_s for m in ms]),
     )
 
 
@@ -247,14 +247,14 @@ def test_held_step_through_a_delayed_lag_is_exact(delay_samples: float) -> None:
     """y = 1 - exp(-(t - t_step - tau) / T) after a held step: the modified z-transform is exact."""
     dt, lag_s = 0.01, 0.05
     model = DelayedStateSpace(
-        np.array([[-1 / lag_s]]),
-        np.array([[1 / lag_s]]),
-        np.eye(1),
-        np.zeros((1, 1)),
-        ("x",),
-        ("u",),
-        ("y",),
-        np.array([delay_samples * dt]),
+        a=np.array([[-1 / lag_s]]),
+        b=np.array([[1 / lag_s]]),
+        c=np.eye(1),
+        d=np.zeros((1, 1)),
+        states=("x",),
+        inputs=("u",),
+        outputs=("y",),
+        input_delays_s=np.array([delay_samples * dt]),
     )
     t = np.arange(60) * dt
     u = (t >= 0.1).astype(float)
@@ -266,7 +266,14 @@ def test_held_step_through_a_delayed_lag_is_exact(delay_samples: float) -> None:
 def test_feedthrough_sees_the_delayed_held_input() -> None:
     """y = D u(t - tau): with a 1.5-sample delay the step shows two samples later."""
     model = DelayedStateSpace(
-        np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1)), (), ("u",), ("y",), np.array([0.015])
+        a=np.zeros((0, 0)),
+        b=np.zeros((0, 1)),
+        c=np.zeros((1, 0)),
+        d=np.ones((1, 1)),
+        states=(),
+        inputs=("u",),
+        outputs=("y",),
+        input_delays_s=np.array([0.015]),
     )
     u = (np.arange(10) >= 3).astype(float)
     y = simulate(discretize(model, 0.01), u[:, None], np.zeros(0))[:, 0]
@@ -276,14 +283,14 @@ def test_feedthrough_sees_the_delayed_held_input() -> None:
 def _second_order() -> DelayedStateSpace:
     """A stable pitch-like pair driven by two inputs, outputs q and an acceleration with feedthrough."""
     return DelayedStateSpace(
-        np.array([[-1.2, -4.0], [1.0, 0.0]]),
-        np.array([[2.0, 0.0], [0.0, 0.5]]),
-        np.array([[1.0, 0.0], [-0.3, 0.8]]),
-        np.array([[0.0, 0.0], [0.4, 0.0]]),
-        ("q", "theta"),
-        ("delta_lon", "wind_lon"),
-        ("q", "ax"),
-        np.array([0.023, 0.011]),
+        a=np.array([[-1.2, -4.0], [1.0, 0.0]]),
+        b=np.array([[2.0, 0.0], [0.0, 0.5]]),
+        c=np.array([[1.0, 0.0], [-0.3, 0.8]]),
+        d=np.array([[0.0, 0.0], [0.4, 0.0]]),
+        states=("q", "theta"),
+        inputs=("delta_lon", "wind_lon"),
+        outputs=("q", "ax"),
+        input_delays_s=np.array([0.023, 0.011]),
     )
 
 
@@ -348,14 +355,14 @@ def test_a_heave_record_names_the_pitch_mode_the_trim_couples_in(trim_u: float) 
     depends on the unstable pitch pair (0.878 +- 1.694i, Table 3.3), which the notice names."""
     a = np.array([[-0.3172, 0.0, -9.81, 0.0], [0.769, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, trim_u, 0.0, 0.0]])
     model = DelayedStateSpace(
-        a,
-        np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, -5.0]]),
-        np.eye(4)[3:],
-        np.zeros((1, 2)),
-        ("u", "q", "theta", "w"),
-        ("delta_lon", "delta_thr"),
-        ("w",),
-        np.zeros(2),
+        a=a,
+        b=np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, -5.0]]),
+        c=np.eye(4)[3:],
+        d=np.zeros((1, 2)),
+        states=("u", "q", "theta", "w"),
+        inputs=("delta_lon", "delta_thr"),
+        outputs=("w",),
+        input_delays_s=np.zeros(2),
     )
     t = np.arange(500) * 0.01
     result = verify_record(
@@ -374,14 +381,14 @@ def test_an_off_axis_output_cannot_move_the_on_axis_verdict() -> None:
     off-axis q is logged well or with a drift the model cannot explain."""
     a = np.array([[-2.0, 0.0], [1.5, 0.0]])  # q' = -2 q + 4 delta_lon, w' = 1.5 q - 5 delta_thr
     model = DelayedStateSpace(
-        a,
-        np.array([[4.0, 0.0], [0.0, -5.0]]),
-        np.eye(2),
-        np.zeros((2, 2)),
-        ("q", "w"),
-        ("delta_lon", "delta_thr"),
-        ("q", "w"),
-        np.zeros(2),
+        a=a,
+        b=np.array([[4.0, 0.0], [0.0, -5.0]]),
+        c=np.eye(2),
+        d=np.zeros((2, 2)),
+        states=("q", "w"),
+        inputs=("delta_lon", "delta_thr"),
+        outputs=("q", "w"),
+        input_delays_s=np.zeros(2),
     )
     t = np.arange(600) * 0.01
     u = np.column_stack([0.02 + 0.1 * np.sin(1.3 * t), 0.2 * np.sign(np.sin(2.0 * t))])
@@ -417,14 +424,14 @@ def test_every_measured_input_drives_the_simulation() -> None:
     """A pitch doublet while the autopilot also moves the thrust, which reaches q: simulated exactly only with
     both inputs (the old excited-input-only simulation left delta_thr out)."""
     model = DelayedStateSpace(
-        np.array([[-1.2, -4.0], [1.0, 0.0]]),
-        np.array([[2.0, 0.6], [0.0, 0.0]]),
-        np.eye(2),
-        np.zeros((2, 2)),
-        ("q", "theta"),
-        ("delta_lon", "delta_thr"),
-        ("q", "theta"),
-        np.array([0.02, 0.01]),
+        a=np.array([[-1.2, -4.0], [1.0, 0.0]]),
+        b=np.array([[2.0, 0.6], [0.0, 0.0]]),
+        c=np.eye(2),
+        d=np.zeros((2, 2)),
+        states=("q", "theta"),
+        inputs=("delta_lon", "delta_thr"),
+        outputs=("q", "theta"),
+        input_delays_s=np.array([0.02, 0.01]),
     )
     t = np.arange(300) * 0.01
     u = np.column_stack(
@@ -445,14 +452,14 @@ def test_every_measured_input_drives_the_simulation() -> None:
     assert [s.name for s in result.off_axis] == ["theta"]
     assert checked.output("q").tic < 1e-9 and result.tic < 1e-9
     alone = DelayedStateSpace(
-        model.a,
-        model.b[:, :1],
-        model.c,
-        model.d[:, :1],
-        model.states,
-        ("delta_lon",),
-        model.outputs,
-        model.input_delays_s[:1],
+        a=model.a,
+        b=model.b[:, :1],
+        c=model.c,
+        d=model.d[:, :1],
+        states=model.states,
+        inputs=("delta_lon",),
+        outputs=model.outputs,
+        input_delays_s=model.input_delays_s[:1],
     )
     bare = VerificationOptions(initial_state="zero", fit_bias=False, fit_reference_shift=False)
     thrust_part = simulate(discretize(model, 0.01), u * [0.0, 1.0], np.zeros(2))[:, 0]
@@ -469,14 +476,14 @@ def _coupled_hover(constants: Mapping[str, float]):  # type: ignore[no-untyped-d
 
     text = (resources.files("sysid.model") / "builtin" / "hover.toml").read_text()
     values = dict(flown(CALM_HOVER)) | {"N_r": 0.0, "Z_w": 0.0}
-    parameters = tuple(ParameterEstimate(p.name, values[p.name]) for p in parse_structure(text).parameters)
+    parameters = tuple(ParameterEstimate(name=p.name, value=values[p.name]) for p in parse_structure(text).parameters)
     return IdentifiedModel(
-        "hover",
-        text,
-        parameters,
-        (),
-        np.zeros((0, 0)),
-        CostSummary(1.0),
+        structure_name="hover",
+        structure_text=text,
+        parameters=parameters,
+        correlation_names=(),
+        correlation=np.zeros((0, 0)),
+        cost=CostSummary(average=1.0),
         constants={"g": G, "phi0": 0.0, "theta0": 0.0} | dict(constants),
     )
 
@@ -509,9 +516,21 @@ def test_axes_come_from_the_structure_not_from_the_trim_coupling(calm_flights: l
 def test_off_axis_names_some_outputs_of_the_record() -> None:
     from sysid.verify import OutputVerification
 
-    out = OutputVerification("q", "rad/s", np.zeros(3), np.zeros(3), 0.0, 0.0, 0.0)
+    out = OutputVerification(
+        name="q", unit="rad/s", measured=np.zeros(3), simulated=np.zeros(3), bias=0.0, rmse=0.0, tic=0.0
+    )
     make = lambda off: RecordVerification(
-        "r", Path("f.bin"), np.arange(3.0), ("delta_lon",), (out,), {}, 0.0, 0.0, 1.0, False, off_axis=off
+        label="r",
+        source=Path("f.bin"),
+        time_s=np.arange(3.0),
+        inputs=("delta_lon",),
+        outputs=(out,),
+        reference_shifts={},
+        rmse=0.0,
+        tic=0.0,
+        growth=1.0,
+        unstable=False,
+        off_axis=off,
     )
     with pytest.raises(ValueError, match="some, not all"):
         make(("q",))
