@@ -11,6 +11,7 @@ the uniform time base.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal, NamedTuple
 
 import numpy as np
 from scipy.fft import irfft, next_fast_len, rfft
@@ -27,6 +28,59 @@ _CALM = 3.0  # edges: calm within 3 noise σ ...
 _RELATIVE_FLOOR = 0.015  # ... or within 1.5 % of the burst's peak, however clean the trace
 _EDGE_PASSES = 6  # edges: searched again from the last edge found until they settle
 
+ManeuverKind = Literal["sweep", "multisine", "doublet", "3211"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FoundManeuver:
+    """A maneuver of a known kind found by :func:`find_maneuvers`.
+
+    Parameters
+    ----------
+    axis : str
+        The axis whose input owns it.
+    kind : str
+        ``"sweep"``, ``"multisine"``, ``"doublet"`` or ``"3211"``.
+    first, last : int
+        Its first and last sample (inclusive), indices of the uniform time base.
+    f_min_hz, f_max_hz : float or None
+        Frequency range of a sweep or multisine, Hz; None for doublets and 3211s.
+    """
+
+    axis: str
+    kind: ManeuverKind
+    first: int
+    last: int
+    f_min_hz: float | None
+    f_max_hz: float | None
+
+
+class _Burst(NamedTuple):
+    """A run of activity on one axis, merged over short pauses: inclusive sample range and 95th-percentile score."""
+
+    axis: str
+    first: int
+    last: int
+    score: float
+
+
+class _Lobe(NamedTuple):
+    """A half-wave of a trace: its sign, begin and end time (s) and signed area."""
+
+    sign: int
+    begin_s: float
+    end_s: float
+    area: float
+
+
+class _Shape(NamedTuple):
+    """What :func:`_classify` recognised: the kind, its frequency range (Hz), refined bounds for steps."""
+
+    kind: ManeuverKind
+    f_min_hz: float | None
+    f_max_hz: float | None
+    span: tuple[int, int] | None = None  # first and last loud sample of a doublet or 3211
+
 
 def find_maneuvers(
     t: np.ndarray,
@@ -36,7 +90,7 @@ def find_maneuvers(
     trend_window_s: float,
     merge_gap_s: float,
     min_active_s: float,
-) -> tuple[list[tuple], list[tuple[int, int]]]:
+) -> tuple[list[FoundManeuver], list[tuple[int, int]]]:
     """Maneuvers found in `traces` and the sample ranges kept busy by any activity.
 
     Parameters
@@ -52,28 +106,31 @@ def find_maneuvers(
 
     Returns
     -------
-    maneuvers : list of tuple
-        ``(axis, kind, first, last, f_min_hz, f_max_hz)`` per maneuver of a
-        known kind, ``first`` and ``last`` sample indices, in the order the
-        bursts start.
+    maneuvers : list of FoundManeuver
+        Each maneuver of a known kind, in the order the bursts start.
     busy : list of (int, int)
         Inclusive index ranges of every maneuver and every reaction to one.
     """
     acts = {axis: _activity(x, dt, threshold, trend_window_s) for axis, x in traces.items()}
     bursts = [b for axis, act in acts.items() for b in _bursts(axis, act, dt, threshold, merge_gap_s, min_active_s)]
-    maneuvers, busy = [], []
+    maneuvers: list[FoundManeuver] = []
+    busy: list[tuple[int, int]] = []
     margin = int(round(_GUARD_S / dt))
     for owner, reactions in _assign(bursts):
-        axis, i0, i1, _ = owner
+        axis, i0, i1 = owner.axis, owner.first, owner.last
         others = [b for b in bursts if b is not owner and b not in reactions]
-        before = max((b[2] + margin for b in others if b[2] < i0), default=0)
-        after = min((b[1] - margin for b in others if b[1] > i1), default=t.size - 1)
+        before = max((b.last + margin for b in others if b.last < i0), default=0)
+        after = min((b.first - margin for b in others if b.first > i1), default=t.size - 1)
         lo, hi = _edges(acts[axis], i0, i1, dt, (min(before, i0), max(after, i1)), threshold)
-        busy += [(lo, hi)] + [(b[1], b[2]) for b in reactions]
-        found = _classify(acts[axis], t, lo, hi, threshold)
-        if found is not None:
-            first, last = found[3] if len(found) > 3 else (lo, hi)
-            maneuvers.append((axis, found[0], first, last, found[1], found[2]))
+        busy += [(lo, hi)] + [(b.first, b.last) for b in reactions]
+        shape = _classify(acts[axis], t, lo, hi, threshold)
+        if shape is not None:
+            first, last = shape.span if shape.span is not None else (lo, hi)
+            maneuvers.append(
+                FoundManeuver(
+                    axis=axis, kind=shape.kind, first=first, last=last, f_min_hz=shape.f_min_hz, f_max_hz=shape.f_max_hz
+                )
+            )
     return maneuvers, busy
 
 
@@ -170,8 +227,8 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
 
 
-def _bursts(axis: str, act: _Activity, dt: float, threshold: float, merge_s: float, active_s: float) -> list[tuple]:
-    """(axis, first, last, score) of each burst: active runs merged over short pauses."""
+def _bursts(axis: str, act: _Activity, dt: float, threshold: float, merge_s: float, active_s: float) -> list[_Burst]:
+    """Each burst: active runs merged over short pauses."""
     active = np.maximum(act.mean_z, act.rms_z) > threshold
     merged: list[list[int]] = []
     for a, b in _runs(active):
@@ -181,21 +238,22 @@ def _bursts(axis: str, act: _Activity, dt: float, threshold: float, merge_s: flo
             merged.append([a, b])
     score = np.maximum(act.mean_z, act.rms_z)
     return [
-        (axis, a, b, float(np.percentile(score[a : b + 1], 95)))
+        _Burst(axis=axis, first=a, last=b, score=float(np.percentile(score[a : b + 1], 95)))
         for a, b in merged
         if active[a : b + 1].sum() * dt >= active_s
     ]
 
 
-def _assign(bursts: list[tuple]) -> list[tuple[tuple, list[tuple]]]:
+def _assign(bursts: list[_Burst]) -> list[tuple[_Burst, list[_Burst]]]:
     """Greedy: the strongest burst owns a maneuver; weaker bursts overlapping it are its reactions."""
-    pending, owned = sorted(bursts, key=lambda b: -b[3]), []
+    pending: list[_Burst] = sorted(bursts, key=lambda b: -b.score)
+    owned: list[tuple[_Burst, list[_Burst]]] = []
     while pending:
         owner, rest = pending[0], pending[1:]
-        reactions = [b for b in rest if b[1] <= owner[2] and b[2] >= owner[1]]
+        reactions = [b for b in rest if b.first <= owner.last and b.last >= owner.first]
         pending = [b for b in rest if b not in reactions]
         owned.append((owner, reactions))
-    return sorted(owned, key=lambda pair: pair[0][1])
+    return sorted(owned, key=lambda pair: pair[0].first)
 
 
 def _edges(act: _Activity, i0: int, i1: int, dt: float, limits: tuple[int, int], threshold: float) -> tuple[int, int]:
@@ -262,8 +320,8 @@ def _robust_poly(t: np.ndarray, x: np.ndarray, degree: int, at: np.ndarray) -> n
     return np.polyval(coef, at)
 
 
-def _lobes(x: np.ndarray, t: np.ndarray, h: float) -> list[tuple[int, float, float, float]]:
-    """(sign, begin_s, end_s, area) of the half-waves of `x`, cut at zero crossings with hysteresis h.
+def _lobes(x: np.ndarray, t: np.ndarray, h: float) -> list[_Lobe]:
+    """The half-waves of `x`, cut at zero crossings with hysteresis h.
 
     A half-wave begins at the zero crossing before `x` passes ±h with the
     other sign; the first begins at t[0], the last ends at t[-1].
@@ -283,11 +341,14 @@ def _lobes(x: np.ndarray, t: np.ndarray, h: float) -> list[tuple[int, float, flo
     bounds.append(float(t[-1]))
     cum = np.r_[0.0, np.cumsum(0.5 * (x[1:] + x[:-1]) * np.diff(t))]
     areas = np.diff(np.interp(bounds, t, cum))
-    return [(int(state[a]), b, e, float(s)) for a, b, e, s in zip(firsts, bounds[:-1], bounds[1:], areas)]
+    return [
+        _Lobe(sign=int(state[a]), begin_s=b, end_s=e, area=float(s))
+        for a, b, e, s in zip(firsts, bounds[:-1], bounds[1:], areas)
+    ]
 
 
-def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float) -> tuple | None:
-    """(kind, f_min_hz, f_max_hz[, (first, last)]) of the maneuver on samples [lo, hi], or None.
+def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float) -> _Shape | None:
+    """Kind and frequency range of the maneuver on samples [lo, hi], or None.
 
     Doublets and 3211s come with refined bounds: the first and last sample
     of their two (four) lobes that stand out of the noise (and above 3 % of
@@ -299,35 +360,35 @@ def _classify(act: _Activity, t: np.ndarray, lo: int, hi: int, threshold: float)
         return _oscillation(lobes)
     if not lobes:
         return None
-    areas = np.array([abs(lobe[3]) for lobe in lobes])
-    durations = np.array([lobe[2] - lobe[1] for lobe in lobes])
+    areas = np.array([abs(lobe.area) for lobe in lobes])
+    durations = np.array([lobe.end_s - lobe.begin_s for lobe in lobes])
     big = np.flatnonzero(areas >= 0.25 * areas.max())
     if big.size == 2 and big[1] == big[0] + 1:
         area_ratio, time_ratio = areas[big[1]] / areas[big[0]], durations[big[1]] / durations[big[0]]
         if 1 / 3 <= area_ratio <= 3 and 1 / 3 <= time_ratio <= 3:
-            return "doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h)
+            return _Shape("doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h))
     if big.size == 3 and np.all(np.diff(big) == 1):
         # closed loop: the rate loop cancels each edge of the doublet, leaving +, -, + (middle largest);
         # the third lobe is the recovery after the doublet has ended
-        signs = [lobes[i][0] for i in big]
+        signs = [lobes[i].sign for i in big]
         if signs[0] == signs[2] == -signs[1] and areas[big[1]] == areas[big].max():
-            return "doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h)
+            return _Shape("doublet", None, None, _loud_span(x, t, lo, lobes[big[0]], lobes[big[1]], h))
     if big.size == 4 and np.all(np.diff(big) == 1):
         # the outer pulses run from the first loud sample and to the last: their steps, not the
         # zero crossings the noise or the loop's settling move away from them
         first, last = _loud_span(x, t, lo, lobes[big[0]], lobes[big[3]], h)
         steps = durations[big].copy()
-        steps[0], steps[3] = lobes[big[0]][2] - t[first], t[last] + (t[1] - t[0]) - lobes[big[3]][1]
+        steps[0], steps[3] = lobes[big[0]].end_s - t[first], t[last] + (t[1] - t[0]) - lobes[big[3]].begin_s
         unit = steps.sum() / 7.0
         if unit > 0 and np.all(np.abs(steps / unit - [3, 2, 1, 1]) <= [1.0, 0.7, 0.4, 0.4]):
-            return "3211", None, None, (first, last)
+            return _Shape("3211", None, None, (first, last))
     pair = _dominant_pair(lobes, areas)
     if pair is not None:
-        return "doublet", None, None, _loud_span(x, t, lo, lobes[pair], lobes[pair + 1], h)
+        return _Shape("doublet", None, None, _loud_span(x, t, lo, lobes[pair], lobes[pair + 1], h))
     return None
 
 
-def _loud_span(x: np.ndarray, t: np.ndarray, lo: int, first: tuple, second: tuple, h: float) -> tuple[int, int]:
+def _loud_span(x: np.ndarray, t: np.ndarray, lo: int, first: _Lobe, second: _Lobe, h: float) -> tuple[int, int]:
     """Absolute indices of the first and last sample from lobe `first` to `second` that are loud.
 
     Loud: above `h` in magnitude and above twice the relative floor of the
@@ -335,17 +396,17 @@ def _loud_span(x: np.ndarray, t: np.ndarray, lo: int, first: tuple, second: tupl
     a fraction of a percent before its first step).
     """
     local = t[lo : lo + x.size]
-    span = (local >= first[1]) & (local <= second[2])
+    span = (local >= first.begin_s) & (local <= second.end_s)
     if not span.any():
-        return _span(t, lo, first[1], second[2])
+        return _span(t, lo, first.begin_s, second.end_s)
     level = max(h, 2 * _RELATIVE_FLOOR * float(np.max(np.abs(x[span]))))
     inside = np.flatnonzero(span & (np.abs(x) > level))
     if inside.size == 0:
-        return _span(t, lo, first[1], second[2])
+        return _span(t, lo, first.begin_s, second.end_s)
     return lo + int(inside[0]), lo + int(inside[-1])
 
 
-def _dominant_pair(lobes: list, areas: np.ndarray) -> int | None:
+def _dominant_pair(lobes: list[_Lobe], areas: np.ndarray) -> int | None:
     """Index of the adjacent opposite pair of lobes that holds most of the burst, if it looks like a doublet.
 
     In closed loop with an unstable airframe the controller's reaction adds
@@ -355,7 +416,7 @@ def _dominant_pair(lobes: list, areas: np.ndarray) -> int | None:
     """
     best, best_area = None, 0.0
     for i in range(len(lobes) - 1):
-        if lobes[i][0] == -lobes[i + 1][0] and 1 / 3 <= areas[i + 1] / areas[i] <= 3:
+        if lobes[i].sign == -lobes[i + 1].sign and 1 / 3 <= areas[i + 1] / areas[i] <= 3:
             if areas[i] + areas[i + 1] > best_area:
                 best, best_area = i, areas[i] + areas[i + 1]
     return best if best is not None and best_area >= 0.45 * areas.sum() else None
@@ -367,16 +428,16 @@ def _span(t: np.ndarray, lo: int, begin_s: float, end_s: float) -> tuple[int, in
     return int(np.searchsorted(t, begin_s)), min(int(np.searchsorted(t, end_s)), t.size - 1)
 
 
-def _oscillation(lobes: list) -> tuple:
+def _oscillation(lobes: list[_Lobe]) -> _Shape:
     """Sweep (frequency trend, or one frequency) or multisine, from the half-wave durations."""
-    durations = np.array([lobe[2] - lobe[1] for lobe in lobes[:-1]])  # the last may be cut short
+    durations = np.array([lobe.end_s - lobe.begin_s for lobe in lobes[:-1]])  # the last may be cut short
     freq = 0.5 / durations
-    mid = np.array([0.5 * (lobe[1] + lobe[2]) for lobe in lobes[:-1]])
+    mid = np.array([0.5 * (lobe.begin_s + lobe.end_s) for lobe in lobes[:-1]])
     smooth = np.array([np.median(freq[max(0, i - 1) : i + 2]) for i in range(freq.size)])
     f_min, f_max = float(min(freq[0], smooth.min())), float(smooth.max())
     if (abs(spearmanr(mid, freq).statistic) > 0.6 and f_max > 2 * f_min) or f_max < 1.5 * f_min:
-        return "sweep", f_min, f_max
-    return "multisine", f_min, f_max
+        return _Shape("sweep", f_min, f_max)
+    return _Shape("multisine", f_min, f_max)
 
 
 def hover_spans(

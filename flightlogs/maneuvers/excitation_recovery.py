@@ -198,7 +198,7 @@ def _candidates(base: np.ndarray, u: np.ndarray, finite: np.ndarray, dt: float) 
     raw = np.where(finite, u - (np.median(u[finite]) if finite.any() else 0.0), 0.0)
     traces = (raw,) if np.array_equal(raw, base) else (base, raw)
     found = sorted(
-        (b[1], b[2])
+        (b.first, b.last)
         for trace in traces
         for b in _bursts("", _activity(trace, dt, _THRESHOLD, _TREND_S), dt, _THRESHOLD, _MERGE_S, _MIN_ACTIVE_S)
     )

@@ -19,7 +19,7 @@ import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
-from typing import Any, Literal, get_args
+from typing import Any, Literal, cast, get_args
 
 import numpy as np
 
@@ -217,8 +217,16 @@ def detect_segments(
     traces = _check_inputs(inputs, t.size)
     maneuvers, busy = find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s)
     segments = [
-        Segment(axis=axis, kind=kind, start_s=t[lo], end_s=t[hi], source="detected", f_min_hz=f_min, f_max_hz=f_max)
-        for axis, kind, lo, hi, f_min, f_max in maneuvers
+        Segment(
+            axis=cast(Axis, m.axis),  # the keys of `traces`, checked against AXES
+            kind=m.kind,
+            start_s=t[m.first],
+            end_s=t[m.last],
+            source="detected",
+            f_min_hz=m.f_min_hz,
+            f_max_hz=m.f_max_hz,
+        )
+        for m in maneuvers
     ]
     segments += [
         Segment(axis=None, kind="hover", start_s=a, end_s=b, source="detected")
@@ -278,7 +286,8 @@ def segments_from_sid(
 
     Examples
     --------
-    >>> run = SystemIdRun(start_s=100.0, end_s=float("nan"), axis=11, axis_name="mixer pitch", magnitude=0.1, f_start_hz=0.1, f_stop_hz=10.0, fade_in_s=2.0, const_s=20.0, record_s=34.0, fade_out_s=1.0)
+    >>> run = SystemIdRun(start_s=100.0, end_s=float("nan"), axis=11, axis_name="mixer pitch", magnitude=0.1,
+    ...                   f_start_hz=0.1, f_stop_hz=10.0, fade_in_s=2.0, const_s=20.0, record_s=34.0, fade_out_s=1.0)
     >>> seg, = segments_from_sid([run])
     >>> seg.axis, seg.start_s, seg.end_s, seg.f_min_hz
     ('lon', 101.0, 135.0, 0.1)
@@ -307,7 +316,7 @@ def segments_from_sid(
         detail = f"SID_AXIS={run.axis} ({name}), magnitude {run.magnitude:g}"
         out.append(
             Segment(
-                axis=axis,
+                axis=axis,  # type: ignore[arg-type]
                 kind="sweep",
                 start_s=start,
                 end_s=end,
@@ -316,7 +325,7 @@ def segments_from_sid(
                 f_max_hz=hi,
                 detail=detail,
             )
-        )  # type: ignore[arg-type]
+        )
     return tuple(out)
 
 
