@@ -54,7 +54,9 @@ def main() -> None:
     folder.mkdir(parents=True, exist_ok=True)
     logs_dir = folder / args.condition
     if not any(logs_dir.glob("*.bin")):
-        wind = WindCondition(args.condition, SPEEDS[args.condition], direction_from_deg=300.0, turbulence_ratio=0.2)
+        wind = WindCondition(
+            name=args.condition, mean_speed_m_s=SPEEDS[args.condition], direction_from_deg=300.0, turbulence_ratio=0.2
+        )
         scenario = replace(load_builtin("linear-sweeps"), trials=args.trials, conditions=(wind,))
         start = time.perf_counter()
         run_scenario(scenario, logs_dir)

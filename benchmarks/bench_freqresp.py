@@ -60,13 +60,17 @@ def campaign_axis(seed: int = 0) -> list[Record]:
     starts = tuple(4.0 + 40.0 * k for k in range(N_SWEEPS))
     flight = simulate_hover(
         starts[-1] + SWEEP_S + 4.0,
-        tuple(Maneuver("lon", "sweep", s, 8.0, SWEEP_S) for s in starts),
+        tuple(Maneuver(axis="lon", kind="sweep", start_s=s, amplitude=8.0, duration_s=SWEEP_S) for s in starts),
         parameters=CALM_HOVER,
         seed=seed,
     )
     table = pd.DataFrame({n: flight.signals[n] for n in ("delta_lon", *OUTPUTS)}, index=flight.time_s)
     table["excitation"] = (
-        excitation_signal(flight.time_s, tuple(Maneuver("lon", "sweep", s, 8.0, SWEEP_S) for s in starts), "lon")
+        excitation_signal(
+            flight.time_s,
+            tuple(Maneuver(axis="lon", kind="sweep", start_s=s, amplitude=8.0, duration_s=SWEEP_S) for s in starts),
+            "lon",
+        )
         / 100.0
     )
     whole = Record(

@@ -38,7 +38,7 @@ N_CONTROLLER_STATES = 6
 _AXES: tuple[Axis, ...] = ("lat", "lon", "yaw", "thr")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ControllerGains:
     """Gains and limits of the cascaded hover controller.
 
@@ -158,7 +158,7 @@ def design_gains(
     )
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Injection:
     """A 3-2-1-1 or multisine excitation on one mixer axis (sweeps and doublets are :class:`Maneuver`).
 

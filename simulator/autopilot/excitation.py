@@ -12,7 +12,7 @@ __all__ = ["Axis", "Maneuver", "sweep", "doublet", "excitation_signal", "three_t
 Axis = Literal["lat", "lon", "yaw", "thr"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Maneuver:
     """One excitation on one mixer axis.
 

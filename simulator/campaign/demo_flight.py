@@ -16,7 +16,7 @@ __all__ = ["FlightFiles", "demo_maneuvers", "write_demo_flight"]
 _DEMO_UTC = datetime(2024, 5, 1, 10, 0, 0, tzinfo=UTC)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FlightFiles:
     """The files one simulated flight leaves behind.
 
@@ -54,8 +54,8 @@ def demo_maneuvers() -> tuple[Maneuver, ...]:
         ("thr", 4.0, 8.0),
     )
     for axis, sweep_pct, doublet_pct in amplitudes:
-        plan.append(Maneuver(axis, "sweep", start, sweep_pct, 34.0))
-        plan.append(Maneuver(axis, "doublet", start + 40.0, doublet_pct, 2.0))
+        plan.append(Maneuver(axis=axis, kind="sweep", start_s=start, amplitude=sweep_pct, duration_s=34.0))
+        plan.append(Maneuver(axis=axis, kind="doublet", start_s=start + 40.0, amplitude=doublet_pct, duration_s=2.0))
         start += 50.0
     return tuple(plan)
 
@@ -88,7 +88,7 @@ def write_demo_flight(
         duration,
         maneuvers,
         parameters=CALM_HOVER,
-        wind=WindField(2.7, 300.0, 0.2),
+        wind=WindField(mean_speed_m_s=2.7, direction_from_deg=300.0, turbulence_ratio=0.2),
         wind_terms=LIGHT_WIND_TERMS,
         seed=seed,
     )

@@ -22,7 +22,7 @@ __all__ = ["TrialPlan", "TrialFiles", "plan_trials", "scenario_trials", "run_sce
 _GAP_BETWEEN_TRIALS_S = 60.0
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class TrialPlan:
     """One trial of a scenario.
 
@@ -56,7 +56,7 @@ class TrialPlan:
     utc_start: datetime
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class TrialFiles:
     """What one trial left on disk.
 
@@ -100,7 +100,16 @@ def plan_trials(scenario: Scenario) -> list[TrialPlan]:
                 duration = _duration(spec, scenario.margin_s)
                 name = f"{condition.name}-{spec.axis}-{spec.kind}-{repeat + 1}"
                 plans.append(
-                    TrialPlan(len(plans), name, condition, spec, maneuvers, duration, scenario.seed + len(plans), utc)
+                    TrialPlan(
+                        index=len(plans),
+                        name=name,
+                        condition=condition,
+                        spec=spec,
+                        maneuvers=maneuvers,
+                        duration_s=duration,
+                        seed=scenario.seed + len(plans),
+                        utc_start=utc,
+                    )
                 )
                 utc = utc + timedelta(seconds=duration + _GAP_BETWEEN_TRIALS_S)
     return plans
@@ -112,15 +121,15 @@ def _maneuvers(spec: ManeuverSpec, margin_s: float) -> tuple[Maneuver, ...]:
     fade = min(spec.fade_in_s, spec.duration_s / 3)
     return (
         Maneuver(
-            spec.axis,
-            spec.kind,
-            margin_s,
-            spec.amplitude,
-            spec.duration_s,  # type: ignore[arg-type]
-            spec.f_start_hz,
-            spec.f_stop_hz,
-            fade,
-            min(1.0, spec.duration_s / 10),
+            axis=spec.axis,
+            kind=spec.kind,
+            start_s=margin_s,
+            amplitude=spec.amplitude,
+            duration_s=spec.duration_s,  # type: ignore[arg-type]
+            f_start_hz=spec.f_start_hz,
+            f_stop_hz=spec.f_stop_hz,
+            fade_in_s=fade,
+            fade_out_s=min(1.0, spec.duration_s / 10),
         ),
     )
 
@@ -132,13 +141,13 @@ def _injections(spec: ManeuverSpec, margin_s: float) -> tuple[Any, ...]:
 
     return (
         Injection(
-            spec.axis,
-            spec.kind,
-            margin_s,
-            spec.amplitude,
-            spec.duration_s,  # type: ignore[arg-type]
-            spec.f_start_hz,
-            spec.f_stop_hz,
+            axis=spec.axis,
+            kind=spec.kind,
+            start_s=margin_s,
+            amplitude=spec.amplitude,
+            duration_s=spec.duration_s,  # type: ignore[arg-type]
+            f_min_hz=spec.f_start_hz,
+            f_max_hz=spec.f_stop_hz,
         ),
     )
 
@@ -166,7 +175,9 @@ def _nonlinear_trial(scenario: Scenario, plan: TrialPlan) -> Any:
             condition.mean_speed_m_s,
             scale=condition.turbulence_ratio * condition.mean_speed_m_s / nominal.sigma_m_s[0],
         )
-    wind = Wind(condition.mean_speed_m_s, condition.direction_from_deg, turbulence)
+    wind = Wind(
+        mean_speed_m_s=condition.mean_speed_m_s, direction_from_deg=condition.direction_from_deg, turbulence=turbulence
+    )
     anemometer = Anemometer(distance_m=scenario.anemometer.distance_m) if scenario.anemometer else Anemometer()
     ground = str(scenario.effects.get("ground_effect", "none")).replace("-", "_").replace("4_rotor", "4rotor")
     ground = ground.replace("2_rotor", "2rotor")
@@ -176,9 +187,9 @@ def _nonlinear_trial(scenario: Scenario, plan: TrialPlan) -> Any:
         times = tuple(scenario.margin_s + k * spec.hold_s for k in range(len(spec.heights_m)))
         steps = HeightSteps(times, spec.heights_m)
     return Trial(
-        plan.duration_s,
-        plan.maneuvers,
-        _injections(spec, scenario.margin_s),
+        duration_s=plan.duration_s,
+        maneuvers=plan.maneuvers,
+        injections=_injections(spec, scenario.margin_s),
         environment=environment,
         seed=plan.seed,
         hover_height_m=height,
@@ -224,7 +235,11 @@ def _simulate(
 
 def _simulate_linear(plan: TrialPlan) -> SimulatedFlight:
     condition = plan.condition
-    wind = WindField(condition.mean_speed_m_s, condition.direction_from_deg, condition.turbulence_ratio)
+    wind = WindField(
+        mean_speed_m_s=condition.mean_speed_m_s,
+        direction_from_deg=condition.direction_from_deg,
+        turbulence_ratio=condition.turbulence_ratio,
+    )
     return simulate_hover(
         plan.duration_s,
         plan.maneuvers,
@@ -247,12 +262,12 @@ def _write_trial(scenario: Scenario, plan: TrialPlan, flight: SimulatedFlight, f
     wind_csv = None
     if scenario.anemometer is not None and plan.condition.mean_speed_m_s > 0:
         spec = scenario.anemometer
-        setup = AnemometerSetup(spec.distance_m, spec.rate_hz, spec.clock_offset_s)
+        setup = AnemometerSetup(distance_m=spec.distance_m, rate_hz=spec.rate_hz, clock_offset_s=spec.clock_offset_s)
         wind_csv = write_anemometer_csv(
             flight, folder / f"{plan.name}-anemometer.csv", utc_start=plan.utc_start, setup=setup
         )
     truth = write_truth(flight, folder / f"{plan.name}-truth.json", utc_start=plan.utc_start, setup=setup)
-    return TrialFiles(plan, tuple(logs), wind_csv, truth)
+    return TrialFiles(plan=plan, logs=tuple(logs), wind_csv=wind_csv, truth=truth)
 
 
 def run_scenario(

@@ -60,7 +60,7 @@ ManeuverKind = Literal["sweep", "doublet", "3211", "multisine", "height_steps"]
 _AXES = ("lat", "lon", "yaw", "thr")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindCondition:
     """One wind condition of a campaign.
 
@@ -86,7 +86,7 @@ class WindCondition:
             raise DataError(f"wind condition {self.name!r}: speed and turbulence ratio must be ≥ 0")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ManeuverSpec:
     """One maneuver flown in every trial of a condition.
 
@@ -132,7 +132,7 @@ class ManeuverSpec:
         object.__setattr__(self, "heights_m", tuple(float(h) for h in self.heights_m))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class AnemometerSpec:
     """The ground anemometer of a campaign.
 
@@ -151,7 +151,7 @@ class AnemometerSpec:
     clock_offset_s: float = 0.0
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Scenario:
     """A simulated flight-test campaign.
 

@@ -33,7 +33,7 @@ __all__ = ["NonlinearFlight", "run_batch"]
 _MARGIN_M = 30.0  # along-wind room for the vehicle's excursions
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class NonlinearFlight(SimulatedFlight):
     """A simulated flight with the anemometer's record and the noise-free truth.
 
@@ -83,7 +83,7 @@ class NonlinearFlight(SimulatedFlight):
                 raise ValueError(f"signal {name!r} must have shape ({n},), got {np.shape(values)}")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class _Setup:
     """Everything fixed before the first step (arrays over trials, and over steps where they vary)."""
 
@@ -150,12 +150,22 @@ def _setup(
     cg = np.array([e.cg_offset_m for e in envs], dtype=np.float64)
     drag = np.array([float(e.rotor_drag) for e in envs])
     sag = np.array([float(e.thrust_sag) for e in envs])
-    conditions = Conditions(cg, drag, sag, ground_effect_function([e.ground_effect for e in envs]), gravity)
+    conditions = Conditions(
+        cg_offset_m=cg,
+        rotor_drag=drag,
+        thrust_sag=sag,
+        ground_effect=ground_effect_function([e.ground_effect for e in envs]),
+        gravity_m_s2=gravity,
+    )
     cache: dict = {}
     trims = []
     for k, trial in enumerate(trials):
         single = Conditions(
-            cg[k : k + 1], drag[k : k + 1], sag[k : k + 1], ground_effect_function([envs[k].ground_effect]), gravity
+            cg_offset_m=cg[k : k + 1],
+            rotor_drag=drag[k : k + 1],
+            thrust_sag=sag[k : k + 1],
+            ground_effect=ground_effect_function([envs[k].ground_effect]),
+            gravity_m_s2=gravity,
         )
         trims.append(_trim_for(trial, vehicle, single, cache))
     state0 = np.array([t.state for t in trims])
@@ -186,26 +196,26 @@ def _setup(
     delays = np.maximum(vehicle.delays_s / dt - 0.5, 0.0)  # the zero-order hold adds half a step
     whole = np.floor(delays).astype(np.intp)
     return _Setup(
-        dt,
-        n_steps,
-        decimation,
-        conditions,
-        np.full(n, vehicle.mass_kg),
-        np.array([e.payload.delta_mass_kg if e.payload else 0.0 for e in envs]),
-        np.array([e.payload.time_s if e.payload else np.inf for e in envs]),
-        state0,
-        initial_controller_state(gains, euler, mixer_trim, gravity),
-        mixer_trim,
-        reference,
-        heights,
-        excitation,
-        BatchWindField.stack([t.environment.wind for t in trials], fields),
-        fields,
-        np.array(anemometers),
-        whole,
-        delays - whole,
-        int(whole.max()) + 2,
-        np.stack([_seen_noise(t, n_steps // decimation + 1) for t in trials], axis=1),
+        dt_s=dt,
+        n_steps=n_steps,
+        decimation=decimation,
+        conditions=conditions,
+        mass_kg=np.full(n, vehicle.mass_kg),
+        payload_kg=np.array([e.payload.delta_mass_kg if e.payload else 0.0 for e in envs]),
+        payload_time_s=np.array([e.payload.time_s if e.payload else np.inf for e in envs]),
+        state0=state0,
+        integrators0=initial_controller_state(gains, euler, mixer_trim, gravity),
+        mixer_trim=mixer_trim,
+        reference=reference,
+        height_ref=heights,
+        excitation=excitation,
+        wind=BatchWindField.stack([t.environment.wind for t in trials], fields),
+        fields=fields,
+        anemometer_ne=np.array(anemometers),
+        delay_whole=whole,
+        delay_frac=delays - whole,
+        buffer_len=int(whole.max()) + 2,
+        seen_noise=np.stack([_seen_noise(t, n_steps // decimation + 1) for t in trials], axis=1),
     )
 
 
@@ -444,17 +454,17 @@ def run_batch(
         }
         flights.append(
             NonlinearFlight(
-                time,
-                MappingProxyType(noisy),
-                np.ascontiguousarray(logs["wind"][:, i, :2]),
-                tuple(trial.maneuvers),
-                {},
-                _anemometer_wind(setup.fields[i], trial, setup.anemometer_ne[i], time),
-                setup.anemometer_ne[i].copy(),
-                trial.environment.anemometer.transport_delay_s(wind),
-                MappingProxyType(truth),
-                tuple(trial.injections),
-                trial.label,
+                time_s=time,
+                signals=MappingProxyType(noisy),
+                wind_at_vehicle=np.ascontiguousarray(logs["wind"][:, i, :2]),
+                maneuvers=tuple(trial.maneuvers),
+                parameters={},
+                wind_at_anemometer=_anemometer_wind(setup.fields[i], trial, setup.anemometer_ne[i], time),
+                anemometer_ne_m=setup.anemometer_ne[i].copy(),
+                transport_delay_s=trial.environment.anemometer.transport_delay_s(wind),
+                truth=MappingProxyType(truth),
+                injections=tuple(trial.injections),
+                label=trial.label,
             )
         )
     return flights

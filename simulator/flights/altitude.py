@@ -68,7 +68,7 @@ class AltitudeController(Protocol):
         """PWM per rotor, counts, shape (n_trials,), for the next `dt_s` (`command_m` shape (n_trials,))."""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class AltitudeVehicle:
     """The heave axis of a multirotor with thrust linear in PWM (eq. 2.6).
 
@@ -225,7 +225,7 @@ class AltitudeVehicle:
 CRAZYFLIE_ALTITUDE: AltitudeVehicle = AltitudeVehicle.from_vehicle(CRAZYFLIE, gear_height_m=CRAZYFLIE_GEAR_HEIGHT_M)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class AltitudeRun:
     """A batch of heave simulations sampled at the control rate.
 
@@ -356,7 +356,7 @@ def simulate_altitude(
         raise ValueError("commanded and initial heights must be finite and >= 0")
     if rate_hz <= 0 or substeps < 1:
         raise ValueError(f"{rate_hz=} must be > 0 and {substeps=} >= 1")
-    law: ThrustRatioModel = ground_effect if ground_effect is not None else GroundEffect("fitted_4rotor")
+    law: ThrustRatioModel = ground_effect if ground_effect is not None else GroundEffect(model="fitted_4rotor")
     n_steps, dt = command.shape[0], 1.0 / rate_hz
     v = np.zeros(n)
     trim = vehicle.hover_pwm / np.asarray(law.ratio(vehicle.height_ratio(z)), dtype=np.float64)
@@ -388,12 +388,12 @@ def simulate_altitude(
         if progress is not None and (k % 1000 == 0 or k == n_steps - 1):
             progress(k + 1, n_steps)
     return AltitudeRun(
-        np.arange(n_steps) * dt,
-        command,
-        out["z"],
-        out["v"],
-        out["zm"],
-        out["pwm"],
-        out["ratio"],
-        tuple(int(s) for s in seeds),
+        time_s=np.arange(n_steps) * dt,
+        command_m=command,
+        height_m=out["z"],
+        climb_rate_m_s=out["v"],
+        measured_height_m=out["zm"],
+        pwm=out["pwm"],
+        thrust_ratio=out["ratio"],
+        seeds=tuple(int(s) for s in seeds),
     )

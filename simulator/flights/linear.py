@@ -24,7 +24,7 @@ __all__ = ["WindField", "SimulatedFlight", "simulate_hover"]
 _AXES: tuple[Axis, ...] = ("lat", "lon", "yaw", "thr")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindField:
     """Horizontal wind: a mean plus frozen turbulence.
 
@@ -66,7 +66,7 @@ class WindField:
         return mean + gusts
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class SimulatedFlight:
     """Truth and measurements of one simulated flight on its 100 Hz log clock.
 
@@ -230,7 +230,11 @@ def simulate_hover(
     _add_sensor_noise(signals, rng)
     truth = dict(parameters) | terms
     return SimulatedFlight(
-        t_fine[pick], MappingProxyType(signals), wind_ne[pick], tuple(maneuvers), MappingProxyType(truth)
+        time_s=t_fine[pick],
+        signals=MappingProxyType(signals),
+        wind_at_vehicle=wind_ne[pick],
+        maneuvers=tuple(maneuvers),
+        parameters=MappingProxyType(truth),
     )
 
 

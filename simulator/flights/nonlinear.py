@@ -31,7 +31,7 @@ from simulator.world.environment import Environment
 __all__ = ["Trial", "NonlinearFlight", "simulate_flights", "truth_parameters"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Trial:
     """One flight to simulate.
 
@@ -138,7 +138,7 @@ def simulate_flights(
 
     Examples
     --------
-    >>> flight = simulate_flights([Trial(1.0, environment=Environment())])[0]
+    >>> flight = simulate_flights([Trial(duration_s=1.0, environment=Environment())])[0]
     >>> flight.signals["az"].size, round(float(np.mean(flight.truth["az"])), 2)
     (100, -9.81)
     """
@@ -188,15 +188,15 @@ def _with_truth(flight: NonlinearFlight, truth: Mapping[str, float], trial: Tria
         "seed": float(trial.seed),
     }
     return NonlinearFlight(
-        flight.time_s,
-        flight.signals,
-        flight.wind_at_vehicle,
-        flight.maneuvers,
-        MappingProxyType(dict(truth) | settings),
-        flight.wind_at_anemometer,
-        flight.anemometer_ne_m,
-        flight.transport_delay_s,
-        flight.truth,
-        flight.injections,
-        flight.label,
+        time_s=flight.time_s,
+        signals=flight.signals,
+        wind_at_vehicle=flight.wind_at_vehicle,
+        maneuvers=flight.maneuvers,
+        parameters=MappingProxyType(dict(truth) | settings),
+        wind_at_anemometer=flight.wind_at_anemometer,
+        anemometer_ne_m=flight.anemometer_ne_m,
+        transport_delay_s=flight.transport_delay_s,
+        truth=flight.truth,
+        injections=flight.injections,
+        label=flight.label,
     )

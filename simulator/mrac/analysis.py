@@ -22,7 +22,7 @@ from simulator.world.environment import GroundEffect
 __all__ = ["LoopAnalysis", "loop_analysis"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class LoopAnalysis:
     """The PID z loop linearised at one height (thrust in N, heights in m).
 
@@ -120,7 +120,7 @@ def loop_analysis(
     >>> round(out.integrator_time_constant_s, 1)
     14.1
     """
-    law: ThrustRatioModel = ground_effect if ground_effect is not None else GroundEffect("fitted_4rotor")
+    law: ThrustRatioModel = ground_effect if ground_effect is not None else GroundEffect(model="fitted_4rotor")
     weight = vehicle.mass_kg * vehicle.gravity_m_s2
     dz = 1e-4
     heights = np.array([max(height_m - dz, 0.0), height_m, height_m + dz])

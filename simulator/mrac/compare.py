@@ -54,7 +54,7 @@ CONTROLLERS: tuple[ControllerName, ...] = ("pid", "mrac_linear", "mrac_rbf")
 _TABLE_HEIGHTS_M: tuple[tuple[float, float], ...] = ((4.0, 0.062), (3.0, 0.042), (2.0, 0.022))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class StepCase:
     """The two commanded heights of one take-off/landing experiment.
 
@@ -136,11 +136,11 @@ def step_case(
         table = dict(_TABLE_HEIGHTS_M)
         if table_heights and height_ratio in table:
             height = table[height_ratio]
-        return StepCase(float(height_ratio), 0.0, height, True)
-    return StepCase(float(height_ratio), height, height + step_m, False)
+        return StepCase(height_ratio=float(height_ratio), low_m=0.0, high_m=height, in_ground_effect=True)
+    return StepCase(height_ratio=float(height_ratio), low_m=height, high_m=height + step_m, in_ground_effect=False)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class CompareConfig:
     """What to fly in :func:`compare_controllers`.
 
@@ -195,7 +195,7 @@ class CompareConfig:
         return tuple(int(s) for s in np.random.SeedSequence(self.seed).generate_state(self.trials))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ControllerResult:
     """One controller flying one case.
 
@@ -248,7 +248,7 @@ class ControllerResult:
         return self.takeoff if phase == "takeoff" else self.landing
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class MracComparison:
     """All controllers on all cases.
 
@@ -339,14 +339,14 @@ def _controller(name: str, config: CompareConfig, vehicle: AltitudeVehicle) -> P
 
 def _columns(run: AltitudeRun, cols: slice) -> AltitudeRun:
     return AltitudeRun(
-        run.time_s,
-        run.command_m[:, cols],
-        run.height_m[:, cols],
-        run.climb_rate_m_s[:, cols],
-        run.measured_height_m[:, cols],
-        run.pwm[:, cols],
-        run.thrust_ratio[:, cols],
-        run.seeds[cols],
+        time_s=run.time_s,
+        command_m=run.command_m[:, cols],
+        height_m=run.height_m[:, cols],
+        climb_rate_m_s=run.climb_rate_m_s[:, cols],
+        measured_height_m=run.measured_height_m[:, cols],
+        pwm=run.pwm[:, cols],
+        thrust_ratio=run.thrust_ratio[:, cols],
+        seeds=run.seeds[cols],
     )
 
 
@@ -396,14 +396,23 @@ def _fly(
             None
             if history is None
             else AdaptiveHistory(
-                history.theta[:, cols],
-                history.reference_height_m[:, cols],
-                history.adaptive_thrust_n[:, cols],
-                history.labels,
+                theta=history.theta[:, cols],
+                reference_height_m=history.reference_height_m[:, cols],
+                adaptive_thrust_n=history.adaptive_thrust_n[:, cols],
+                labels=history.labels,
             )
         )
         results.append(
-            ControllerResult(name, case, float(phase_s), _columns(run, cols), reference, adaptive, takeoff, landing)
+            ControllerResult(
+                controller=name,
+                case=case,
+                phase_s=float(phase_s),
+                run=_columns(run, cols),
+                reference_m=reference,
+                adaptive=adaptive,
+                takeoff=takeoff,
+                landing=landing,
+            )
         )
     return results
 
@@ -443,7 +452,7 @@ def compare_controllers(
     >>> [r.controller for r in comparison.results]
     ['pid', 'mrac_linear', 'mrac_rbf']
     """
-    law: ThrustRatioModel = ground_effect if ground_effect is not None else GroundEffect("fitted_4rotor")
+    law: ThrustRatioModel = ground_effect if ground_effect is not None else GroundEffect(model="fitted_4rotor")
     label = ground_effect_label or ("eq. 2.5 (fitted, 4 rotors)" if ground_effect is None else type(law).__name__)
     cases = [step_case(r, vehicle=vehicle, table_heights=vehicle == CRAZYFLIE_ALTITUDE) for r in config.height_ratios]
     lengths = [
@@ -461,4 +470,4 @@ def compare_controllers(
     analyses = tuple(
         loop_analysis(case.high_m, vehicle=vehicle, ground_effect=law, gamma=config.gamma) for case in cases
     )
-    return MracComparison(config, vehicle, label, results, analyses)
+    return MracComparison(config=config, vehicle=vehicle, ground_effect=label, results=results, analyses=analyses)

@@ -47,7 +47,7 @@ from simulator.mrac.reference import REFERENCE_EQ_2_20, ReferenceModel
 __all__ = ["PidGains", "PidAltitude", "AdaptiveHistory", "MracAltitude"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class PidGains:
     """Gains of the z loop in PWM counts (Table 2.5).
 
@@ -148,7 +148,7 @@ class PidAltitude:
         return pwm
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class AdaptiveHistory:
     """What an MRAC did at each control step (values before that step's update).
 
@@ -298,6 +298,16 @@ class MracAltitude:
         """
         n, k = self._origin.size, self.regressor.n_basis
         if not self._log:
-            return AdaptiveHistory(np.zeros((0, n, k)), np.zeros((0, n)), np.zeros((0, n)), self.regressor.labels)
+            return AdaptiveHistory(
+                theta=np.zeros((0, n, k)),
+                reference_height_m=np.zeros((0, n)),
+                adaptive_thrust_n=np.zeros((0, n)),
+                labels=self.regressor.labels,
+            )
         theta, reference, adaptive = zip(*self._log)
-        return AdaptiveHistory(np.stack(theta), np.stack(reference), np.stack(adaptive), self.regressor.labels)
+        return AdaptiveHistory(
+            theta=np.stack(theta),
+            reference_height_m=np.stack(reference),
+            adaptive_thrust_n=np.stack(adaptive),
+            labels=self.regressor.labels,
+        )

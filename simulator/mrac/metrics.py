@@ -10,7 +10,7 @@ import numpy as np
 __all__ = ["StepMetrics", "step_metrics", "Statistic", "MetricStatistics", "statistics"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class StepMetrics:
     """Indices of one step response (NaN where an index is undefined).
 
@@ -138,7 +138,7 @@ def step_metrics(
     )
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Statistic:
     """Mean and sample standard deviation over the finite values of a set.
 
@@ -184,12 +184,12 @@ class Statistic:
         array = np.asarray(values, dtype=np.float64)
         finite = array[np.isfinite(array)]
         if finite.size == 0:
-            return cls(float("nan"), float("nan"), 0, array.size)
+            return cls(mean=float("nan"), std=float("nan"), n=0, total=array.size)
         std = float(np.std(finite, ddof=1)) if finite.size > 1 else 0.0
-        return cls(float(np.mean(finite)), std, int(finite.size), int(array.size))
+        return cls(mean=float(np.mean(finite)), std=std, n=int(finite.size), total=int(array.size))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class MetricStatistics:
     """Mean and spread of each index of Tables 2.6-2.8 over a set of step responses.
 
@@ -230,4 +230,6 @@ def statistics(metrics: Sequence[StepMetrics]) -> MetricStatistics:
     -------
     MetricStatistics
     """
-    return MetricStatistics(*(Statistic.of([getattr(m, f.name) for m in metrics]) for f in fields(StepMetrics)))
+    return MetricStatistics(
+        **{f.name: Statistic.of([getattr(m, f.name) for m in metrics]) for f in fields(StepMetrics)}
+    )

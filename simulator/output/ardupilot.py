@@ -42,7 +42,7 @@ _EARTH_RADIUS_M = 6_371_008.8
 _HOLD_S = 2.0  # time constant of the position hold's wander
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class AnemometerSetup:
     """Where the ground anemometer stands and how its clock is off.
 

@@ -55,7 +55,7 @@ _Signals = Mapping[str, np.ndarray]
 _SDLOG_PROFILE = 1 | 8  # default set + system identification (high-rate rates, setpoints, motors)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Airframe:
     """A multirotor as PX4 parameters describe it.
 
@@ -140,9 +140,23 @@ class Airframe:
 #: octorotor X (8001; motors every 45° from 22.5°, alternating spin, as the ArduPilot writer).
 AIRFRAMES: Mapping[str, Airframe] = MappingProxyType(
     {
-        "quad": Airframe("quad", 4001, 2, (45.0, 225.0, 315.0, 135.0), (1, 1, -1, -1), 0.25, 4),
+        "quad": Airframe(
+            name="quad",
+            autostart=4001,
+            mav_type=2,
+            angles_deg=(45.0, 225.0, 315.0, 135.0),
+            spins=(1, 1, -1, -1),
+            arm_m=0.25,
+            cells=4,
+        ),
         "octo": Airframe(
-            "octo", 8001, 14, tuple(22.5 + 45.0 * k for k in range(8)), (1, -1, 1, -1, 1, -1, 1, -1), 0.5, 6
+            name="octo",
+            autostart=8001,
+            mav_type=14,
+            angles_deg=tuple(22.5 + 45.0 * k for k in range(8)),
+            spins=(1, -1, 1, -1, 1, -1, 1, -1),
+            arm_m=0.5,
+            cells=6,
         ),
     }
 )

@@ -13,7 +13,7 @@ from simulator.vehicle.multirotor import Vehicle
 __all__ = ["Conditions", "vehicle_derivative"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Conditions:
     """Per-trial physics switches and offsets for :func:`vehicle_derivative`.
 
@@ -57,7 +57,13 @@ class Conditions:
         -------
         Conditions
         """
-        return cls(np.zeros((n_trials, 3)), np.ones(n_trials), np.zeros(n_trials), None, gravity_m_s2)
+        return cls(
+            cg_offset_m=np.zeros((n_trials, 3)),
+            rotor_drag=np.ones(n_trials),
+            thrust_sag=np.zeros(n_trials),
+            ground_effect=None,
+            gravity_m_s2=gravity_m_s2,
+        )
 
 
 def _rotation(quaternion: np.ndarray) -> tuple[np.ndarray, ...]:

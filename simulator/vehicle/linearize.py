@@ -43,7 +43,7 @@ MIXER_INPUTS = ("delta_lat", "delta_lon", "delta_yaw", "delta_thr")
 _RIGID = EQ33_STATES[:9]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Trim:
     """A steady hover over a point in a steady wind.
 
@@ -72,7 +72,7 @@ class Trim:
         return quaternion_to_euler(self.state[None, 6:10])[0]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class LinearModel:
     """A continuous linear model x' = A x + B u(t - tau).
 
@@ -110,7 +110,7 @@ class LinearModel:
         return np.linalg.eigvals(self.a)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class EigenComparison:
     """Eigenvalues of a reference model paired with the nearest of another model's.
 
@@ -248,7 +248,7 @@ def trim_hover(
         raise RuntimeError(f"no hover trim for {vehicle.name} in wind {wind.tolist()} m/s: {solution.message}")
     state, delta_arr = build(solution.x)
     thrust = vehicle.thrust_curve(state[13 : 13 + vehicle.n_rotors])
-    return Trim(state, delta_arr, wind, float(np.sum(thrust)))
+    return Trim(state=state, mixer_input=delta_arr, wind_ned=wind, total_thrust_n=float(np.sum(thrust)))
 
 
 def _air_body(phi: float, theta: float, psi: float, air_ned: np.ndarray) -> np.ndarray:
@@ -328,7 +328,14 @@ def linearize_hover(
     dropped = [i for i in range(a_new.shape[0]) if i not in keep]
     coupling = float(np.max(np.abs(a_new[np.ix_(keep, dropped)]))) if dropped else 0.0
     delays = dict(zip(MIXER_INPUTS, vehicle.delays_s.tolist()))
-    return LinearModel(a_new[np.ix_(keep, keep)], b_new[keep], EQ33_STATES, MIXER_INPUTS, delays, coupling)
+    return LinearModel(
+        a=a_new[np.ix_(keep, keep)],
+        b=b_new[keep],
+        states=EQ33_STATES,
+        inputs=MIXER_INPUTS,
+        delays_s=delays,
+        dropped_coupling=coupling,
+    )
 
 
 def reference_model(parameters: Mapping[str, float] = CALM_HOVER, *, gravity_m_s2: float = 9.81) -> LinearModel:
@@ -368,7 +375,7 @@ def reference_model(parameters: Mapping[str, float] = CALM_HOVER, *, gravity_m_s
         a[idx[state], idx[state]] = -1.0 / p["T_a"]
         b[idx[state], k] = 1.0 / p["T_a"]
     delays = {name: float(p.get(f"tau_{name.split('_')[1]}", 0.0)) for name in MIXER_INPUTS}
-    return LinearModel(a, b, EQ33_STATES, MIXER_INPUTS, delays)
+    return LinearModel(a=a, b=b, states=EQ33_STATES, inputs=MIXER_INPUTS, delays_s=delays)
 
 
 def hover_derivatives(model: LinearModel) -> dict[str, float]:
@@ -427,4 +434,4 @@ def compare_eigenvalues(reference: LinearModel, other: LinearModel, *, zero_tol:
     order = np.argsort(rows)
     ref_sorted, paired = ref[rows[order]], oth[cols[order]]
     scale = np.where(np.abs(ref_sorted) > zero_tol, np.abs(ref_sorted), 1.0)
-    return EigenComparison(ref_sorted, paired, np.abs(paired - ref_sorted) / scale)
+    return EigenComparison(reference=ref_sorted, paired=paired, error=np.abs(paired - ref_sorted) / scale)

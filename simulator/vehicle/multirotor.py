@@ -60,7 +60,7 @@ def _array(value: object, shape: tuple[int, ...], name: str) -> np.ndarray:
     return array
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Battery:
     """A lithium-polymer pack: open-circuit voltage falls with the charge drawn.
 
@@ -112,7 +112,7 @@ class Battery:
         return self.full_v - (self.full_v - self.empty_v) * np.asarray(charge_c) / (3600.0 * self.capacity_ah)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Vehicle:
     """A multirotor's physical and mixer parameters (SI, radians; mixer in % of input).
 

@@ -238,7 +238,7 @@ def octocopter(
         thrust_expo=1.0,
         torque_ratio_m=0.016,
         max_speed_rad_s=720.0,
-        battery=Battery(25.2, 21.0, 16.0, 0.02, 0.5),
+        battery=Battery(full_v=25.2, empty_v=21.0, capacity_ah=16.0, resistance_ohm=0.02, time_constant_s=0.5),
     )
 
 
@@ -276,7 +276,7 @@ def crazyflie(*, mass_kg: float = 0.03812) -> Vehicle:
     mixer = np.column_stack(
         [-np.sign(positions[:, 1]) * 0.005, np.sign(positions[:, 0]) * 0.005, spins * 0.005, np.full(4, 0.01)]
     )
-    battery = Battery(4.2, 3.3, 0.25, 0.15, 0.5)
+    battery = Battery(full_v=4.2, empty_v=3.3, capacity_ah=0.25, resistance_ohm=0.15, time_constant_s=0.5)
     power = 1.0 / (0.5 * 0.7 * np.sqrt(2 * _RHO_AIR * np.pi * 0.0225**2))
     return Vehicle(
         name="crazyflie",

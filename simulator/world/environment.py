@@ -92,7 +92,7 @@ def thrust_ratio(
     raise ValueError(f"unknown ground-effect model {model!r}; choose from {_MODELS}")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class GroundEffect:
     """A ground-effect model and its constants (see :func:`thrust_ratio`).
 
@@ -241,7 +241,7 @@ class PayloadChange:
     delta_mass_kg: float
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class SensorNoise:
     """White noise and constant biases on the logged signals (1 sigma; biases in body axes).
 
@@ -286,7 +286,15 @@ class SensorNoise:
         -------
         SensorNoise
         """
-        return cls(0.0, (0.0, 0.0, 0.0), 0.0, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0)
+        return cls(
+            gyro_rad_s=0.0,
+            gyro_bias_rad_s=(0.0, 0.0, 0.0),
+            accel_m_s2=0.0,
+            accel_bias_m_s2=(0.0, 0.0, 0.0),
+            attitude_rad=0.0,
+            velocity_m_s=0.0,
+            height_m=0.0,
+        )
 
     def apply(self, signals: dict[str, np.ndarray], rng: np.random.Generator) -> dict[str, np.ndarray]:
         """Noisy copies of the canonical signals (others unchanged).
@@ -324,7 +332,7 @@ class SensorNoise:
         return out
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Environment:
     """Everything outside the vehicle for one trial.
 

@@ -87,7 +87,7 @@ class Dryden:
         return cls((sigma_u, sigma_u, sigma_w), (length_u, length_u, h_ft * _FT))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Gust:
     """A discrete 1-cosine gust, frozen into the field.
 
@@ -115,7 +115,7 @@ class Gust:
             raise ValueError(f"component={self.component!r} must be along, across or vertical")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Wind:
     """Mean wind plus optional Dryden turbulence and discrete gusts.
 
@@ -180,7 +180,11 @@ class Wind:
         Wind
         """
         speed = {"calm": 0.9, "light": 2.7, "strong": 5.4}[kind]
-        return cls(speed, direction_from_deg, Dryden.low_altitude(height_m, speed) if turbulence else None)
+        return cls(
+            mean_speed_m_s=speed,
+            direction_from_deg=direction_from_deg,
+            turbulence=Dryden.low_altitude(height_m, speed) if turbulence else None,
+        )
 
 
 def dryden_psd(
@@ -224,7 +228,7 @@ def dryden_psd(
     return sigma_m_s**2 * length_m / (np.pi * speed_m_s) * shape
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FrozenField:
     """Gust velocities on a uniform grid of the along-wind coordinate xi.
 
@@ -318,10 +322,10 @@ def realize_field(
         inside = (xi <= start) & (xi >= start - length)
         k = ("along", "across", "vertical").index(gust.component)
         values[inside, k] += gust.amplitude_m_s / 2 * (1 - np.cos(2 * np.pi * (start - xi[inside]) / length))
-    return FrozenField(float(xi_min_m), float(dxi), values)
+    return FrozenField(xi0_m=float(xi_min_m), dxi_m=float(dxi), values=values)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class BatchWindField:
     """The frozen fields of a batch of trials, sampled at arbitrary points in one vectorised gather.
 
@@ -376,12 +380,12 @@ class BatchWindField:
         for k, f in enumerate(fields):
             stacked[k, : f.values.shape[0]] = f.values
         return cls(
-            stacked,
-            np.array([f.xi0_m for f in fields]),
-            np.array([f.dxi_m for f in fields]),
-            np.array([w.mean_ned for w in winds]),
-            np.array([w.towards for w in winds]),
-            np.array([w.mean_speed_m_s for w in winds]),
+            fields=stacked,
+            xi0_m=np.array([f.xi0_m for f in fields]),
+            dxi_m=np.array([f.dxi_m for f in fields]),
+            mean_ned=np.array([w.mean_ned for w in winds]),
+            towards=np.array([w.towards for w in winds]),
+            speed_m_s=np.array([w.mean_speed_m_s for w in winds]),
         )
 
     def gusts(self, xi_m: np.ndarray) -> np.ndarray:

@@ -91,7 +91,12 @@ def test_the_reference_can_be_switched_off(demo: dict[str, Path]) -> None:
 
 def test_a_px4_log_has_no_excitation_and_the_mixer_input_is_used(tmp_path: Path) -> None:
     """PX4 logs no injected excitation: the responses come from the mixer input, and the notes say so."""
-    flight = simulate_hover(50.0, (Maneuver("lon", "sweep", 8.0, 8.0, 34.0),), parameters=CALM_HOVER, seed=2)
+    flight = simulate_hover(
+        50.0,
+        (Maneuver(axis="lon", kind="sweep", start_s=8.0, amplitude=8.0, duration_s=34.0),),
+        parameters=CALM_HOVER,
+        seed=2,
+    )
     log = write_px4_log(flight, tmp_path / "sweep.ulg", utc_start=datetime(2024, 5, 1, 10, tzinfo=UTC))
     result = CliRunner().invoke(cli, ["freqresp", str(log), "--pairs", "q/delta_lon", "--json", "-", "-q"])
     assert result.exit_code == 0, result.output

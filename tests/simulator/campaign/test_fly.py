@@ -131,8 +131,8 @@ def test_the_logged_gps_is_the_path_flown(tmp_path: Path) -> None:
     from simulator.world.environment import Environment
     from simulator.world.wind_field import Dryden, Wind
 
-    wind = Wind(5.4, 300.0, Dryden.low_altitude(4.6, 5.4))
-    (flight,) = simulate_flights([Trial(10.0, environment=Environment(wind=wind), seed=3)])
+    wind = Wind(mean_speed_m_s=5.4, direction_from_deg=300.0, turbulence=Dryden.low_altitude(4.6, 5.4))
+    (flight,) = simulate_flights([Trial(duration_s=10.0, environment=Environment(wind=wind), seed=3)])
     utc_start = datetime(2024, 5, 1, tzinfo=UTC)
     log = read_log(write_ardupilot_log(flight, tmp_path / "gps.bin", utc_start=utc_start))
     lat0, lon0 = np.radians(VEHICLE_POSITION_DEG)

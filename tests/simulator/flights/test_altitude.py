@@ -12,7 +12,7 @@ from simulator.vehicle.presets import CRAZYFLIE
 from simulator.world.environment import GroundEffect, SensorNoise
 
 VEHICLE = CRAZYFLIE_ALTITUDE
-EQ_2_5 = GroundEffect("fitted_4rotor")
+EQ_2_5 = GroundEffect(model="fitted_4rotor")
 QUIET = SensorNoise.off()
 SLOPE_PER_M = -0.0373 / VEHICLE.rotor_radius_m  # d(F/F0)/dz of eq. 2.5
 

@@ -26,19 +26,24 @@ STRONG = Wind.dissertation("strong", direction_from_deg=250.0)
 def long_flights() -> list[NonlinearFlight]:
     """One 60 s batch: sweeps on every axis in strong wind; a calm hover dropping 0.7 kg; an anemometer abeam."""
     sweeps = tuple(
-        Maneuver(axis, "sweep", 4.0, pct, 52.0)
+        Maneuver(axis=axis, kind="sweep", start_s=4.0, amplitude=pct, duration_s=52.0)
         for axis, pct in (("lat", 8.0), ("lon", 8.0), ("yaw", 10.0), ("thr", 4.0))
     )
-    strong = Trial(60.0, sweeps, environment=Environment(wind=STRONG), seed=5, label="strong")
+    strong = Trial(duration_s=60.0, maneuvers=sweeps, environment=Environment(wind=STRONG), seed=5, label="strong")
     calm = Trial(
-        60.0,
+        duration_s=60.0,
         environment=Environment(
-            wind=Wind(0.9, 20.0), payload=PayloadChange(30.0, -0.7), thrust_sag=True, sensors=SensorNoise.off()
+            wind=Wind(mean_speed_m_s=0.9, direction_from_deg=20.0),
+            payload=PayloadChange(30.0, -0.7),
+            thrust_sag=True,
+            sensors=SensorNoise.off(),
         ),
         seed=6,
         label="calm",
     )
-    abeam = Trial(60.0, environment=Environment(wind=STRONG, anemometer=Anemometer(15.0, bearing_deg=340.0)), seed=7)
+    abeam = Trial(
+        duration_s=60.0, environment=Environment(wind=STRONG, anemometer=Anemometer(15.0, bearing_deg=340.0)), seed=7
+    )
     return simulate_flights([strong, calm, abeam])
 
 
@@ -133,14 +138,30 @@ def test_payload_drop_lowers_the_thrust_input_by_the_weight_change(long_flights)
 
 def test_a_batch_gives_the_same_flights_as_each_trial_alone() -> None:
     trials = [
-        Trial(3.0, (Maneuver("lon", "doublet", 0.5, 10.0, 1.0),), environment=Environment(wind=STRONG), seed=1),
         Trial(
-            3.0,
-            injections=(Injection("lat", "3211", 0.5, 6.0, 1.4), Injection("thr", "multisine", 0.2, 3.0, 2.5)),
-            environment=Environment(wind=Wind(2.7, 300.0, None, (Gust(1.0, 1.0, 2.0),)), cg_offset_m=(0.01, 0, 0)),
+            duration_s=3.0,
+            maneuvers=(Maneuver(axis="lon", kind="doublet", start_s=0.5, amplitude=10.0, duration_s=1.0),),
+            environment=Environment(wind=STRONG),
+            seed=1,
+        ),
+        Trial(
+            duration_s=3.0,
+            injections=(
+                Injection(axis="lat", kind="3211", start_s=0.5, amplitude=6.0, duration_s=1.4),
+                Injection(axis="thr", kind="multisine", start_s=0.2, amplitude=3.0, duration_s=2.5),
+            ),
+            environment=Environment(
+                wind=Wind(
+                    mean_speed_m_s=2.7,
+                    direction_from_deg=300.0,
+                    turbulence=None,
+                    gusts=(Gust(arrival_s=1.0, duration_s=1.0, amplitude_m_s=2.0),),
+                ),
+                cg_offset_m=(0.01, 0, 0),
+            ),
             seed=2,
         ),
-        Trial(3.0, environment=Environment(wind=Wind.dissertation("light")), seed=3, heading_deg=45.0),
+        Trial(duration_s=3.0, environment=Environment(wind=Wind.dissertation("light")), seed=3, heading_deg=45.0),
     ]
     batch = simulate_flights(trials)
     for trial, together in zip(trials, batch):
@@ -155,8 +176,8 @@ def test_a_batch_gives_the_same_flights_as_each_trial_alone() -> None:
 def test_crazyflie_ground_effect_steps_show_eq_2_5_in_flight() -> None:
     """Chapter 2's descent: in a steady hover F/F0 = weight / sum(k_f PWM) (eq. 2.6) follows eq. 2.5."""
     steps = HeightSteps.ground_effect_descent(CRAZYFLIE.rotor_radius_m, ratios=(6.0, 2.0), hold_s=8.0)
-    environment = Environment(ground_effect=GroundEffect("fitted_4rotor"), sensors=SensorNoise.off())
-    flight = simulate_flights([Trial(16.0, environment=environment, height_steps=steps)], CRAZYFLIE)[0]
+    environment = Environment(ground_effect=GroundEffect(model="fitted_4rotor"), sensors=SensorNoise.off())
+    flight = simulate_flights([Trial(duration_s=16.0, environment=environment, height_steps=steps)], CRAZYFLIE)[0]
     time, truth = flight.time_s, flight.truth
     pwm = np.column_stack([truth[f"motor_{k}"] for k in range(1, 5)]) / 100 * 65535
     ratio = CRAZYFLIE.mass_kg * G / np.sum(2.083e-6 * pwm, axis=1)
@@ -170,8 +191,10 @@ def test_crazyflie_ground_effect_steps_show_eq_2_5_in_flight() -> None:
 
 
 def test_the_log_writer_accepts_a_nonlinear_flight(tmp_path) -> None:
-    sweep = Maneuver("lat", "sweep", 0.2, 5.0, 1.5, fade_in_s=0.5, fade_out_s=0.2)
-    flight = simulate_flights([Trial(2.0, (sweep,))])[0]
+    sweep = Maneuver(
+        axis="lat", kind="sweep", start_s=0.2, amplitude=5.0, duration_s=1.5, fade_in_s=0.5, fade_out_s=0.2
+    )
+    flight = simulate_flights([Trial(duration_s=2.0, maneuvers=(sweep,))])[0]
     path = write_ardupilot_log(flight, tmp_path / "flight.bin", utc_start=datetime(2024, 5, 1, tzinfo=UTC))
     assert path.stat().st_size > 10_000
 
@@ -181,8 +204,8 @@ def test_campaign_has_120_trials_and_euler_agrees_with_rk4() -> None:
     assert len(campaign) == 120
     assert sorted({t.duration_s for t in campaign}) == [8.0, 40.0]  # 2 s doublet or 34 s sweep + 3 s trim each side
     assert len({t.seed for t in campaign}) == 120
-    doublet = Maneuver("lon", "doublet", 1.0, 10.0, 2.0)
-    trial = Trial(4.0, (doublet,), environment=Environment(sensors=SensorNoise.off()))
+    doublet = Maneuver(axis="lon", kind="doublet", start_s=1.0, amplitude=10.0, duration_s=2.0)
+    trial = Trial(duration_s=4.0, maneuvers=(doublet,), environment=Environment(sensors=SensorNoise.off()))
     rk4, euler = simulate_flights([trial], method="rk4")[0], simulate_flights([trial], method="euler")[0]
     assert np.max(np.abs(rk4.signals["q"] - euler.signals["q"])) < 0.02 * np.max(np.abs(rk4.signals["q"]))
     assert OCTO_S1000.n_rotors == 8

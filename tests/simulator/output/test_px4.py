@@ -28,9 +28,9 @@ F32 = float(np.finfo(np.float32).eps)  # relative precision of the logged floats
 def flight() -> SimulatedFlight:
     """12 s of hover in light wind with a pitch sweep, a roll doublet and a yaw doublet."""
     maneuvers = (
-        Maneuver("lon", "sweep", 1.0, 8.0, 7.0, fade_in_s=1.0, f_stop_hz=5.0),
-        Maneuver("lat", "doublet", 8.5, 15.0, 1.0),
-        Maneuver("yaw", "doublet", 10.0, 10.0, 1.0),
+        Maneuver(axis="lon", kind="sweep", start_s=1.0, amplitude=8.0, duration_s=7.0, fade_in_s=1.0, f_stop_hz=5.0),
+        Maneuver(axis="lat", kind="doublet", start_s=8.5, amplitude=15.0, duration_s=1.0),
+        Maneuver(axis="yaw", kind="doublet", start_s=10.0, amplitude=10.0, duration_s=1.0),
     )
     return simulate_hover(12.0, maneuvers, wind=WindField(), wind_terms=LIGHT_WIND_TERMS, seed=4)
 

@@ -101,7 +101,12 @@ def test_strong_wind_trim_pitches_into_the_wind() -> None:
 
 
 def test_ground_effect_lowers_the_hover_command_by_the_thrust_ratio() -> None:
-    conditions = Conditions(np.zeros((1, 3)), np.ones(1), np.zeros(1), GroundEffect("fitted_4rotor").ratio)
+    conditions = Conditions(
+        cg_offset_m=np.zeros((1, 3)),
+        rotor_drag=np.ones(1),
+        thrust_sag=np.zeros(1),
+        ground_effect=GroundEffect(model="fitted_4rotor").ratio,
+    )
     height = 2.0 * CRAZYFLIE.rotor_radius_m  # Z/R = 2 (rotors at the CG's height)
     trim = trim_hover(CRAZYFLIE, conditions=conditions, height_m=height)
     commands = CRAZYFLIE.trim_command + CRAZYFLIE.mixer @ trim.mixer_input
@@ -112,7 +117,7 @@ def test_ground_effect_lowers_the_hover_command_by_the_thrust_ratio() -> None:
 def test_a_cg_offset_is_trimmed_by_the_pitch_input_it_needs() -> None:
     """With the CG 1 cm forward the rotors must pitch the nose up by m g dx: delta_lon = m g dx / (M_lon Iyy)."""
     dx = 0.01
-    conditions = Conditions(np.array([[dx, 0.0, 0.0]]), np.ones(1), np.zeros(1))
+    conditions = Conditions(cg_offset_m=np.array([[dx, 0.0, 0.0]]), rotor_drag=np.ones(1), thrust_sag=np.zeros(1))
     trim = trim_hover(OCTO_S1000, conditions=conditions)
     expected = OCTO_S1000.mass_kg * 9.81 * dx / (CALM_HOVER["M_lon"] * OCTO_S1000.inertia_kg_m2[1])
     assert trim.mixer_input[1] == pytest.approx(expected, rel=0.01)

@@ -107,10 +107,12 @@ def test_a_batch_gives_each_trial_the_same_numbers_as_alone() -> None:
     states[:, 10:13] = rng.normal(size=(n, 3))
     commands = rng.uniform(0.3, 0.8, size=(n, vehicle.n_rotors))
     wind = rng.normal(size=(n, 3))
-    conditions = Conditions(rng.normal(scale=0.01, size=(n, 3)), np.ones(n), np.ones(n))
+    conditions = Conditions(
+        cg_offset_m=rng.normal(scale=0.01, size=(n, 3)), rotor_drag=np.ones(n), thrust_sag=np.ones(n)
+    )
     batch, _ = vehicle_derivative(vehicle, states, commands, wind, np.full(n, 7.0), conditions)
     for i in range(n):
-        single = Conditions(conditions.cg_offset_m[i : i + 1], np.ones(1), np.ones(1))
+        single = Conditions(cg_offset_m=conditions.cg_offset_m[i : i + 1], rotor_drag=np.ones(1), thrust_sag=np.ones(1))
         alone, _ = vehicle_derivative(
             vehicle, states[i : i + 1], commands[i : i + 1], wind[i : i + 1], np.full(1, 7.0), single
         )
@@ -118,7 +120,7 @@ def test_a_batch_gives_each_trial_the_same_numbers_as_alone() -> None:
 
 
 def test_battery_sags_with_charge_and_current() -> None:
-    battery = Battery(25.2, 21.0, 16.0, 0.02, 0.5)
+    battery = Battery(full_v=25.2, empty_v=21.0, capacity_ah=16.0, resistance_ohm=0.02, time_constant_s=0.5)
     assert float(battery.open_circuit_v(0.0)) == 25.2
     assert float(battery.open_circuit_v(16.0 * 3600)) == pytest.approx(21.0)
     vehicle = OCTO_S1000
@@ -133,8 +135,8 @@ def test_thrust_drops_with_voltage_only_when_switched_on() -> None:
     state = _hover_state(vehicle)
     state[0, -1] = 2.0  # 2 V of sag
     command = np.full((1, 8), vehicle.trim_command)
-    on = Conditions(np.zeros((1, 3)), np.ones(1), np.ones(1))
-    off = Conditions(np.zeros((1, 3)), np.ones(1), np.zeros(1))
+    on = Conditions(cg_offset_m=np.zeros((1, 3)), rotor_drag=np.ones(1), thrust_sag=np.ones(1))
+    off = Conditions(cg_offset_m=np.zeros((1, 3)), rotor_drag=np.ones(1), thrust_sag=np.zeros(1))
     dot_on, _ = vehicle_derivative(vehicle, state, command, np.zeros((1, 3)), np.full(1, 7.0), on)
     dot_off, _ = vehicle_derivative(vehicle, state, command, np.zeros((1, 3)), np.full(1, 7.0), off)
     assert dot_off[0, 5] == pytest.approx(0.0, abs=1e-12)
@@ -155,37 +157,37 @@ def test_state_layout_and_validation() -> None:
     positions, spins = rotor_ring(8, 0.5)
     with pytest.raises(ValueError, match="rotor_spins"):
         Vehicle(
-            "bad",
-            1.0,
-            np.ones(3),
-            positions,
-            spins * 2,
-            0.1,
-            10.0,
-            1.0,
-            0.01,
-            500.0,
-            1e-5,
-            0.05,
-            np.zeros(4),
-            np.zeros((8, 4)),
-            0.5,
+            name="bad",
+            mass_kg=1.0,
+            inertia_kg_m2=np.ones(3),
+            rotor_positions_m=positions,
+            rotor_spins=spins * 2,
+            rotor_radius_m=0.1,
+            max_thrust_n=10.0,
+            thrust_expo=1.0,
+            torque_ratio_m=0.01,
+            max_speed_rad_s=500.0,
+            rotor_inertia_kg_m2=1e-5,
+            motor_time_constant_s=0.05,
+            delays_s=np.zeros(4),
+            mixer=np.zeros((8, 4)),
+            trim_command=0.5,
         )
     with pytest.raises(ValueError, match="mixer"):
         Vehicle(
-            "bad",
-            1.0,
-            np.ones(3),
-            positions,
-            spins,
-            0.1,
-            10.0,
-            1.0,
-            0.01,
-            500.0,
-            1e-5,
-            0.05,
-            np.zeros(4),
-            np.zeros((4, 4)),
-            0.5,
+            name="bad",
+            mass_kg=1.0,
+            inertia_kg_m2=np.ones(3),
+            rotor_positions_m=positions,
+            rotor_spins=spins,
+            rotor_radius_m=0.1,
+            max_thrust_n=10.0,
+            thrust_expo=1.0,
+            torque_ratio_m=0.01,
+            max_speed_rad_s=500.0,
+            rotor_inertia_kg_m2=1e-5,
+            motor_time_constant_s=0.05,
+            delays_s=np.zeros(4),
+            mixer=np.zeros((4, 4)),
+            trim_command=0.5,
         )

@@ -35,7 +35,7 @@ def test_ground_effect_ratio_against_the_formulas(model: str, height_ratio: floa
 
 def test_corrected_model_uses_rho_and_clamps_low_heights() -> None:
     x = np.array([0.2, 1.0, 3.0])
-    ratio = GroundEffect("corrected", rho=2.788).ratio(x)
+    ratio = GroundEffect(model="corrected", rho=2.788).ratio(x)
     expected = 1 / (1 - 2.788 * (1 / (4 * np.maximum(x, 1.0))) ** 2)
     np.testing.assert_allclose(ratio, expected, rtol=1e-12)
     assert ratio[0] == ratio[1]  # clamped at the landing-gear height Z/R = 1
@@ -46,7 +46,9 @@ def test_corrected_model_uses_rho_and_clamps_low_heights() -> None:
 
 def test_ground_effect_function_mixes_models_per_trial() -> None:
     assert ground_effect_function([GroundEffect(), GroundEffect()]) is None
-    function = ground_effect_function([GroundEffect("fitted_4rotor"), GroundEffect(), GroundEffect("fitted_4rotor")])
+    function = ground_effect_function(
+        [GroundEffect(model="fitted_4rotor"), GroundEffect(), GroundEffect(model="fitted_4rotor")]
+    )
     ratio = function(np.full((3, 4), 2.0))
     np.testing.assert_allclose(ratio[:, 0], [1.0905, 1.0, 1.0905])
 
@@ -61,7 +63,7 @@ def test_dryden_psd_integrates_to_the_variance() -> None:
 def test_generated_turbulence_has_the_dryden_spectrum() -> None:
     speed, rate = 5.0, 100.0
     turbulence = Dryden((1.0, 0.8, 0.5), (30.0, 30.0, 6.0))
-    wind = Wind(speed, 0.0, turbulence)
+    wind = Wind(mean_speed_m_s=speed, direction_from_deg=0.0, turbulence=turbulence)
     field = realize_field(wind, xi_min_m=-speed * 1300.0, xi_max_m=0.0, seed=11, resolution_hz=rate)
     n = field.values.shape[0]  # the whole periodic field, seen from a fixed point at 100 Hz
     nperseg = 4096
@@ -82,7 +84,12 @@ def test_generated_turbulence_has_the_dryden_spectrum() -> None:
 
 def test_anemometer_sees_the_vehicles_gusts_one_transport_delay_earlier() -> None:
     speed, rate = 4.6, 100.0
-    wind = Wind(speed, 300.0, Dryden.low_altitude(4.6, speed), (Gust(10.0, 2.0, 1.5),))
+    wind = Wind(
+        mean_speed_m_s=speed,
+        direction_from_deg=300.0,
+        turbulence=Dryden.low_altitude(4.6, speed),
+        gusts=(Gust(arrival_s=10.0, duration_s=2.0, amplitude_m_s=1.5),),
+    )
     site = Anemometer(4.6)  # upstream: delay 4.6 m / 4.6 m/s = 1 s = 100 samples
     delay = site.transport_delay_s(wind)
     assert delay == pytest.approx(1.0)
@@ -94,7 +101,17 @@ def test_anemometer_sees_the_vehicles_gusts_one_transport_delay_earlier() -> Non
     sensor = np.array([batch.at(np.array([position, position]), t)[0] for t in time])
     np.testing.assert_allclose(sensor[:-100], vehicle[100:], atol=1e-9)  # Taylor: same gusts, 1 s earlier
     # a lone 1-cosine gust peaks at the vehicle at arrival + duration / 2, at the sensor one delay before
-    gust_only = realize_field(Wind(speed, 300.0, None, (Gust(10.0, 2.0, 1.5),)), xi_min_m=-200, xi_max_m=10, seed=0)
+    gust_only = realize_field(
+        Wind(
+            mean_speed_m_s=speed,
+            direction_from_deg=300.0,
+            turbulence=None,
+            gusts=(Gust(arrival_s=10.0, duration_s=2.0, amplitude_m_s=1.5),),
+        ),
+        xi_min_m=-200,
+        xi_max_m=10,
+        seed=0,
+    )
     lone = BatchWindField.stack([wind], [gust_only])
     peak_vehicle = time[np.argmax([lone.at(np.zeros((1, 2)), t)[0] @ np.append(wind.towards, 0) for t in time])]
     peak_sensor = time[np.argmax([lone.at(position[None], t)[0] @ np.append(wind.towards, 0) for t in time])]
@@ -103,7 +120,7 @@ def test_anemometer_sees_the_vehicles_gusts_one_transport_delay_earlier() -> Non
 
 
 def test_a_crosswind_anemometer_has_no_transport_delay() -> None:
-    wind = Wind(5.0, 0.0)
+    wind = Wind(mean_speed_m_s=5.0, direction_from_deg=0.0)
     assert Anemometer(4.6, bearing_deg=90.0).transport_delay_s(wind) == pytest.approx(0.0, abs=1e-12)
     assert Anemometer(4.6, bearing_deg=180.0).transport_delay_s(wind) == pytest.approx(-0.92)  # downstream
 
@@ -119,10 +136,12 @@ def test_low_altitude_dryden_follows_mil_f_8785c() -> None:
 
 def test_wind_validation() -> None:
     with pytest.raises(ValueError, match="advected"):
-        Wind(0.2, 0.0, Dryden.low_altitude(4.6, 0.2))
+        Wind(mean_speed_m_s=0.2, direction_from_deg=0.0, turbulence=Dryden.low_altitude(4.6, 0.2))
     with pytest.raises(ValueError, match="duration_s"):
-        Gust(1.0, 0.0, 1.0)
-    np.testing.assert_allclose(Wind(2.0, 90.0).mean_ned, [0.0, -2.0, 0.0], atol=1e-12)  # from the east
+        Gust(arrival_s=1.0, duration_s=0.0, amplitude_m_s=1.0)
+    np.testing.assert_allclose(
+        Wind(mean_speed_m_s=2.0, direction_from_deg=90.0).mean_ned, [0.0, -2.0, 0.0], atol=1e-12
+    )  # from the east
 
 
 def test_sensor_noise_levels_and_biases() -> None:

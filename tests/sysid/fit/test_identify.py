@@ -36,7 +36,7 @@ def _identify(folder: Path, name: str, speed: float, seed: int, structure: str) 
     scenario = replace(
         load_builtin("linear-sweeps"),
         seed=seed,
-        conditions=(WindCondition(name, speed, direction_from_deg=300.0, turbulence_ratio=0.2),),
+        conditions=(WindCondition(name=name, mean_speed_m_s=speed, direction_from_deg=300.0, turbulence_ratio=0.2),),
     )
     written = run_scenario(scenario, folder / name)
     logs = [log for trial in written for log in trial.logs]

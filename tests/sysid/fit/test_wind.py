@@ -34,8 +34,14 @@ UNITS = {
 
 def _record(axis: str, seed: int) -> Record:
     """A sweep flown in strong wind, as conditioning leaves it: air-relative u from the noisy velocity."""
-    sweep = Maneuver(axis, "sweep", 3.0, 8.0 if axis == "lon" else 4.0, 34.0)  # type: ignore[arg-type]
-    flight = simulate_hover(40.0, (sweep,), wind=WindField(5.4, 0.0, 0.2), wind_terms=STRONG_WIND_TERMS, seed=seed)
+    sweep = Maneuver(axis=axis, kind="sweep", start_s=3.0, amplitude=8.0 if axis == "lon" else 4.0, duration_s=34.0)  # type: ignore[arg-type]
+    flight = simulate_hover(
+        40.0,
+        (sweep,),
+        wind=WindField(mean_speed_m_s=5.4, direction_from_deg=0.0, turbulence_ratio=0.2),
+        wind_terms=STRONG_WIND_TERMS,
+        seed=seed,
+    )
     s, wind = flight.signals, flight.wind_at_vehicle
     table = pd.DataFrame(
         {

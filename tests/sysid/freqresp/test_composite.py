@@ -111,7 +111,9 @@ def _lag_sweeps(noise: float, seed: int) -> tuple[list[Record], DelayedStateSpac
         input_delays_s=np.array([0.05]),
     )
     rng = np.random.default_rng(seed)
-    maneuver = Maneuver("lon", "sweep", 2.0, 1.0, 34.0, f_start_hz=0.1, f_stop_hz=12.0)
+    maneuver = Maneuver(
+        axis="lon", kind="sweep", start_s=2.0, amplitude=1.0, duration_s=34.0, f_start_hz=0.1, f_stop_hz=12.0
+    )
     fine = np.arange(int(38.0 * RATE_HZ * 10)) / (RATE_HZ * 10)
     _, y, _ = sps.lsim(sps.StateSpace(model.a, model.b, model.c, model.d), sweep(fine - 0.05, maneuver)[0], fine)
     x, y = sweep(fine, maneuver)[0][::10], np.ravel(y)[::10]

@@ -55,7 +55,15 @@ PAD_S = 2.0  # trim before and after each sweep, as flown
 
 
 def _sweep(amplitude: float = 1.0, f_stop_hz: float = 12.0) -> Maneuver:
-    return Maneuver("lon", "sweep", PAD_S, amplitude, 34.0, f_start_hz=0.1, f_stop_hz=f_stop_hz)
+    return Maneuver(
+        axis="lon",
+        kind="sweep",
+        start_s=PAD_S,
+        amplitude=amplitude,
+        duration_s=34.0,
+        f_start_hz=0.1,
+        f_stop_hz=f_stop_hz,
+    )
 
 
 def _record(columns: dict[str, np.ndarray], time_s: np.ndarray) -> Record:
@@ -340,7 +348,7 @@ def octocopter_sweeps() -> list[Record]:
     """Three 34 s pitch sweeps (0.1-10 Hz, 8 %) of the Table 3.3 calm model flown by the LQR hover controller,
     with the injected sweep logged as ``excitation`` (normalised, as SIDD)."""
     starts = (4.0, 44.0, 84.0)
-    maneuvers = tuple(Maneuver("lon", "sweep", s, 8.0, 34.0) for s in starts)
+    maneuvers = tuple(Maneuver(axis="lon", kind="sweep", start_s=s, amplitude=8.0, duration_s=34.0) for s in starts)
     flight = simulate_hover(124.0, maneuvers, parameters=CALM_HOVER, seed=5)
     time_s = flight.time_s
     table = pd.DataFrame({name: flight.signals[name] for name in ("delta_lon", "q", "ax", "theta", "u")}, index=time_s)

@@ -141,10 +141,10 @@ def truth_models(
 
 # ---------------------------------------------------------------------------------------------- simulated flights
 DOUBLETS = (
-    Maneuver("lon", "doublet", 5.0, 15.0, 2.0),
-    Maneuver("lat", "doublet", 11.0, 15.0, 2.0),
-    Maneuver("yaw", "doublet", 17.0, 15.0, 2.0),
-    Maneuver("thr", "doublet", 23.0, 8.0, 2.0),
+    Maneuver(axis="lon", kind="doublet", start_s=5.0, amplitude=15.0, duration_s=2.0),
+    Maneuver(axis="lat", kind="doublet", start_s=11.0, amplitude=15.0, duration_s=2.0),
+    Maneuver(axis="yaw", kind="doublet", start_s=17.0, amplitude=15.0, duration_s=2.0),
+    Maneuver(axis="thr", kind="doublet", start_s=23.0, amplitude=8.0, duration_s=2.0),
 )
 START_S = 1.0  # the simulator's own start transient is left out of the trim
 
@@ -207,7 +207,9 @@ def calm_flights() -> list[ConditionedFlight]:
 
 @pytest.fixture(scope="module")
 def strong_flights() -> list[ConditionedFlight]:
-    wind = WindField(5.4, 300.0, 0.2)  # the chapter 3 campaign's strong condition
+    wind = WindField(
+        mean_speed_m_s=5.4, direction_from_deg=300.0, turbulence_ratio=0.2
+    )  # the chapter 3 campaign's strong condition
     return [
         conditioned(
             simulate_hover(27.0, DOUBLETS, wind=wind, wind_terms=STRONG_WIND_TERMS, seed=seed), f"strong-{seed}"
