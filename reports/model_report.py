@@ -63,7 +63,7 @@ Grade = Literal["good", "acceptable", "poor"]
 _ORDER: dict[str, int] = {"good": 0, "acceptable": 1, "poor": 2}
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Check:
     """One guideline and how the model meets it.
 
@@ -88,7 +88,7 @@ class Check:
     problem: str = ""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Verdict:
     """The report's verdict: the worst grade of its checks, said in one sentence.
 
@@ -131,11 +131,11 @@ def _cost_checks(model: IdentifiedModel) -> list[Check]:
     )
     checks = [
         Check(
-            "average cost J_ave",
-            f"{j:.1f}",
-            f"≤ {J_AVE_GOOD:g} good, ≤ {J_AVE_ACCEPTABLE:g} acceptable",
-            grade,
-            problem,
+            guideline="average cost J_ave",
+            value=f"{j:.1f}",
+            limit=f"≤ {J_AVE_GOOD:g} good, ≤ {J_AVE_ACCEPTABLE:g} acceptable",
+            grade=grade,
+            problem=problem,
         )
     ]
     over = {k: v for k, v in model.cost.responses.items() if not v <= J_RESPONSE_MAX}
@@ -150,11 +150,11 @@ def _cost_checks(model: IdentifiedModel) -> list[Check]:
     )
     checks.append(
         Check(
-            "cost of each response J",
-            f"worst {worst:.1f}",
-            f"≤ {J_RESPONSE_MAX:g}",
-            "acceptable" if over else "good",
-            problem,
+            guideline="cost of each response J",
+            value=f"worst {worst:.1f}",
+            limit=f"≤ {J_RESPONSE_MAX:g}",
+            grade="acceptable" if over else "good",
+            problem=problem,
         )
     )
     return checks
@@ -173,11 +173,11 @@ def _parameter_check(model: IdentifiedModel) -> Check:
         )
     )
     return Check(
-        "parameter accuracy",
-        f"{len(estimated) - len(failing)} of {len(estimated)} within",
-        f"CR ≤ {CR_MAX_PERCENT:g} %, I ≤ {INSENSITIVITY_MAX_PERCENT:g} %",
-        "acceptable" if failing else "good",
-        problem,
+        guideline="parameter accuracy",
+        value=f"{len(estimated) - len(failing)} of {len(estimated)} within",
+        limit=f"CR ≤ {CR_MAX_PERCENT:g} %, I ≤ {INSENSITIVITY_MAX_PERCENT:g} %",
+        grade="acceptable" if failing else "good",
+        problem=problem,
     )
 
 
@@ -197,11 +197,11 @@ def _verification_check(verification: Verification) -> Check | None:
         )
     )
     return Check(
-        "prediction of doublets, worst on-axis output TIC",
-        f"{shown} ({worst.name})",
-        f"≤ {TIC_GOOD:g}-{TIC_ACCEPTABLE:g}",
-        grade,
-        problem,
+        guideline="prediction of doublets, worst on-axis output TIC",
+        value=f"{shown} ({worst.name})",
+        limit=f"≤ {TIC_GOOD:g}-{TIC_ACCEPTABLE:g}",
+        grade=grade,
+        problem=problem,
     )
 
 
@@ -249,7 +249,7 @@ def model_verdict(model: IdentifiedModel, verification: Verification | None = No
         if fit_ok:
             sentence += f", although the fit meets the guidelines ({fit_text})"
         sentence += "." if verified is not None else "; not yet verified on doublets."
-    return Verdict(grade, sentence, tuple(checks))
+    return Verdict(grade=grade, sentence=sentence, checks=tuple(checks))
 
 
 def _wind_text(model: IdentifiedModel) -> str:
@@ -316,7 +316,7 @@ def _shown(figure: Any, caption: str) -> tuple[str, str, float]:
     return sized_svg(figure_svg(figure), caption)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class _ParameterRow:
     name: str
     value: float
@@ -329,7 +329,7 @@ class _ParameterRow:
     ins_flag: bool
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class _CostRow:
     pair: str
     cost: float
@@ -347,15 +347,15 @@ def _parameter_rows(model: IdentifiedModel) -> list[_ParameterRow]:
         estimated = p.status == "estimated"
         rows.append(
             _ParameterRow(
-                p.name,
-                p.value,
-                p.unit,
-                p.cr_percent,
-                p.insensitivity_percent,
-                p.status,
-                p.stage,
-                estimated and p.cr_percent > CR_MAX_PERCENT,
-                estimated and p.insensitivity_percent > INSENSITIVITY_MAX_PERCENT,
+                name=p.name,
+                value=p.value,
+                unit=p.unit,
+                cr=p.cr_percent,
+                ins=p.insensitivity_percent,
+                status=p.status,
+                stage=p.stage,
+                cr_flag=estimated and p.cr_percent > CR_MAX_PERCENT,
+                ins_flag=estimated and p.insensitivity_percent > INSENSITIVITY_MAX_PERCENT,
             )
         )
     return rows
@@ -376,7 +376,18 @@ def _cost_rows(model: IdentifiedModel) -> list[_CostRow]:
             inside = (r.omega >= low) & (r.omega <= high)
             coherence = float(np.mean(r.coherence[inside])) if inside.any() else math.nan
             conditioned = ", ".join(r.conditioned_on)
-        rows.append(_CostRow(pair, cost, not cost <= J_RESPONSE_MAX, low, high, decades, coherence, conditioned))
+        rows.append(
+            _CostRow(
+                pair=pair,
+                cost=cost,
+                flag=not cost <= J_RESPONSE_MAX,
+                low=low,
+                high=high,
+                decades=decades,
+                coherence=coherence,
+                conditioned=conditioned,
+            )
+        )
     return rows
 
 

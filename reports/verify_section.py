@@ -44,7 +44,7 @@ def sized_svg(svg: str, caption: str) -> tuple[str, str, float]:
     return svg, caption, round(min(100.0, 100.0 * width_in / 7.6), 1)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class _OutputRow:
     name: str
     unit: str
@@ -71,15 +71,15 @@ def _output_rows(
         )
         rows.append(
             _OutputRow(
-                s.name,
-                unit,
-                s.rmse * scale,
-                s.tic,
-                grade,
-                None if s.prediction_rmse is None else s.prediction_rmse * scale,
-                s.prediction_tic,
-                s.n_records,
-                ", ".join(excited),
+                name=s.name,
+                unit=unit,
+                rmse=s.rmse * scale,
+                tic=s.tic,
+                grade=grade,
+                prediction_rmse=None if s.prediction_rmse is None else s.prediction_rmse * scale,
+                prediction_tic=s.prediction_tic,
+                n_records=s.n_records,
+                doublets=", ".join(excited),
             )
         )
     return rows
