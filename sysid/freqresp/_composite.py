@@ -69,7 +69,7 @@ def composite_pair(
     reach = np.array([omega >= w.omega_low * (1.0 - 1e-12) for w in windows]).reshape(len(windows), omega.size)
     valid = reach.copy()
     for i, window in enumerate(windows):
-        _, gamma2, *_ = pair_estimate(window.spectra[reach[i]], inputs, j, y, instrument)
+        gamma2 = pair_estimate(window.spectra[reach[i]], inputs, j, y, instrument).coherence
         if window.noise_dof is not None:  # the whole-record member: only where its signal is significant
             valid[i, reach[i]] = _significant(gamma2, window.n_effective, len(inputs), window.noise_dof[reach[i]])
         unbiased = np.where(valid[i, reach[i]], _unbiased_coherence(gamma2, n_d[i]), 0.0)
@@ -81,8 +81,8 @@ def composite_pair(
     weights /= np.maximum(weights.sum(axis=0), np.finfo(float).tiny)
     stacked = np.stack([window.spectra for window in windows])  # (n_windows, n_freq, n_ch, n_ch)
     spectra = np.einsum("if,ifab->fab", weights, stacked)
-    response, gamma2, g_jj, g_yy, g_jy = pair_estimate(spectra, inputs, j, y, instrument)
-    gamma2 = np.where(usable, gamma2, 0.0)
+    estimate = pair_estimate(spectra, inputs, j, y, instrument)
+    gamma2 = np.where(usable, estimate.coherence, 0.0)
     # averages credited: each member's, by its share of the estimate (weight x the spectrum H is divided by)
     divisor = instrument if instrument is not None and j == 0 else inputs[j]
     share = weights * np.abs(stacked[:, :, divisor, inputs[j]])
@@ -91,12 +91,12 @@ def composite_pair(
     )
     used = tuple(float(w.window_s) for k, w in enumerate(windows) if w.noise_dof is None and np.any(weights[k] > 0))
     return PairEstimate(
-        response=response,
+        response=estimate.response,
         coherence=gamma2,
         random_error=random_error(_unbiased_coherence(gamma2, n_d_mean), n_d_mean),
-        input_autospectrum=g_jj,
-        output_autospectrum=g_yy,
-        cross_spectrum=g_jy,
+        input_autospectrum=estimate.g_jj,
+        output_autospectrum=estimate.g_yy,
+        cross_spectrum=estimate.g_jy,
         windows_s=used,
         whole_record=whole,
     )

@@ -32,12 +32,22 @@ noise fed back, understates the scatter by 40 % (tests/sysid/freqresp/test_estim
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 
 __all__: list[str] = []
 
-Estimate = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+class Estimate(NamedTuple):
+    """One input/output pair from a spectral matrix, each array (n_freq,): see :func:`pair_estimate`."""
+
+    response: np.ndarray
+    coherence: np.ndarray
+    g_jj: np.ndarray
+    g_yy: np.ndarray
+    g_jy: np.ndarray
+
 
 _RIDGE = 1e-12  # relative diagonal loading of G_rr: inputs identical at a frequency give zero partial coherence there
 
@@ -110,8 +120,8 @@ def pair_estimate(
 ) -> Estimate:
     """Response of channel `y` to input channel ``inputs[j]`` from a spectral matrix, shape (n_freq, n_ch, n_ch).
 
-    Returns ``(response, coherence, g_jj, g_yy, g_jy)``, each (n_freq,): the
-    spectra conditioned on the other inputs; with an `instrument` (the
+    Returns an :class:`Estimate` of ``response``, ``coherence``, ``g_jj``,
+    ``g_yy`` and ``g_jy``, each (n_freq,): the spectra conditioned on the other inputs; with an `instrument` (the
     channel standing in for ``inputs[0]``) the instrumental-variable response
     and its coherence (module notes), and ``g_jy = response g_jj``.
     """
@@ -120,7 +130,7 @@ def pair_estimate(
     g_xx_total = np.real(spectra[..., inputs[j], inputs[j]])
     if instrument is None:
         gamma2 = coherence(g_jj, g_yy, g_jy, g_xx_total=g_xx_total, g_yy_total=np.real(spectra[..., y, y]))
-        return response(g_jj, g_jy, g_xx_total), gamma2, g_jj, g_yy, g_jy
+        return Estimate(response=response(g_jj, g_jy, g_xx_total), coherence=gamma2, g_jj=g_jj, g_yy=g_yy, g_jy=g_jy)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # a reference without power: gamma^2 = 0
         h, noise, spread = _instrumental(spectra, list(inputs), y, instrument)
         h_j = h[..., j]
@@ -129,7 +139,7 @@ def pair_estimate(
         rho = np.maximum(noise, 0.0) * spread[..., j] / np.where(usable, signal, 1.0)
         gamma2 = np.where(usable & np.isfinite(rho), 1.0 / (1.0 + rho), 0.0)
         h_j = np.where(np.isfinite(h_j), h_j, 0.0)
-    return h_j, gamma2, g_jj, g_yy, h_j * g_jj
+    return Estimate(response=h_j, coherence=gamma2, g_jj=g_jj, g_yy=g_yy, g_jy=h_j * g_jj)
 
 
 def residual_noise(spectra: np.ndarray, inputs: Sequence[int], y: int, instrument: int | None = None) -> np.ndarray:
