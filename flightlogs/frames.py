@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
 
 __all__ = ["quaternion_to_euler", "earth_to_body", "air_velocity_body", "wind_to_body_axes"]
@@ -79,7 +81,7 @@ def earth_to_body(vectors_ned: np.ndarray, phi: np.ndarray, theta: np.ndarray, p
     if vectors_ned.ndim != 2 or vectors_ned.shape[1] != 3:
         raise ValueError(f"vectors_ned must have shape (n_samples, 3), got {vectors_ned.shape}")
     matrices = _earth_to_body_matrices(np.asarray(phi), np.asarray(theta), np.asarray(psi))
-    return np.einsum("nij,nj->ni", matrices, vectors_ned)
+    return cast(np.ndarray, np.einsum("nij,nj->ni", matrices, vectors_ned))
 
 
 def air_velocity_body(

@@ -6,6 +6,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
+from typing import cast
 
 import numpy as np
 import pandas as pd
@@ -63,13 +64,13 @@ class Record:
     @property
     def time_s(self) -> np.ndarray:
         """Sample times, s, shape (n_samples,)."""
-        return self.table.index.to_numpy(dtype=np.float64)
+        return cast(np.ndarray, self.table.index.to_numpy(dtype=np.float64))
 
     @property
     def rate_hz(self) -> float:
         """Sample rate, Hz."""
         t = self.time_s
-        return (t.size - 1) / (t[-1] - t[0])
+        return float((t.size - 1) / (t[-1] - t[0]))
 
     @property
     def start_s(self) -> float:
@@ -90,7 +91,7 @@ class Record:
         """Perturbation values of one signal, shape (n_samples,)."""
         if name not in self.table.columns:
             raise MissingSignalError(f"{self.source.name}: record {self.label!r} has no signal {name!r}")
-        return self.table[name].to_numpy(dtype=np.float64)
+        return cast(np.ndarray, self.table[name].to_numpy(dtype=np.float64))
 
     def absolute(self, name: str) -> np.ndarray:
         """Values of one signal with its trim added back, shape (n_samples,).

@@ -276,7 +276,7 @@ def pole_map_figure(found: Sequence[Mode]) -> Figure:
     fastest = max(abs(m.eigenvalue) for m in found)
     zoom = bool(slow) and len(slow) < len(found) and 1.3 * max(abs(m.eigenvalue) for m in slow) < 0.35 * fastest
     figure, created = new_figure(1, 2 if zoom else 1, width_in=7.5 if zoom else 5.0, height_in=3.0)
-    axes = list(np.atleast_1d(cast(np.ndarray, np.asarray(created, dtype=object))))
+    axes = list(np.atleast_1d(np.asarray(created, dtype=object)))
     others: dict[str, tuple[str, str]] = {}
     groups = [found, slow] if zoom else [found]
     for k, (ax, shown) in enumerate(zip(axes, groups)):

@@ -186,8 +186,8 @@ def _verify(
         before_s=before_s,
         after_s=after_s,
         hint=hint,
-        options=VerificationOptions(initial_state=initial_state),
-    )  # type: ignore[arg-type]
+        options=VerificationOptions(initial_state=initial_state),  # type: ignore[arg-type]
+    )
     return verification, notes
 
 

@@ -6,6 +6,8 @@ spans are ordered lists of disjoint closed ``(start_s, end_s)`` intervals.
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
 from scipy.signal import fftconvolve, firwin, kaiserord
@@ -82,18 +84,18 @@ def _kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
     numtaps, beta = kaiserord(_STOPBAND_DB, min(width, 1.0))
     numtaps |= 1
     cutoff = 0.5 * (_PASS_EDGE + _STOP_EDGE) * target_rate_hz
-    return firwin(numtaps, min(cutoff, 0.999 * nyquist), window=("kaiser", beta), fs=fs_hz)
+    return cast(np.ndarray, firwin(numtaps, min(cutoff, 0.999 * nyquist), window=("kaiser", beta), fs=fs_hz))
 
 
 def interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: str) -> np.ndarray:
     """Evaluate the chosen interpolant through (t, v) at times `at` inside [t[0], t[-1]]."""
     if method == "linear" or t.size < 3:
-        return np.interp(at, t, v)
+        return cast(np.ndarray, np.interp(at, t, v))
     if method == "spline":
-        return CubicSpline(t, v, bc_type="not-a-knot")(at)
+        return cast(np.ndarray, CubicSpline(t, v, bc_type="not-a-knot")(at))
     if method == "pchip":
         with np.errstate(over="ignore"):  # SciPy divides by slopes that underflow for subnormal data
-            return PchipInterpolator(t, v)(at)
+            return cast(np.ndarray, PchipInterpolator(t, v)(at))
     raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
 
 

@@ -11,7 +11,7 @@ the uniform time base.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import Literal, NamedTuple, cast
 
 import numpy as np
 from scipy.fft import irfft, next_fast_len, rfft
@@ -206,7 +206,7 @@ def _trend(x: np.ndarray, width: int) -> np.ndarray:
             break
         c0 = (b0 * minor - m1 * (b1 * m4 - m3 * b2) + m2 * (b1 * m3 - m2 * b2))[good] / det[good]
         trend = np.interp(idx, idx[good], c0)
-    return trend
+    return cast(np.ndarray, trend)
 
 
 def _robust_std(x: np.ndarray, quantile: float = 0.5, *, centred: bool = False) -> float:

@@ -28,6 +28,7 @@ pulses and explains the burst clearly better, it is returned instead.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from scipy.interpolate import BSpline
@@ -189,7 +190,7 @@ def _orthonormal(columns: np.ndarray) -> np.ndarray:
     columns = columns[:, scale > 0] / scale[scale > 0]
     power, vectors = np.linalg.eigh(columns.T @ columns)  # the Gram matrix: fast for n >> k
     keep = power > 1e-10 * power[-1]
-    return columns @ (vectors[:, keep] / np.sqrt(power[keep]))
+    return cast(np.ndarray, columns @ (vectors[:, keep] / np.sqrt(power[keep])))
 
 
 def _scan(

@@ -18,6 +18,7 @@ excitation there is the input minus that joint fit of the feedback.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import cast
 
 import numpy as np
 
@@ -150,7 +151,7 @@ def _quiet_fit(u: np.ndarray, x: np.ndarray, usable: np.ndarray) -> np.ndarray:
         return np.nan_to_num(u - (np.median(u[finite]) if finite.any() else 0.0))
     regressors = np.column_stack([x, np.ones(u.size)])
     gains, *_ = np.linalg.lstsq(regressors[usable], u[usable], rcond=None)
-    return np.nan_to_num(u - regressors @ gains)
+    return cast(np.ndarray, np.nan_to_num(u - regressors @ gains))
 
 
 def _with_doublets(

@@ -458,7 +458,7 @@ def _checked_run(run: SystemIdRun) -> SystemIdRun:
     return replace(run, axis=int(run.axis))
 
 
-def _toml_entries(path: Path, text: str) -> list[tuple[int, dict]]:
+def _toml_entries(path: Path, text: str) -> list[tuple[int, dict[str, Any]]]:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
@@ -473,8 +473,8 @@ def _toml_entries(path: Path, text: str) -> list[tuple[int, dict]]:
     return list(zip(lines + [0] * (len(tables) - len(lines)), tables))
 
 
-def _csv_entries(path: Path, text: str) -> list[tuple[int, dict]]:
-    entries: list[tuple[int, dict]] = []
+def _csv_entries(path: Path, text: str) -> list[tuple[int, dict[str, Any]]]:
+    entries: list[tuple[int, dict[str, Any]]] = []
     header = None
     for line, row in enumerate(csv.reader(text.splitlines()), 1):
         cells = [cell.strip() for cell in row]
@@ -501,7 +501,7 @@ def _is_number(text: str) -> bool:
     return True
 
 
-def _user_segment(entry: dict) -> Segment:
+def _user_segment(entry: dict[str, Any]) -> Segment:
     unknown = [key for key in entry if key not in _USER_KEYS]
     if unknown:
         raise DataError(f"unknown key {unknown[0]!r} (expected {', '.join(_USER_KEYS)})")

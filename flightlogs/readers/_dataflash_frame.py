@@ -16,6 +16,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 from pymavlink.DFReader import FORMAT_TO_STRUCT, DFFormat
@@ -271,7 +272,7 @@ def gather(buf: np.ndarray, offsets: np.ndarray, length: int) -> np.ndarray:
     if offsets.size == 0 or buf.size < length:
         return np.empty((0, length), np.uint8)
     windows = np.ndarray((buf.size - length + 1, length), np.uint8, buffer=buf, strides=(1, 1))
-    return windows[offsets]
+    return cast(np.ndarray, windows[offsets])
 
 
 def strings(raw: np.ndarray, decode: Callable[[bytes], str]) -> np.ndarray:

@@ -47,7 +47,7 @@ Key = tuple[int, int]  # (system id, component id)
 class Scan:
     """What one pass over the file keeps: rows of wanted fields per source and type."""
 
-    rows: dict[Key, dict[str, list[tuple]]] = field(default_factory=dict)
+    rows: dict[Key, dict[str, list[tuple[Any, ...]]]] = field(default_factory=dict)
     heartbeats: list[tuple[Key, int, int]] = field(default_factory=list)  # key, type, autopilot
     n_known: int = 0
     known_bytes: int = 0
@@ -117,7 +117,7 @@ def _keep(scan: Scan, msg: Any) -> None:
         scan.heartbeats.append((key, int(msg.type), int(msg.autopilot)))
 
 
-def message_table(name: str, rows: list[tuple]) -> dict[str, np.ndarray]:
+def message_table(name: str, rows: list[tuple[Any, ...]]) -> dict[str, np.ndarray]:
     """Columns of one message type as float arrays; ``"rx"`` is the tlog receive time, s."""
     fields = FIELDS[name]
     if name in ("PARAM_VALUE", "STATUSTEXT"):

@@ -41,6 +41,7 @@ from datetime import UTC, datetime
 from os import PathLike
 from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -400,7 +401,7 @@ def _from_polar(
     speed_m_s: np.ndarray,
     direction_rad: np.ndarray,
     wind_d: np.ndarray | None,
-    **metadata,
+    **metadata: Any,
 ) -> WindMeasurement:
     """Measurement from speed (m/s) and direction FROM (rad): the air moves the other way."""
     wind_n, wind_e = -speed_m_s * np.cos(direction_rad), -speed_m_s * np.sin(direction_rad)

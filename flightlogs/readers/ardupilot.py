@@ -31,6 +31,7 @@ import calendar
 import re
 from collections.abc import Callable
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
@@ -239,7 +240,7 @@ def _map_imu_attitude(messages: DataFlashMessages, add: _Add) -> None:
 
 def _wrap_deg(yaw_deg: np.ndarray) -> np.ndarray:
     """Degrees → radians in (-π, π]."""
-    return np.pi - np.mod(np.pi - np.deg2rad(yaw_deg), 2.0 * np.pi)
+    return cast(np.ndarray, np.pi - np.mod(np.pi - np.deg2rad(yaw_deg), 2.0 * np.pi))
 
 
 def _map_mixer(messages: DataFlashMessages, add: _Add) -> None:

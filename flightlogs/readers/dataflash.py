@@ -40,6 +40,7 @@ from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
+from typing import cast
 
 import numpy as np
 from pymavlink.DFReader import FORMAT_TO_STRUCT, MULT_TO_PREFIX
@@ -355,8 +356,8 @@ def _column(raw: np.ndarray, char: str, message: str) -> np.ndarray:
     mult = FORMAT_TO_STRUCT[char][1]
     if mult is not None:
         if 0.0 < mult < 1.0:  # DFReader divides by 1/mult for accuracy
-            return raw.astype(np.float64) / (1 / mult)
-        return raw.astype(np.float64) * mult
+            return cast(np.ndarray, raw.astype(np.float64) / (1 / mult))
+        return cast(np.ndarray, raw.astype(np.float64) * mult)
     if raw.dtype.kind == "S":
         if message == "FILE" and char == "Z":
             return np.array([bytes(v).ljust(raw.dtype.itemsize, b"\0") for v in raw.tolist()], dtype=object)

@@ -35,6 +35,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 
@@ -243,13 +244,13 @@ class _BootClock:
         """Log-clock time, s, of messages stamped `boot_s` and received at `rx`."""
         if self.rx.size == 0 or self.shift.size == 1:
             return boot_s
-        return boot_s + self.shift[self.session[self._index(rx)]]
+        return cast(np.ndarray, boot_s + self.shift[self.session[self._index(rx)]])
 
     def boot_time_s(self, rx: np.ndarray) -> np.ndarray | None:
         """Boot-clock time, s, of receive times `rx` (own session); None if nothing is timed."""
         if self.rx.size == 0:
             return None
-        return rx - self.offset[self._index(rx)]
+        return cast("np.ndarray | None", rx - self.offset[self._index(rx)])
 
 
 def _log_time(table: dict[str, np.ndarray], msg: str, clock: _BootClock) -> np.ndarray:
@@ -458,7 +459,7 @@ def _position(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: l
 
 def _not_null_island(table: dict[str, np.ndarray]) -> np.ndarray:
     """Rows whose position is not exactly 0, 0 (what MAVLink sends before there is one)."""
-    return (table["lat"] != 0) | (table["lon"] != 0)
+    return cast(np.ndarray, (table["lat"] != 0) | (table["lon"] != 0))
 
 
 def _add_position(
@@ -504,7 +505,7 @@ def _utc_offset(tables: _Tables, clock: _BootClock) -> float | None:
     return None
 
 
-def _parameters(rows: list[tuple]) -> dict[str, float]:
+def _parameters(rows: list[tuple[Any, ...]]) -> dict[str, float]:
     """First value seen of each parameter."""
     parameters: dict[str, float] = {}
     for _rx, name, value in rows:
@@ -514,7 +515,7 @@ def _parameters(rows: list[tuple]) -> dict[str, float]:
     return parameters
 
 
-def _vehicle_string(rows: dict[str, list[tuple]], mav_type: int) -> str:
+def _vehicle_string(rows: dict[str, list[tuple[Any, ...]]], mav_type: int) -> str:
     """Firmware, board and frame lines from STATUSTEXT/AUTOPILOT_VERSION, then MAV_TYPE."""
     from pymavlink.dialects.v20 import all as mavlink2
 

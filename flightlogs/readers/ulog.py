@@ -239,8 +239,8 @@ def _zero_tail(stream: Any, size: int) -> int:
 class _CountingULog(ULog):  # type: ignore[misc]
     """pyulog's reader, counting the messages and bytes it skips (pyulog only sets a flag)."""
 
-    class _MessageData(ULog._MessageData):  # type: ignore[misc,name-defined]
-        def initialize(self, data: bytes, header: Any, subscriptions: dict, ulog_object: Any) -> bool:
+    class _MessageData(ULog._MessageData):  # type: ignore[misc]
+        def initialize(self, data: bytes, header: Any, subscriptions: dict[int, Any], ulog_object: Any) -> bool:
             corrupt = bool(super().initialize(data, header, subscriptions, ulog_object))
             if corrupt:
                 msg_id = int.from_bytes(data[:2], "little")

@@ -14,9 +14,9 @@ names) by loop shaping (:func:`design_gains`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
@@ -106,6 +106,12 @@ class ControllerGains:
             raise ValueError("gains must be three per attitude axis and all >= 0")
 
 
+def _per_axis(values: Iterable[float]) -> tuple[float, float, float]:
+    """Roll, pitch and yaw values as a triple."""
+    roll, pitch, yaw = values
+    return (roll, pitch, yaw)
+
+
 def design_gains(
     derivatives: Mapping[str, float],
     *,
@@ -140,14 +146,14 @@ def design_gains(
     the integrator corner is a fifth of the crossover.
     """
     effectiveness = (abs(derivatives["L_lat"]), abs(derivatives["M_lon"]), abs(derivatives["N_yaw"]))
-    rate_kp = tuple(w / e for w, e in zip(rate_crossover_rad_s, effectiveness))
-    rate_ki = tuple(k * w / 5.0 for k, w in zip(rate_kp, rate_crossover_rad_s))
-    angle_kp = tuple(angle_ratio * w for w in rate_crossover_rad_s)
+    rate_kp = _per_axis(w / e for w, e in zip(rate_crossover_rad_s, effectiveness))
+    rate_ki = _per_axis(k * w / 5.0 for k, w in zip(rate_kp, rate_crossover_rad_s))
+    angle_kp = _per_axis(angle_ratio * w for w in rate_crossover_rad_s)
     climb = 3.0 * height_crossover_rad_s
     return ControllerGains(
         rate_kp=rate_kp,
         rate_ki=rate_ki,
-        angle_kp=angle_kp,  # type: ignore[arg-type]
+        angle_kp=angle_kp,
         velocity_kp=velocity_crossover_rad_s,
         velocity_ki=0.2 * velocity_crossover_rad_s**2,
         position_kp=0.4 * velocity_crossover_rad_s,
@@ -345,7 +351,7 @@ def initial_controller_state(
 
 
 def _clip(value: np.ndarray, low: float, high: float) -> np.ndarray:
-    return np.minimum(np.maximum(value, low), high)
+    return cast(np.ndarray, np.minimum(np.maximum(value, low), high))
 
 
 def _euler(quaternion: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
@@ -227,7 +227,9 @@ def multisine(
     phases = -np.pi * k * (k - 1) / harmonics.size
 
     def shape(t: np.ndarray) -> np.ndarray:
-        return np.sum(np.cos(2 * np.pi * base * harmonics[:, None] * t[None, :] + phases[:, None]), axis=0)
+        return cast(
+            np.ndarray, np.sum(np.cos(2 * np.pi * base * harmonics[:, None] * t[None, :] + phases[:, None]), axis=0)
+        )
 
     grid = np.arange(0.0, duration_s, 1.0 / (64 * f_max_hz))
     peak = float(np.max(np.abs(shape(grid))))

@@ -7,11 +7,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from flightlogs.errors import DataError
 from flightlogs.writers.atomic import atomic_output
-from simulator.autopilot.excitation import Maneuver
+from simulator.autopilot.excitation import Axis, Maneuver
 from simulator.campaign.scenario import ManeuverSpec, Scenario, WindCondition
 from simulator.flights.linear import SimulatedFlight, WindField, simulate_hover
 from simulator.output.ardupilot import AnemometerSetup, write_anemometer_csv, write_ardupilot_log, write_truth
@@ -121,11 +121,11 @@ def _maneuvers(spec: ManeuverSpec, margin_s: float) -> tuple[Maneuver, ...]:
     fade = min(spec.fade_in_s, spec.duration_s / 3)
     return (
         Maneuver(
-            axis=spec.axis,
+            axis=cast(Axis, spec.axis),  # validated by ManeuverSpec
             kind=spec.kind,
             start_s=margin_s,
             amplitude=spec.amplitude,
-            duration_s=spec.duration_s,  # type: ignore[arg-type]
+            duration_s=spec.duration_s,
             f_start_hz=spec.f_start_hz,
             f_stop_hz=spec.f_stop_hz,
             fade_in_s=fade,
@@ -141,11 +141,11 @@ def _injections(spec: ManeuverSpec, margin_s: float) -> tuple[Any, ...]:
 
     return (
         Injection(
-            axis=spec.axis,
+            axis=cast(Axis, spec.axis),  # validated by ManeuverSpec
             kind=spec.kind,
             start_s=margin_s,
             amplitude=spec.amplitude,
-            duration_s=spec.duration_s,  # type: ignore[arg-type]
+            duration_s=spec.duration_s,
             f_min_hz=spec.f_start_hz,
             f_max_hz=spec.f_stop_hz,
         ),

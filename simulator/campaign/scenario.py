@@ -40,7 +40,7 @@ from dataclasses import MISSING, dataclass, field, fields
 from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal, get_args
+from typing import Any, Literal, TypeVar, get_args
 
 from flightlogs.errors import DataError
 
@@ -53,6 +53,8 @@ __all__ = [
     "builtin_scenarios",
     "load_builtin",
 ]
+
+_T = TypeVar("_T")
 
 VehicleName = Literal["octo-s1000", "crazyflie", "linear-octo"]
 LogFormatName = Literal["dataflash", "ulog"]
@@ -250,7 +252,7 @@ _SIMPLE = {
 
 
 def _scenario_from(raw: dict[str, Any], path: Path) -> Scenario:
-    def build(kind: type, table: Any, where: str, inner: dict[str, Any] | None = None) -> Any:
+    def build(kind: type[_T], table: Any, where: str, inner: dict[str, Any] | None = None) -> _T:
         _check_table(path, kind, table, where, tuple(inner or ()))
         try:
             return kind(**table, **(inner or {}))

@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -22,6 +22,7 @@ from simulator.autopilot.control import (
     initial_controller_state,
 )
 from simulator.flights.linear import SimulatedFlight
+from simulator.flights.trial import Trial
 from simulator.vehicle.dynamics import Conditions, vehicle_derivative
 from simulator.vehicle.linearize import Trim, trim_hover
 from simulator.vehicle.multirotor import Vehicle, mixer_commands
@@ -109,7 +110,7 @@ class _Setup:
     seen_noise: np.ndarray  # (n_log, n, 10): rates, attitude, velocity, height errors the controller sees
 
 
-def _trim_for(trial, vehicle: Vehicle, conditions: Conditions, cache: dict) -> Trim:
+def _trim_for(trial: Trial, vehicle: Vehicle, conditions: Conditions, cache: dict[tuple[Any, ...], Trim]) -> Trim:
     env = trial.environment
     key = (
         tuple(env.wind.mean_ned),
@@ -132,12 +133,12 @@ def _trim_for(trial, vehicle: Vehicle, conditions: Conditions, cache: dict) -> T
     return cache[key]
 
 
-def _start_height(trial) -> float:
+def _start_height(trial: Trial) -> float:
     return float(trial.height_steps.heights_m[0]) if trial.height_steps is not None else trial.hover_height_m
 
 
 def _setup(
-    trials: list, vehicle: Vehicle, gains: ControllerGains, n_log: int, rate_hz: float, decimation: int
+    trials: list[Trial], vehicle: Vehicle, gains: ControllerGains, n_log: int, rate_hz: float, decimation: int
 ) -> _Setup:
     n = len(trials)
     envs = [t.environment for t in trials]
@@ -157,7 +158,7 @@ def _setup(
         ground_effect=ground_effect_function([e.ground_effect for e in envs]),
         gravity_m_s2=gravity,
     )
-    cache: dict = {}
+    cache: dict[tuple[Any, ...], Trim] = {}
     trims = []
     for k, trial in enumerate(trials):
         single = Conditions(
@@ -230,7 +231,7 @@ def _seen_noise(trial: Any, n_log: int) -> np.ndarray:
         [sensors.gyro_rad_s] * 3 + [sensors.attitude_rad] * 3 + [sensors.velocity_m_s] * 3 + [sensors.height_m]
     )
     rng = np.random.default_rng(np.random.SeedSequence(trial.seed).spawn(4)[3])
-    return rng.standard_normal((n_log, sigma.size)) * sigma
+    return cast(np.ndarray, rng.standard_normal((n_log, sigma.size)) * sigma)
 
 
 def _as_seen(state: np.ndarray, noise: np.ndarray) -> np.ndarray:
@@ -320,7 +321,7 @@ def _integrate(
     return logs
 
 
-def _anemometer_wind(field: FrozenField, trial, position_ne: np.ndarray, time_s: np.ndarray) -> np.ndarray:
+def _anemometer_wind(field: FrozenField, trial: Trial, position_ne: np.ndarray, time_s: np.ndarray) -> np.ndarray:
     """Wind at the fixed anemometer, NED north and east, shape (n_samples, 2).
 
     Along the wind the sensor samples the vehicle's frozen field. Off the wind
@@ -401,7 +402,7 @@ def _flight_signals(vehicle: Vehicle, logs: dict[str, np.ndarray], i: int) -> di
 
 
 def run_batch(
-    trials: list,
+    trials: list[Trial],
     vehicle: Vehicle,
     gains: ControllerGains,
     *,
@@ -410,7 +411,7 @@ def run_batch(
     decimation: int,
     method: str,
     progress: Callable[[int, int], None] | None,
-) -> list:
+) -> list[NonlinearFlight]:
     """Simulate trials of equal length together.
 
     Parameters
@@ -440,7 +441,7 @@ def run_batch(
     setup = _setup(trials, vehicle, gains, n_log, rate_hz, decimation)
     logs = _integrate(setup, vehicle, gains, "euler" if method == "euler" else "rk4", progress)
     time = np.arange(n_log) / (rate_hz / decimation)
-    flights = []
+    flights: list[NonlinearFlight] = []
     for i, trial in enumerate(trials):
         clean = _flight_signals(vehicle, logs, i)
         noise_rng = np.random.default_rng(np.random.SeedSequence(trial.seed).spawn(3)[1])

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import cast
 
 import numpy as np
 from scipy import linalg
@@ -63,7 +64,7 @@ class WindField:
         gusts *= self.turbulence_ratio * self.mean_speed_m_s / gusts[time_s.size // 10 :].std(axis=0)
         towards = np.radians(self.direction_from_deg) + np.pi
         mean = self.mean_speed_m_s * np.array([np.cos(towards), np.sin(towards)])
-        return mean + gusts
+        return cast(np.ndarray, mean + gusts)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -126,7 +127,7 @@ def _trim_states(
 
 def _lqr(a: np.ndarray, b: np.ndarray, weights: np.ndarray) -> np.ndarray:
     x = linalg.solve_continuous_are(a, b, np.diag(weights), np.eye(1) * 0.02)
-    return (b.T @ x / 0.02).ravel()
+    return cast(np.ndarray, (b.T @ x / 0.02).ravel())
 
 
 _WEIGHTS = {"lat": [2.0, 1.0, 20.0, 0.0], "lon": [2.0, 1.0, 20.0, 0.0], "yaw": [1.0, 5.0], "thr": [1.0, 2.0, 0.0]}

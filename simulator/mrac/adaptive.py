@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
@@ -108,7 +108,7 @@ def adaptive_law(phi: np.ndarray, error: np.ndarray, p_b: np.ndarray, gamma: np.
     error = np.atleast_2d(np.asarray(error, dtype=np.float64))
     scale = error @ np.asarray(p_b, dtype=np.float64)
     weighted = phi * gamma if np.ndim(gamma) == 0 else phi @ np.asarray(gamma, dtype=np.float64).T
-    return weighted * scale[:, None]
+    return cast(np.ndarray, weighted * scale[:, None])
 
 
 def lyapunov_function(
@@ -135,6 +135,6 @@ def lyapunov_function(
     theta_error = np.atleast_2d(np.asarray(theta_error, dtype=np.float64))
     quadratic = np.einsum("ni,ij,nj->n", error, np.asarray(p, dtype=np.float64), error)
     if np.ndim(gamma) == 0:
-        return quadratic + np.einsum("nk,nk->n", theta_error, theta_error) / float(gamma)  # type: ignore[arg-type]
+        return quadratic + np.einsum("nk,nk->n", theta_error, theta_error) / float(gamma)  # type: ignore[no-any-return]
     inverse = np.linalg.inv(np.asarray(gamma, dtype=np.float64))
-    return quadratic + np.einsum("ni,ij,nj->n", theta_error, inverse, theta_error)
+    return cast(np.ndarray, quadratic + np.einsum("ni,ij,nj->n", theta_error, inverse, theta_error))

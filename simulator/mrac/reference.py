@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 import scipy.linalg
@@ -48,7 +49,7 @@ def lyapunov_matrix(a: np.ndarray, q: np.ndarray) -> np.ndarray:
     if not np.allclose(q, q.T) or np.any(np.linalg.eigvalsh(q) <= 0):
         raise ValueError("q must be symmetric positive definite")
     p = scipy.linalg.solve_continuous_lyapunov(a.T, -q)
-    return 0.5 * (p + p.T)
+    return cast(np.ndarray, 0.5 * (p + p.T))
 
 
 @dataclass(frozen=True, slots=True)
@@ -131,7 +132,9 @@ class ReferenceModel:
         ndarray, shape (...)
         """
         state = np.asarray(state)
-        return self.a[0, 0] * state[..., 0] + self.a[0, 1] * state[..., 1] + self.b[0] * np.asarray(command_m)
+        return cast(
+            np.ndarray, self.a[0, 0] * state[..., 0] + self.a[0, 1] * state[..., 1] + self.b[0] * np.asarray(command_m)
+        )
 
     def discretize(self, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
         """Exact zero-order-hold discretisation over `dt_s`.

@@ -25,8 +25,8 @@ from scipy import signal as sps
 
 from flightlogs.conditioning.lag import destination_point
 from flightlogs.writers.atomic import atomic_output
-from flightlogs.writers.dataflash import standard_block, write_dataflash
-from simulator.autopilot.excitation import sweep
+from flightlogs.writers.dataflash import MessageBlock, standard_block, write_dataflash
+from simulator.autopilot.excitation import Maneuver, sweep
 from simulator.flights.linear import SimulatedFlight
 
 __all__ = ["AnemometerSetup", "VEHICLE_POSITION_DEG", "write_ardupilot_log", "write_anemometer_csv", "write_truth"]
@@ -201,7 +201,7 @@ def _octo_pwm(out: dict[str, np.ndarray], hover: float) -> dict[str, np.ndarray]
     return pwm
 
 
-def _system_id_blocks(flight: SimulatedFlight, sweeps: list, us: np.ndarray) -> list:
+def _system_id_blocks(flight: SimulatedFlight, sweeps: list[Maneuver], us: np.ndarray) -> list[MessageBlock]:
     """SIDS when the mode is entered, SIDD while the chirp runs.
 
     As ArduCopter's mode_systemid.cpp logs them: the chirp starts 1 s after

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from types import MappingProxyType
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
@@ -133,7 +133,7 @@ class Airframe:
         """
         angles = np.radians(self.angles_deg)
         mixer = np.column_stack([-np.sin(angles), np.cos(angles), np.asarray(self.spins, float)])
-        return np.clip(thrust[:, None] + torque @ mixer.T, 0.0, 1.0)
+        return cast(np.ndarray, np.clip(thrust[:, None] + torque @ mixer.T, 0.0, 1.0))
 
 
 #: PX4 quadrotor X (4001; motors front-right, rear-left, front-left, rear-right) and an

@@ -10,6 +10,8 @@ import numpy as np
 from simulator.vehicle.multirotor import FIRST_ROTOR_STATE as _BASE
 from simulator.vehicle.multirotor import Vehicle
 
+_Columns = tuple[np.ndarray, ...]  # per-trial columns, each (n,)
+
 __all__ = ["Conditions", "vehicle_derivative"]
 
 
@@ -85,7 +87,9 @@ def _rotation(quaternion: np.ndarray) -> tuple[np.ndarray, ...]:
     )
 
 
-def _rotor_thrusts(vehicle: Vehicle, state: np.ndarray, rot: tuple, conditions: Conditions) -> tuple:
+def _rotor_thrusts(
+    vehicle: Vehicle, state: np.ndarray, rot: _Columns, conditions: Conditions
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rotor thrusts (n, n_rotors), N, the voltage scale (n,) and the terminal voltage (n,)."""
     n_r = vehicle.n_rotors
     volts = vehicle.battery.open_circuit_v(state[:, _BASE + n_r]) - state[:, _BASE + n_r + 1]
@@ -103,7 +107,7 @@ def _rotor_thrusts(vehicle: Vehicle, state: np.ndarray, rot: tuple, conditions: 
     return thrust, scale, volts
 
 
-def _loads(vehicle: Vehicle, sums: np.ndarray, air_body: tuple, conditions: Conditions) -> tuple:
+def _loads(vehicle: Vehicle, sums: np.ndarray, air_body: _Columns, conditions: Conditions) -> tuple[_Columns, _Columns]:
     """Body force (3 arrays, N) and moment about the CG (3 arrays, N m) of thrust, drag, flapping and coupling.
 
     `sums` holds, per trial, the sums over rotors of T, T x, T y, T z and T spin
@@ -194,9 +198,9 @@ def vehicle_derivative(
 def _rigid_body(
     vehicle: Vehicle,
     state: np.ndarray,
-    rot: tuple,
+    rot: _Columns,
     specific: np.ndarray,
-    moment: tuple,
+    moment: _Columns,
     h_z: np.ndarray,
     gravity: float,
     out: np.ndarray,

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from scipy import linalg, optimize
@@ -69,7 +70,7 @@ class Trim:
         """Roll, pitch, yaw, rad, shape (3,)."""
         from flightlogs.frames import quaternion_to_euler
 
-        return quaternion_to_euler(self.state[None, 6:10])[0]
+        return cast(np.ndarray, quaternion_to_euler(self.state[None, 6:10])[0])
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -262,7 +263,7 @@ def _air_body(phi: float, theta: float, psi: float, air_ned: np.ndarray) -> np.n
             [2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)],
         ]
     )
-    return ned_to_body @ air_ned
+    return cast(np.ndarray, ned_to_body @ air_ned)
 
 
 def linearize_hover(

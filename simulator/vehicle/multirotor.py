@@ -33,6 +33,7 @@ the presets in :mod:`simulator.vehicle.presets`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 
@@ -236,7 +237,7 @@ class Vehicle:
             Thrust, N, same shape.
         """
         x = np.asarray(speed_fraction)
-        return self.max_thrust_n * ((1.0 - self.thrust_expo) * x + self.thrust_expo * x * x)
+        return cast(np.ndarray, self.max_thrust_n * ((1.0 - self.thrust_expo) * x + self.thrust_expo * x * x))
 
 
 def state_names(n_rotors: int) -> tuple[str, ...]:
@@ -324,4 +325,4 @@ def mixer_commands(vehicle: Vehicle, mixer_input: np.ndarray) -> np.ndarray:
     command = vehicle.trim_command + mixer_input[:, 0:1] * mix[:, 0]
     for axis in (1, 2, 3):  # term by term: the same rounding whatever the batch size
         command = command + mixer_input[:, axis : axis + 1] * mix[:, axis]
-    return np.minimum(np.maximum(command, vehicle.idle_command), 1.0)
+    return cast(np.ndarray, np.minimum(np.maximum(command, vehicle.idle_command), 1.0))

@@ -22,7 +22,9 @@ __all__ = ["rotor_ring", "vehicle_from_derivatives", "octocopter", "crazyflie", 
 _RHO_AIR = 1.225  # kg/m^3, sea level
 
 
-def rotor_ring(n_rotors: int, radius_m: float, *, height_m: float = 0.0, first_deg: float | None = None) -> tuple:
+def rotor_ring(
+    n_rotors: int, radius_m: float, *, height_m: float = 0.0, first_deg: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Rotors evenly spaced on a circle, spins alternating.
 
     Parameters

@@ -20,7 +20,7 @@ and in temporal frequency omega = Omega M at a fixed point, Phi(omega) = Phi(Ome
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
@@ -406,7 +406,7 @@ class BatchWindField:
         frac = np.clip(position - index, 0.0, 1.0)[:, None]
         low = self.fields[self._rows, index]
         high = self.fields[self._rows, index + 1]
-        return low + frac * (high - low)
+        return cast(np.ndarray, low + frac * (high - low))
 
     def at(self, position_ne: np.ndarray, time_s: float) -> np.ndarray:
         """Wind velocity (NED, m/s) at one horizontal position per trial, shape (n_trials, 3).

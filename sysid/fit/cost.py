@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import cast
 
 import numpy as np
 
@@ -184,7 +185,7 @@ def fit_points(responses: Sequence[FrequencyResponse], *, weights: CostWeights =
 
 def _times_real(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     """``left @ right`` for complex `left` and real `right` without converting `right` to complex."""
-    return (left.real @ right) + 1j * (left.imag @ right)
+    return cast(np.ndarray, (left.real @ right) + 1j * (left.imag @ right))
 
 
 class ResponseModel:
@@ -277,7 +278,7 @@ class ResponseModel:
         dg += np.moveaxis(dm.d[:, self._row, :], 0, 1)
         dg -= self._s[:, None, None] * dm.delays[None, :, :] * g[:, None, :]
         with np.errstate(divide="ignore", invalid="ignore"):
-            return (dg @ delay[:, :, None])[:, :, 0] / t[:, None]
+            return cast(np.ndarray, (dg @ delay[:, :, None])[:, :, 0] / t[:, None])
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
         """Weighted residual vector; its sum of squares is J.

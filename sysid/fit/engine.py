@@ -363,7 +363,7 @@ class _Search:
                 model.residuals,
                 theta0,
                 jac=jac,
-                bounds=(lower, upper),  # type: ignore[arg-type]
+                bounds=(lower, upper),
                 method="trf",
                 x_scale="jac",
                 max_nfev=self.options.max_evaluations,

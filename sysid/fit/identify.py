@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from scipy import linalg
@@ -354,6 +354,7 @@ def model_from_fit(
         cr |= dict(zip(wind.accuracy.names, wind.accuracy.cramer_rao_percent.tolist()))
         ins |= dict(zip(wind.accuracy.names, wind.accuracy.insensitivity_percent.tolist()))
     for p in structure.parameters:
+        stage: Literal["frequency", "wind"]
         unit = p.unit
         for signal, text in units.items():
             unit = unit.replace("{" + signal + "}", text)
@@ -388,7 +389,7 @@ def model_from_fit(
                 unit=unit,
                 stage=stage,
             )
-        )  # type: ignore[arg-type]
+        )
     reduction = [dataclasses.replace(step, step=k + 1) for k, step in enumerate(reduction)]
     names = fit.accuracy.names + (wind.accuracy.names if wind is not None else ())
     blocks = [fit.accuracy.correlation] + ([wind.accuracy.correlation] if wind is not None else [])

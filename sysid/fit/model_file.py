@@ -8,7 +8,7 @@ outside Python. NaN is written as ``null``. Files are written atomically.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -232,11 +232,11 @@ def _parameters(doc: Mapping[str, Any], f: _Fields) -> tuple[ParameterEstimate, 
                 value=f.number(p, "value", where, finite=True),
                 cr_percent=f.number(p, "cr_percent", where),
                 insensitivity_percent=f.number(p, "insensitivity_percent", where),
-                status=status,  # type: ignore[arg-type]
+                status=status,
                 unit=f.get(p, "unit", where, str, ""),
                 stage=stage,
             )
-        )  # type: ignore[arg-type]
+        )
     return tuple(out)
 
 
@@ -419,6 +419,11 @@ def read_model(path: str | Path) -> IdentifiedModel:
     return model_from_dict(read_json_object(path, ModelError, "model"), source=str(path))
 
 
+def _cell(names: Iterable[str]) -> np.ndarray:
+    """Strings as a MATLAB cell array (object array), shape (n,)."""
+    return np.array(list(names), dtype=object)
+
+
 def write_mat(path: str | Path, model: IdentifiedModel) -> Path:
     """Write the identified model for MATLAB (``A B C D``, names, delays, parameters), atomically.
 
@@ -441,21 +446,20 @@ def write_mat(path: str | Path, model: IdentifiedModel) -> Path:
     ``parameter_status``, ``cost_average``, ``structure`` (the TOML text).
     """
     linear = model.linear_model()
-    cell = lambda names: np.array(list(names), dtype=object)
     content = {
         "A": linear.a,
         "B": linear.b,
         "C": linear.c,
         "D": linear.d,
-        "states": cell(linear.states),
-        "inputs": cell(linear.inputs),
-        "outputs": cell(linear.outputs),
+        "states": _cell(linear.states),
+        "inputs": _cell(linear.inputs),
+        "outputs": _cell(linear.outputs),
         "input_delays_s": linear.input_delays_s,
-        "parameter_names": cell(p.name for p in model.parameters),
+        "parameter_names": _cell(p.name for p in model.parameters),
         "parameter_values": np.array([p.value for p in model.parameters]),
         "cr_percent": np.array([p.cr_percent for p in model.parameters]),
         "insensitivity_percent": np.array([p.insensitivity_percent for p in model.parameters]),
-        "parameter_status": cell(p.status for p in model.parameters),
+        "parameter_status": _cell(p.status for p in model.parameters),
         "cost_average": model.cost.average,
         "structure": model.structure_text,
     }

@@ -32,7 +32,7 @@ noise fed back, understates the scatter by 40 % (tests/sysid/freqresp/test_estim
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import NamedTuple, cast
 
 import numpy as np
 
@@ -104,7 +104,7 @@ def response(g_xx: np.ndarray, g_xy: np.ndarray, reference: np.ndarray) -> np.nd
     floor keeps the (meaningless, zero-coherence) response finite.
     """
     floor = 1e-12 * np.maximum(reference, np.finfo(float).tiny)
-    return g_xy / np.maximum(g_xx, floor)
+    return cast(np.ndarray, g_xy / np.maximum(g_xx, floor))
 
 
 def random_error(gamma2: np.ndarray, n_effective: float | np.ndarray) -> np.ndarray:
@@ -149,7 +149,7 @@ def residual_noise(spectra: np.ndarray, inputs: Sequence[int], y: int, instrumen
     """
     if instrument is None:
         g_jj, g_yy, g_jy = conditioned_spectra(spectra, inputs[0], list(inputs[1:]), y)
-        return np.maximum(g_yy - np.abs(g_jy) ** 2 / np.maximum(g_jj, np.finfo(float).tiny), 0.0)
+        return cast(np.ndarray, np.maximum(g_yy - np.abs(g_jy) ** 2 / np.maximum(g_jj, np.finfo(float).tiny), 0.0))
     with np.errstate(over="ignore", invalid="ignore"):
         noise = _instrumental(spectra, list(inputs), y, instrument)[1]
     return np.where(np.isfinite(noise), np.maximum(noise, 0.0), 0.0)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -113,7 +114,7 @@ def _matrix_dft(flat: np.ndarray, dt: float, taper: np.ndarray, omega: np.ndarra
     product = flat @ kernel.T
     product -= flat.mean(axis=1)[:, None] * kernel.sum(axis=1)[None, :]
     n_freq = omega.size
-    return product[:, :n_freq] - 1j * product[:, n_freq:]
+    return cast(np.ndarray, product[:, :n_freq] - 1j * product[:, n_freq:])
 
 
 def _czt(flat: np.ndarray, dt: float, taper: np.ndarray, omega: np.ndarray) -> np.ndarray:

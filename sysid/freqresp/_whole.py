@@ -41,6 +41,7 @@ composite's weights (inverse random error) sort that out.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import cast
 
 import numpy as np
 
@@ -115,7 +116,7 @@ def significance_threshold(noise_dof: np.ndarray, level: float = SIGNIFICANCE) -
     ``P(F > x) = (1 + 2 x / d)^(-d / 2)``; ``ln(1 / level)`` for large ``d``.
     """
     d = np.maximum(np.asarray(noise_dof, dtype=float), 1.0)
-    return d / 2.0 * (level ** (-2.0 / d) - 1.0)
+    return cast(np.ndarray, d / 2.0 * (level ** (-2.0 / d) - 1.0))
 
 
 def _edge_taper(n_samples: int, dt: float) -> np.ndarray:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -95,9 +96,9 @@ class FrequencyResponse:
     @property
     def magnitude_db(self) -> np.ndarray:
         """Magnitude, dB, shape (n_freq,)."""
-        return 20.0 * np.log10(np.maximum(np.abs(self.response), 1e-300))
+        return cast(np.ndarray, 20.0 * np.log10(np.maximum(np.abs(self.response), 1e-300)))
 
     @property
     def phase_deg(self) -> np.ndarray:
         """Phase, deg, unwrapped along frequency, shape (n_freq,)."""
-        return np.degrees(np.unwrap(np.angle(self.response)))
+        return cast(np.ndarray, np.degrees(np.unwrap(np.angle(self.response))))

@@ -35,6 +35,7 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from scipy import optimize, stats
@@ -179,10 +180,10 @@ def _fit_corrected(x: np.ndarray, y: np.ndarray) -> _Fitted:
     start = float(np.clip(np.dot(u, 1.0 - 1.0 / y) / np.dot(u, u), -upper, upper * 0.999))  # linearised
 
     def residual(p: np.ndarray) -> np.ndarray:
-        return formulas.corrected(x, p[0]) - y
+        return cast(np.ndarray, formulas.corrected(x, p[0]) - y)
 
     def jac(p: np.ndarray) -> np.ndarray:
-        return (u * formulas.corrected(x, p[0]) ** 2)[:, None]
+        return cast(np.ndarray, (u * formulas.corrected(x, p[0]) ** 2)[:, None])
 
     result = optimize.least_squares(residual, [start], jac=jac, bounds=([-np.inf], [upper]), method="trf")
     notes = [] if result.success else [f"optimiser: {result.message}"]
@@ -211,7 +212,7 @@ def _fit_exponential(x: np.ndarray, y: np.ndarray) -> _Fitted:
     a0 = float(linear_fit(np.array(b0))[0][0])
 
     def residual(p: np.ndarray) -> np.ndarray:
-        return formulas.exponential(x, p[0], p[1]) - y
+        return cast(np.ndarray, formulas.exponential(x, p[0], p[1]) - y)
 
     def jac(p: np.ndarray) -> np.ndarray:
         e = np.exp(-x / p[1])

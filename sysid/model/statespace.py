@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import cast
 
 import numpy as np
 
@@ -74,4 +75,4 @@ class DelayedStateSpace:
         out = np.empty((omega.size, len(self.outputs), len(self.inputs)), dtype=complex)
         for k, s_k in enumerate(s):
             out[k] = self.c @ np.linalg.solve(s_k * identity - self.a, self.b) + self.d
-        return out * np.exp(-s[:, None, None] * np.asarray(self.input_delays_s)[None, None, :])
+        return cast(np.ndarray, out * np.exp(-s[:, None, None] * np.asarray(self.input_delays_s)[None, None, :]))

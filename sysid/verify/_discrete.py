@@ -14,6 +14,7 @@ between samples, as a mixer input is between autopilot loop updates.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from scipy import linalg
@@ -111,7 +112,7 @@ def delayed_inputs(model: DiscreteModel, inputs: np.ndarray) -> tuple[np.ndarray
 def output_feedthrough(model: DiscreteModel, now: np.ndarray, prev: np.ndarray) -> np.ndarray:
     """``D u(t_k - tau)``: the held value at the delayed instant, shape (n_samples, n_outputs)."""
     held = np.where(model.fraction[None, :] > 0, prev, now)
-    return held @ model.d.T
+    return cast(np.ndarray, held @ model.d.T)
 
 
 def simulate(model: DiscreteModel, inputs: np.ndarray, x0: np.ndarray) -> np.ndarray:
@@ -136,7 +137,7 @@ def simulate(model: DiscreteModel, inputs: np.ndarray, x0: np.ndarray) -> np.nda
     for k in range(inputs.shape[0]):
         states[k] = x
         x = model.ad @ x + drive[k]
-    return states @ model.c.T + output_feedthrough(model, now, prev)
+    return cast(np.ndarray, states @ model.c.T + output_feedthrough(model, now, prev))
 
 
 def predict_one_step(model: DiscreteModel, inputs: np.ndarray, measured: np.ndarray, x0: np.ndarray) -> np.ndarray:
@@ -165,4 +166,4 @@ def predict_one_step(model: DiscreteModel, inputs: np.ndarray, measured: np.ndar
         states[k] = x
         start = np.where(known[k], measured[k], x)
         x = model.ad @ start + drive[k]
-    return states @ model.c.T + output_feedthrough(model, now, prev)
+    return cast(np.ndarray, states @ model.c.T + output_feedthrough(model, now, prev))

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
@@ -204,7 +204,9 @@ def _one_step(
         if name in record.signals:
             states[:, i] = record[name]
     predicted = predict_one_step(disc, inputs, states, x0)[:, outputs]
-    return predicted + (measured - predicted).mean(axis=0)  # bias only: one step is too short to see a shift
+    return cast(
+        np.ndarray, predicted + (measured - predicted).mean(axis=0)
+    )  # bias only: one step is too short to see a shift
 
 
 def _overall(measured: np.ndarray, simulated: np.ndarray, weights: np.ndarray) -> tuple[float, float]:
