@@ -1,4 +1,4 @@
-"""The packages type-check (house style: mypy clean)."""
+"""The packages type-check under ``mypy --strict`` (house style; issue 13)."""
 
 from __future__ import annotations
 
@@ -11,9 +11,12 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.mark.slow
-def test_packages_are_mypy_clean() -> None:
+def test_packages_are_mypy_strict_clean() -> None:
     stdout, stderr, status = api.run(
         [
+            "--strict",
+            "--config-file",
+            str(ROOT / "pyproject.toml"),
             "--ignore-missing-imports",
             "--no-error-summary",
             "--cache-dir",

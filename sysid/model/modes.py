@@ -1,8 +1,14 @@
 """Modes of a linear model: eigenvalues, damping, natural frequency, time to double or half, and a label.
 
-Each mode is labelled by the states that take part in it, measured by
-participation factors ``|l_i r_i|`` (left times right eigenvector
-components, normalised), which do not depend on the states' units. States
+The state matrix is first split into its strongly connected blocks (states
+that feed each other back); the eigenvalues of a block-triangular matrix
+are those of its diagonal blocks, so each mode belongs to one block even
+when eigenvalues repeat across blocks (a dropped damping term leaves a zero
+eigenvalue in heave and another in yaw, which a whole-matrix eigenvector
+basis would mix). Within a block each mode is labelled by the states that
+take part in it, measured by participation factors ``|l_i r_i|`` (left
+times right eigenvector components, normalised), which do not depend on
+the states' units. States
 are grouped by name: ``roll`` (v, p, phi), ``pitch`` (u, q, theta), ``yaw``
 (r, psi), ``heave`` (w, z, height_agl) and ``actuator`` (``d_*`` lag
 states); any other state forms a group of its own name.
@@ -16,6 +22,7 @@ from typing import Any, Literal
 
 import numpy as np
 from scipy import linalg
+from scipy.sparse.csgraph import connected_components
 
 from sysid.model.statespace import DelayedStateSpace
 
@@ -156,6 +163,20 @@ def state_modes(a: np.ndarray, states: tuple[str, ...]) -> tuple[Mode, ...]:
     a = np.asarray(a, dtype=float)
     if a.size == 0:
         return ()
+    found: list[Mode] = []
+    for block in _coupled_blocks(a):
+        found += _block_modes(a[np.ix_(block, block)], [states[i] for i in block])
+    return tuple(sorted(found, key=lambda m: (m.mode, -m.real, -m.imag)))
+
+
+def _coupled_blocks(a: np.ndarray) -> list[np.ndarray]:
+    """State indices of each strongly connected block of `a` (edge j -> i where a[i, j] != 0)."""
+    n_blocks, label = connected_components(a != 0, directed=True, connection="strong")
+    return [np.flatnonzero(label == k) for k in range(n_blocks)]
+
+
+def _block_modes(a: np.ndarray, states: list[str]) -> list[Mode]:
+    """Modes of one strongly connected block, labelled by participation."""
     values, left, right = linalg.eig(a, left=True, right=True)
     found = []
     for k, value in enumerate(values):
@@ -166,7 +187,7 @@ def state_modes(a: np.ndarray, states: tuple[str, ...]) -> tuple[Mode, ...]:
         for name, share in zip(states, participation):
             groups[_group(name)] = groups.get(_group(name), 0.0) + float(share)
         found.append(_mode(complex(value.real, max(value.imag, 0.0)), max(groups, key=lambda g: groups[g])))
-    return tuple(sorted(found, key=lambda m: (m.mode, -m.real, -m.imag)))
+    return found
 
 
 def _mode(value: complex, label: str) -> Mode:

@@ -56,6 +56,19 @@ def test_calm_table_3_3_gives_the_si_eigenvalues_of_tables_md() -> None:
     assert {m.stability for m in found["yaw"] + found["heave"]} == {"neutral"}
 
 
+def test_repeated_zero_eigenvalues_keep_every_motion() -> None:
+    """Issue 14: with no speed damping or stability (X_u = M_u = Y_v = L_v = 0) and no Z_w, N_r the hover model
+    has eight zero eigenvalues; a whole-matrix eigenvector basis mixed them and labelled five "pitch", losing
+    roll, heave and yaw. Each motion keeps its own: pitch 3, roll 3, heave 1, yaw 1, actuator 3."""
+    values = {**TABLE_3_3_CALM, "X_u": 0.0, "M_u": 0.0, "Y_v": 0.0, "L_v": 0.0}
+    model, _ = structure_model(load_structure("hover"), values)
+    found = _by_mode(modes(model))
+    counts = {mode: sum(2 if m.oscillatory else 1 for m in group) for mode, group in found.items()}
+    assert counts == {"pitch": 3, "roll": 3, "heave": 1, "yaw": 1, "actuator": 3}
+    assert all(m.real == 0.0 and m.stability == "neutral" for m in found["pitch"] + found["roll"])
+    assert [m.real for m in found["actuator"]] == pytest.approx([-1 / 0.0458] * 3)
+
+
 def test_second_order_damping_and_frequency_are_analytic() -> None:
     zeta, omega_n = 0.3, 4.0
     a = np.array([[0.0, 1.0], [-(omega_n**2), -2 * zeta * omega_n]])
