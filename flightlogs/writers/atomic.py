@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
+import shutil
 import stat
 import tempfile
 from collections.abc import Iterator
@@ -23,6 +24,10 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     `path` is left untouched. The result has the permissions an ordinary
     ``open(path, "w")`` would give: those of the file it replaces, else
     0o666 less the umask (the temporary file itself is private, 0o600).
+    A `path` that is not a regular file (``/dev/null``, a pipe such as
+    ``>(cat)``, a terminal) is never replaced: the output is completed in a
+    private temporary folder and then written to it in one pass, so nothing
+    reaches it when the block fails.
 
     Parameters
     ----------
@@ -32,7 +37,8 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     Raises
     ------
     DataError
-        If the folder of `path` does not exist or is not a folder.
+        If the folder of `path` does not exist or is not a folder, or
+        `path` is a folder.
 
     Examples
     --------
@@ -44,6 +50,12 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     'done'
     """
     path = Path(path)
+    if path.is_dir():
+        raise DataError(f"{path}: is a folder, not a file to write")
+    if path.exists() and not path.is_file():
+        with _through_private_copy(path) as tmp:
+            yield tmp
+        return
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise DataError(
@@ -61,6 +73,16 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+@contextlib.contextmanager
+def _through_private_copy(path: Path) -> Iterator[Path]:
+    """Yield a temporary path in a private folder; copy it into the device or pipe `path` on success."""
+    with tempfile.TemporaryDirectory(prefix="sysid-") as folder:
+        tmp = Path(folder) / (path.name or "output")
+        yield tmp
+        with open(tmp, "rb") as source, open(path, "wb") as target:
+            shutil.copyfileobj(source, target)
 
 
 def _mode_for(path: Path) -> int:

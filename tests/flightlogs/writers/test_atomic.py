@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import os
 import stat
+import threading
 from pathlib import Path
 
 import pytest
 
+from flightlogs.errors import DataError
 from flightlogs.writers.atomic import atomic_output
 
 
@@ -55,7 +57,6 @@ def test_a_failure_leaves_the_old_file_and_no_temporary(tmp_path: Path) -> None:
 
 
 def test_a_missing_folder_is_a_data_error_naming_it(tmp_path: Path) -> None:
-    from flightlogs.errors import DataError
 
     with pytest.raises(DataError, match="nodir: the output folder does not exist"):
         with atomic_output(tmp_path / "nodir" / "x.h5"):
@@ -64,9 +65,64 @@ def test_a_missing_folder_is_a_data_error_naming_it(tmp_path: Path) -> None:
 
 
 def test_a_file_in_place_of_the_folder_is_a_data_error(tmp_path: Path) -> None:
-    from flightlogs.errors import DataError
 
     (tmp_path / "plain").write_text("x")
     with pytest.raises(DataError, match="plain: the output folder is a file"):
         with atomic_output(tmp_path / "plain" / "x.h5"):
             pass  # pragma: no cover - never entered
+
+
+def _read_fifo_in_background(fifo: Path) -> tuple[threading.Thread, list[bytes]]:
+    received: list[bytes] = []
+
+    def read() -> None:
+        with open(fifo, "rb") as stream:  # blocks until the writer opens the pipe
+            received.append(stream.read())
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    return reader, received
+
+
+def test_a_pipe_receives_the_output_and_stays_a_pipe(tmp_path: Path) -> None:
+    """``--json >(cat)``: the output goes through the pipe; it is not replaced by a regular file."""
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    reader, received = _read_fifo_in_background(fifo)
+    with atomic_output(fifo) as tmp:
+        tmp.write_text('{"ok": true}')
+        assert tmp.parent != tmp_path  # completed away from the pipe's folder
+    reader.join(timeout=10)
+    assert received == [b'{"ok": true}']
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe"]
+
+
+def test_a_failure_sends_nothing_down_a_pipe(tmp_path: Path) -> None:
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    with pytest.raises(RuntimeError), atomic_output(fifo) as tmp:
+        tmp.write_text("half")
+        raise RuntimeError("failed")
+    reader_fd = os.open(fifo, os.O_RDONLY | os.O_NONBLOCK)  # no writer ever opened it: reads nothing
+    try:
+        assert os.read(reader_fd, 100) == b""
+    finally:
+        os.close(reader_fd)
+    assert stat.S_ISFIFO(fifo.stat().st_mode)
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="making a character device needs root (the case the bug hit)")
+def test_a_character_device_is_written_through_not_replaced(tmp_path: Path) -> None:
+    """``-o /dev/null`` as root replaced the device by a regular file; here on a private copy of /dev/null."""
+    null = tmp_path / "null"
+    os.mknod(null, stat.S_IFCHR | 0o666, os.makedev(1, 3))
+    with atomic_output(null) as tmp:
+        tmp.write_text("discarded")
+    assert stat.S_ISCHR(null.stat().st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["null"]
+
+
+def test_a_folder_in_place_of_the_file_is_a_data_error(tmp_path: Path) -> None:
+    with pytest.raises(DataError, match="is a folder"), atomic_output(tmp_path):
+        pass
