@@ -1,4 +1,9 @@
-"""JSON encoding shared by the files sysid writes: NaN as ``null`` and back, nested float lists, atomic write and checked read."""
+"""JSON shared by the files sysid writes: float arrays as nested lists, ``null`` back as NaN, checked read.
+
+The encoding itself (NaN as ``null``, numpy values as numbers, the atomic
+write) is flightlogs' one encoder, :mod:`flightlogs.writers.jsonio`;
+:func:`finite_or_none` and :func:`write_json` are its, re-exported.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from flightlogs.errors import SysidError
-from flightlogs.writers.atomic import atomic_output
+from flightlogs.writers.jsonio import finite_or_none, jsonable, write_json
 
 __all__ = [
     "finite_or_none",
@@ -21,26 +26,6 @@ __all__ = [
     "write_json",
     "read_json_object",
 ]
-
-
-def finite_or_none(value: float | None) -> float | None:
-    """`value` as a float, or None (JSON ``null``) when it is None, NaN or infinite.
-
-    Parameters
-    ----------
-    value : float or None
-        Any number, in its own unit.
-
-    Returns
-    -------
-    float or None
-
-    Examples
-    --------
-    >>> finite_or_none(2), finite_or_none(float("nan")), finite_or_none(None)
-    (2.0, None, None)
-    """
-    return None if value is None or not math.isfinite(value) else float(value)
 
 
 def float_or_nan(value: Any) -> float:
@@ -81,9 +66,7 @@ def json_floats(values: np.ndarray) -> Any:
     >>> json_floats(np.array([[1.0, np.nan], [np.inf, 2.0]]))
     [[1.0, None], [None, 2.0]]
     """
-    if np.ndim(values) > 1:
-        return [json_floats(v) for v in values]
-    return [finite_or_none(float(v)) for v in np.ravel(values)]
+    return jsonable(np.atleast_1d(np.asarray(values, dtype=float)))
 
 
 def float_array(values: Any) -> np.ndarray:
@@ -125,27 +108,6 @@ def value_text(value: Any) -> str:
     """
     text = "null" if value is None else repr(value)
     return text if len(text) <= 40 else text[:37] + "..."
-
-
-def write_json(path: str | Path, doc: Any) -> Path:
-    """Write a JSON document (no NaN allowed, one-space indent, final newline), atomically.
-
-    Parameters
-    ----------
-    path : str or Path
-        Destination; its folder must exist.
-    doc : dict
-        JSON-compatible (non-finite numbers already None).
-
-    Returns
-    -------
-    Path
-        The path written.
-    """
-    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
-    with atomic_output(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-    return Path(path)
 
 
 def read_json_object(path: str | Path, error: type[SysidError], what: str) -> dict[str, Any]:

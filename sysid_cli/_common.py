@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-import math
 import os
 import sys
 from collections.abc import Callable, Iterator
@@ -13,7 +11,7 @@ from typing import Any
 
 import click
 
-from flightlogs.writers.atomic import atomic_output
+from flightlogs.writers.jsonio import json_text, write_json
 
 __all__ = ["OutputPath", "json_option", "emit_json", "progress_bar"]
 
@@ -75,27 +73,14 @@ json_option = click.option(
 )
 
 
-def _clean(value: Any) -> Any:
-    """JSON has no NaN: write null instead."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _clean(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_clean(v) for v in value]
-    return value
-
-
 def emit_json(summary: dict[str, Any], json_path: str | None) -> None:
-    """Write `summary` as JSON to a file (atomically) or to stdout for ``-``."""
+    """Write `summary` as JSON (NaN as null) to a file (atomically) or to stdout for ``-``."""
     if json_path is None:
         return
-    text = json.dumps(_clean(summary), indent=2, allow_nan=False) + "\n"
     if json_path == "-":
-        sys.stdout.write(text)
+        sys.stdout.write(json_text(summary, indent=2))
         return
-    with atomic_output(json_path) as tmp:
-        Path(tmp).write_text(text)
+    write_json(json_path, summary, indent=2)
 
 
 @contextmanager

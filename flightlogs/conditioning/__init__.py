@@ -12,8 +12,6 @@ from flightlogs.conditioning.lag import (
     FROZEN_TURBULENCE_LIMIT,
     LagEstimate,
     TransportDelay,
-    bearing_and_distance,
-    destination_point,
     estimate_lag,
     transport_delay,
 )
@@ -43,8 +41,6 @@ __all__ = [
     "estimate_lag",
     "TransportDelay",
     "transport_delay",
-    "bearing_and_distance",
-    "destination_point",
     "FROZEN_TURBULENCE_LIMIT",
     "Method",
     "SeriesLike",

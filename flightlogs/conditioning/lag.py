@@ -15,14 +15,11 @@ __all__ = [
     "estimate_lag",
     "TransportDelay",
     "transport_delay",
-    "bearing_and_distance",
-    "destination_point",
     "FROZEN_TURBULENCE_LIMIT",
 ]
 
 #: Taylor's frozen-turbulence condition: sigma_M / M must stay below this (section 3.3.2).
 FROZEN_TURBULENCE_LIMIT = 0.5
-_EARTH_RADIUS_M = 6_371_008.8
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -229,71 +226,3 @@ def transport_delay(
         speed_std_m_s=speed_std,
         bearing_rad=bearing,
     )
-
-
-def bearing_and_distance(lat_from: float, lon_from: float, lat_to: float, lon_to: float) -> tuple[float, float]:
-    """Initial bearing and great-circle distance between two positions (haversine, spherical Earth).
-
-    Parameters
-    ----------
-    lat_from, lon_from : float
-        Start (the anemometer), WGS-84 latitude and longitude, rad.
-    lat_to, lon_to : float
-        End (the vehicle), rad.
-
-    Returns
-    -------
-    tuple of float
-        Bearing, rad clockwise from north in [0, 2π), and distance, m.
-
-    Notes
-    -----
-    The sphere of mean radius 6 371 008.8 m is within 0.5 % of the
-    ellipsoid's distances: millimetres over an anemometer's few metres.
-
-    Examples
-    --------
-    >>> bearing, distance = bearing_and_distance(0.0, 0.0, 0.0, np.radians(0.001))
-    >>> round(float(np.degrees(bearing)), 6), round(distance, 2)
-    (90.0, 111.2)
-    """
-    phi1, phi2 = lat_from, lat_to
-    dlon = lon_to - lon_from
-    dphi = phi2 - phi1
-    hav = np.sin(dphi / 2) ** 2 + np.cos(phi1) * np.cos(phi2) * np.sin(dlon / 2) ** 2
-    distance = 2 * _EARTH_RADIUS_M * np.arcsin(np.sqrt(hav))
-    bearing = np.arctan2(
-        np.sin(dlon) * np.cos(phi2), np.cos(phi1) * np.sin(phi2) - np.sin(phi1) * np.cos(phi2) * np.cos(dlon)
-    )
-    return float(np.mod(bearing, 2 * np.pi)), float(distance)
-
-
-def destination_point(lat_rad: float, lon_rad: float, bearing_rad: float, distance_m: float) -> tuple[float, float]:
-    """Position reached from a start along a great circle, the inverse of :func:`bearing_and_distance`.
-
-    Parameters
-    ----------
-    lat_rad, lon_rad : float
-        Start, WGS-84 latitude and longitude, rad.
-    bearing_rad : float
-        Initial direction, rad clockwise from north.
-    distance_m : float
-        Distance travelled, m.
-
-    Returns
-    -------
-    tuple of float
-        Latitude and longitude of the end, rad (longitude in [-π, π)).
-
-    Examples
-    --------
-    >>> lat, lon = destination_point(0.0, 0.0, np.pi / 2, 111.2)
-    >>> round(float(np.degrees(lon)), 5), round(float(lat), 12)
-    (0.001, 0.0)
-    """
-    angle = distance_m / _EARTH_RADIUS_M
-    lat = np.arcsin(np.sin(lat_rad) * np.cos(angle) + np.cos(lat_rad) * np.sin(angle) * np.cos(bearing_rad))
-    lon = lon_rad + np.arctan2(
-        np.sin(bearing_rad) * np.sin(angle) * np.cos(lat_rad), np.cos(angle) - np.sin(lat_rad) * np.sin(lat)
-    )
-    return float(lat), float(np.mod(lon + np.pi, 2 * np.pi) - np.pi)

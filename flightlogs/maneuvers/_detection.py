@@ -18,6 +18,8 @@ from scipy.fft import irfft, next_fast_len, rfft
 from scipy.ndimage import binary_dilation, median_filter, uniform_filter1d
 from scipy.stats import spearmanr
 
+from flightlogs.masks import true_runs
+
 __all__: list[str] = []
 
 _SHORT_S = 0.2  # window of the short moving mean and RMS, s
@@ -221,17 +223,12 @@ def _robust_std(x: np.ndarray, quantile: float = 0.5, *, centred: bool = False) 
     return spread if spread > 0 else float(np.std(x))
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """Inclusive index ranges of the True runs of `mask`."""
-    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
-    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
-
-
 def _bursts(axis: str, act: _Activity, dt: float, threshold: float, merge_s: float, active_s: float) -> list[_Burst]:
     """Each burst: active runs merged over short pauses."""
     active = np.maximum(act.mean_z, act.rms_z) > threshold
     merged: list[list[int]] = []
-    for a, b in _runs(active):
+    for a, stop in true_runs(active):
+        b = stop - 1  # a burst spans samples first..last inclusive
         if merged and (a - merged[-1][1]) * dt < merge_s:
             merged[-1][1] = b
         else:
@@ -448,4 +445,4 @@ def hover_spans(
     pad = int(round(margin_s / (t[1] - t[0])))
     for lo, hi in busy:
         quiet[max(0, lo - pad) : hi + pad + 1] = False
-    return [(float(t[a]), float(t[b])) for a, b in _runs(quiet) if t[b] - t[a] >= min_hover_s]
+    return [(float(t[a]), float(t[b - 1])) for a, b in true_runs(quiet) if t[b - 1] - t[a] >= min_hover_s]

@@ -23,8 +23,9 @@ from typing import cast
 import numpy as np
 
 from flightlogs.errors import DataError
-from flightlogs.maneuvers._detection import _activity, _bursts, _runs
+from flightlogs.maneuvers._detection import _activity, _bursts
 from flightlogs.maneuvers._doublet_fit import fit_doublet
+from flightlogs.masks import true_runs
 
 __all__ = ["FEEDBACK_STATES", "estimate_excitation"]
 
@@ -167,7 +168,7 @@ def _with_doublets(
     bursts = _candidates(base, u, finite, dt)
     pad = int(round((_PAD_S if trusted else _WIDE_PAD_S) / dt))
     gap, out = int(round(_GAP_S / dt)), base.copy()
-    pieces = _runs(finite)
+    pieces = [(start, stop - 1) for start, stop in true_runs(finite)]  # inclusive, as the bursts
     for k, (a, b) in enumerate(bursts):
         piece = next((p for p in pieces if p[0] <= a and b <= p[1]), None)
         if piece is None or (b - a) * dt > _MAX_BURST_S:

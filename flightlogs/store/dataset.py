@@ -39,6 +39,7 @@ import numpy as np
 from flightlogs.flightlog import FlightLog, Signal, SystemIdRun
 from flightlogs.store.schema import open_schema, stamp_schema
 from flightlogs.writers.atomic import atomic_output
+from flightlogs.writers.jsonio import jsonable
 
 __all__ = ["Dataset", "write_dataset", "read_dataset", "file_sha256", "SCHEMA_VERSION"]
 
@@ -251,18 +252,8 @@ def _write_dataclass(group: h5py.Group, item: Any) -> None:
         elif isinstance(value, (str, int, float, bool, np.floating, np.integer)):
             group.attrs[field.name] = value
         else:
-            group.attrs[field.name] = json.dumps(_jsonable(value))
+            group.attrs[field.name] = json.dumps(jsonable(value, nonfinite="keep"))
             group.attrs[f"{field.name}.json"] = True
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, Path):
-        return str(value)
-    if isinstance(value, dict) or hasattr(value, "items"):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (tuple, list)):
-        return [_jsonable(v) for v in value]
-    return value
 
 
 def _read_wind(group: h5py.Group) -> Any:
@@ -304,7 +295,7 @@ def _write_conditioned(group: h5py.Group, flight: Any) -> None:
     group.attrs["source"] = str(flight.source)
     group.attrs["rate_hz"] = flight.rate_hz
     group.attrs["warnings"] = json.dumps(list(flight.warnings))
-    group.attrs["wind_alignment"] = json.dumps(_jsonable(_asdict(flight.wind)))
+    group.attrs["wind_alignment"] = json.dumps(jsonable(flight.wind, nonfinite="keep"))
     rows = [
         (
             s.axis or "",
@@ -328,10 +319,6 @@ def _write_conditioned(group: h5py.Group, flight: Any) -> None:
         sub.create_dataset("time_s", data=record.time_s)
         for name in record.signals:
             sub.create_dataset(name, data=record[name], compression="gzip", shuffle=True)
-
-
-def _asdict(item: Any) -> Any:
-    return None if item is None else dataclasses.asdict(item)
 
 
 def _read_conditioned(group: h5py.Group) -> Any:

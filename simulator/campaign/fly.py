@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta
@@ -10,7 +9,7 @@ from pathlib import Path
 from typing import Any, cast
 
 from flightlogs.errors import DataError
-from flightlogs.writers.atomic import atomic_output
+from flightlogs.writers.jsonio import write_json
 from simulator.autopilot.excitation import Axis, Maneuver
 from simulator.campaign.scenario import ManeuverSpec, Scenario, WindCondition
 from simulator.flights.linear import SimulatedFlight, WindField, simulate_hover
@@ -325,5 +324,4 @@ def _write_index(scenario: Scenario, written: Sequence[TrialFiles], path: Path) 
             for t in written
         ],
     }
-    with atomic_output(path) as tmp:
-        tmp.write_text(json.dumps(index, indent=2) + "\n")
+    write_json(path, index, indent=2)

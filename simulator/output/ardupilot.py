@@ -15,7 +15,6 @@ mean offset).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
@@ -23,9 +22,10 @@ from pathlib import Path
 import numpy as np
 from scipy import signal as sps
 
-from flightlogs.conditioning.lag import destination_point
+from flightlogs.geo import destination_point, lat_lon_offset
 from flightlogs.writers.atomic import atomic_output
 from flightlogs.writers.dataflash import MessageBlock, standard_block, write_dataflash
+from flightlogs.writers.jsonio import write_json
 from simulator.autopilot.excitation import Maneuver, sweep
 from simulator.flights.linear import SimulatedFlight
 
@@ -38,7 +38,6 @@ _GPS_EPOCH = datetime(1980, 1, 6, tzinfo=UTC)
 _LEAP_SECONDS = 18
 _SID_AXIS = {"lat": 10, "lon": 11, "yaw": 12, "thr": 13}  # ArduPilot SID_AXIS: mixer roll/pitch/yaw/thrust
 _BOOT_S = 20.0  # the log starts this long after boot
-_EARTH_RADIUS_M = 6_371_008.8
 _HOLD_S = 2.0  # time constant of the position hold's wander
 
 
@@ -184,10 +183,8 @@ def _gps_track(flight: SimulatedFlight, hover_deg: tuple[float, float]) -> tuple
         wander = [
             sps.lfilter([dt], [1.0, -keep], flight.signals[name] - flight.signals[name].mean()) for name in ("vn", "ve")
         ]
-    lat0 = np.radians(hover_deg[0])
-    lat = hover_deg[0] + np.degrees(wander[0] / _EARTH_RADIUS_M)
-    lng = hover_deg[1] + np.degrees(wander[1] / (_EARTH_RADIUS_M * np.cos(lat0)))
-    return lat, lng
+    dlat, dlon = lat_lon_offset(wander[0], wander[1], np.radians(hover_deg[0]))
+    return hover_deg[0] + np.degrees(dlat), hover_deg[1] + np.degrees(dlon)
 
 
 def _octo_pwm(out: dict[str, np.ndarray], hover: float) -> dict[str, np.ndarray]:
@@ -360,6 +357,4 @@ def write_truth(
             ],
         }
         truth["vehicle_position_deg"] = list(vehicle_position_deg)
-    with atomic_output(path) as tmp:
-        tmp.write_text(json.dumps(truth, indent=2) + "\n")
-    return Path(path)
+    return write_json(path, truth, indent=2)

@@ -22,6 +22,7 @@ from typing import Literal, cast
 
 import numpy as np
 
+from flightlogs.geo import lat_lon_offset
 from flightlogs.writers.ulog import TopicData, write_ulog
 from simulator.flights.linear import SimulatedFlight
 
@@ -29,7 +30,6 @@ __all__ = ["Airframe", "AIRFRAMES", "write_px4_log"]
 
 _EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
 _ORIGIN = (47.397742, 8.545594, 488.0)  # PX4's default home: lat, lon (deg), altitude (m MSL)
-_EARTH_RADIUS_M = 6_371_000.0
 _VER_SW_RELEASE = 0x011000FF  # v1.16.0, release
 _RATES_HZ = {"battery_status": 10.0, "sensor_gps": 5.0, "wind": 25.0}
 _REQUIRED = (
@@ -414,8 +414,8 @@ def _gps(stamps: np.ndarray, t: np.ndarray, s: _Signals, utc_start: datetime, ev
     since_us = np.round((t[pick] - t[0]) * 1e6).astype(np.int64)
     n = since_us.size
     north, east = _position_ne(t, s)[pick].T
-    lat = _ORIGIN[0] + np.degrees(north / _EARTH_RADIUS_M)
-    lon = _ORIGIN[1] + np.degrees(east / (_EARTH_RADIUS_M * np.cos(np.radians(_ORIGIN[0]))))
+    dlat, dlon = lat_lon_offset(north, east, np.radians(_ORIGIN[0]))
+    lat, lon = _ORIGIN[0] + np.degrees(dlat), _ORIGIN[1] + np.degrees(dlon)
     vn, ve, vd = (np.asarray(s[k])[pick] for k in ("vn", "ve", "vd"))
     return TopicData(
         "sensor_gps",

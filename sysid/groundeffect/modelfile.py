@@ -202,7 +202,7 @@ def write_ground_effect_model(fit: GroundEffectFit, path: str | Path) -> Path:
         "rotor_radius_m": chosen.rotor_radius_m,
         "min_height_ratio": chosen.min_height_ratio,
         "source": chosen.source,
-        "fit": _finite(fit_summary(fit)),
+        "fit": fit_summary(fit),  # NaN written null
     }
     return write_json(path, document)
 
@@ -294,14 +294,3 @@ def _number(
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ModelError(f"{path}: {label or key} is {_show(value)}, not a finite number")
     return float(value)
-
-
-def _finite(value: Any) -> Any:
-    """JSON has no NaN or infinity: write null."""
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
-    return value

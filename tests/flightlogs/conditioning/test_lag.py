@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import signal as sps
 
-from flightlogs.conditioning.lag import bearing_and_distance, destination_point, estimate_lag, transport_delay
+from flightlogs.conditioning.lag import estimate_lag, transport_delay
 from flightlogs.errors import DataError
 
 RATE_HZ = 100.0
@@ -96,26 +96,6 @@ def test_a_downstream_anemometer_is_refused() -> None:
     with pytest.raises(DataError, match="distance"):
         transport_delay(wind)
     assert transport_delay(wind, delay_s=0.4).delay_s == 0.4
-
-
-def test_bearing_and_distance_against_known_points() -> None:
-    """Radians in; one degree of latitude is 111 195 m on the mean-radius sphere (analytic)."""
-    lat, lon = np.radians(45.0), np.radians(7.0)
-    bearing, distance = bearing_and_distance(lat, lon, lat + np.radians(4.6 / 111_195.0), lon)
-    assert bearing == pytest.approx(0.0, abs=1e-9) and distance == pytest.approx(4.6, rel=1e-3)
-    bearing, _ = bearing_and_distance(lat, lon, lat, np.radians(6.9999))
-    assert np.degrees(bearing) == pytest.approx(270.0, abs=1e-3)
-
-
-@pytest.mark.parametrize("bearing_deg", [0.0, 37.0, 90.0, 211.0, 300.0])
-@pytest.mark.parametrize("lat_deg, lon_deg", [(35.0, -106.9), (-35.36, 149.16), (51.9, 179.99999)])
-def test_destination_point_inverts_bearing_and_distance(lat_deg: float, lon_deg: float, bearing_deg: float) -> None:
-    """Out 4.6 m and back: the bearing and distance come back to 1e-9 rad and 1 µm (round trip)."""
-    start = np.radians(lat_deg), np.radians(lon_deg)
-    end = destination_point(*start, np.radians(bearing_deg), 4.6)
-    bearing, distance = bearing_and_distance(*start, *end)
-    assert distance == pytest.approx(4.6, abs=1e-6)
-    assert np.angle(np.exp(1j * (bearing - np.radians(bearing_deg)))) == pytest.approx(0.0, abs=1e-7)
 
 
 def test_the_transport_delay_records_the_bearing_it_used() -> None:
