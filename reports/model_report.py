@@ -1,8 +1,9 @@
 """The model report: one self-contained HTML page on an identified model and, when given, its verification.
 
-Sections: a summary card with a verdict against Tischler's guidelines
-(DESIGN.md), Bode and coherence of every response with the model overlaid,
-parameters with CR% and I%, costs, correlations, modes and poles, the
+Sections: a summary card with the verdict of :func:`sysid.fit.model_verdict`
+against Tischler's guidelines (DESIGN.md) as the model was fitted with them,
+Bode and coherence of every response with the model overlaid, parameters
+with CR% and I%, costs, correlations, modes and poles, the
 verification on doublets (with and without the wind term), the structure
 reduction log and provenance. Everything that comes from a log or a file
 (vehicle names, labels, parameter names, notes, options) is escaped by the
@@ -16,11 +17,12 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
-from sysid.fit import IdentifiedModel
+from sysid.fit import Guidelines, IdentifiedModel, Verdict, model_verdict
+from sysid.fit.result import PARAMETER_STATUSES
 from sysid.freqresp import FrequencyResponse
 from sysid.model.modes import Mode, modes
 from sysid.verify import Verification
@@ -28,228 +30,12 @@ from sysid.verify import Verification
 from .html import render_html, write_html
 from .model_figures import correlation_figure, pole_map_figure, response_figures
 from .svg import figure_svg
-from .verify_section import TIC_ACCEPTABLE, TIC_GOOD, sized_svg, verification_context
+from .verify_section import sized_svg, verification_context
 
-__all__ = [
-    "J_AVE_GOOD",
-    "J_AVE_ACCEPTABLE",
-    "J_RESPONSE_MAX",
-    "CR_MAX_PERCENT",
-    "INSENSITIVITY_MAX_PERCENT",
-    "CORRELATION_FLAG",
-    "TIC_GOOD",
-    "TIC_ACCEPTABLE",
-    "Check",
-    "Verdict",
-    "model_verdict",
-    "model_report_html",
-    "write_model_report",
-]
+__all__ = ["CORRELATION_FLAG", "model_report_html", "write_model_report"]
 
-#: J_ave of a good fit (eq. 3.9; Tischler & Remple).
-J_AVE_GOOD = 100.0
-#: J_ave of an acceptable fit.
-J_AVE_ACCEPTABLE = 150.0
-#: Guideline on the cost of any single response.
-J_RESPONSE_MAX = 200.0
-#: Cramér–Rao bound guideline, % of the value.
-CR_MAX_PERCENT = 20.0
-#: Insensitivity guideline, % of the value.
-INSENSITIVITY_MAX_PERCENT = 10.0
 #: |r| above which two parameters are reported as correlated.
 CORRELATION_FLAG = 0.9
-
-Grade = Literal["good", "acceptable", "poor"]
-_ORDER: dict[str, int] = {"good": 0, "acceptable": 1, "poor": 2}
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Check:
-    """One guideline and how the model meets it.
-
-    Parameters
-    ----------
-    guideline : str
-        What is checked, in words.
-    value : str
-        The model's figure, for display.
-    limit : str
-        The guideline's limit, for display.
-    grade : {"good", "acceptable", "poor"}
-        Met, nearly met (or missed where Tischler tolerates a few), missed.
-    problem : str
-        What misses the guideline, in words; empty when it is met.
-    """
-
-    guideline: str
-    value: str
-    limit: str
-    grade: Grade
-    problem: str = ""
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Verdict:
-    """The report's verdict: the worst grade of its checks, said in one sentence.
-
-    Parameters
-    ----------
-    grade : {"good", "acceptable", "poor"}
-        Worst grade of `checks`.
-    sentence : str
-        One sentence for the summary card.
-    checks : tuple of Check
-        Cost, response costs, parameter accuracy and (when verified) prediction.
-    """
-
-    grade: Grade
-    sentence: str
-    checks: tuple[Check, ...]
-
-
-def _worst(grades: Sequence[Grade]) -> Grade:
-    return max(grades, key=lambda g: _ORDER[g], default="good")
-
-
-def _misses(p: Any) -> bool:
-    cr, ins = p.cr_percent, p.insensitivity_percent
-    return p.status == "estimated" and (
-        (math.isfinite(cr) and cr > CR_MAX_PERCENT) or (math.isfinite(ins) and ins > INSENSITIVITY_MAX_PERCENT)
-    )
-
-
-def _cost_checks(model: IdentifiedModel) -> list[Check]:
-    j = model.cost.average
-    grade: Grade = "good" if j <= J_AVE_GOOD else "acceptable" if j <= J_AVE_ACCEPTABLE else "poor"
-    problem = (
-        ""
-        if grade == "good"
-        else (
-            f"J_ave = {j:.1f} is above {J_AVE_GOOD:g}"
-            + (f" (acceptable up to {J_AVE_ACCEPTABLE:g})" if grade == "acceptable" else f" and {J_AVE_ACCEPTABLE:g}")
-        )
-    )
-    checks = [
-        Check(
-            guideline="average cost J_ave",
-            value=f"{j:.1f}",
-            limit=f"≤ {J_AVE_GOOD:g} good, ≤ {J_AVE_ACCEPTABLE:g} acceptable",
-            grade=grade,
-            problem=problem,
-        )
-    ]
-    over = {k: v for k, v in model.cost.responses.items() if not v <= J_RESPONSE_MAX}
-    worst = max(model.cost.responses.values(), default=math.nan)
-    problem = (
-        ""
-        if not over
-        else (
-            f"{len(over)} response cost{'s' if len(over) > 1 else ''} exceed "
-            f"{J_RESPONSE_MAX:g} ({', '.join(f'{k} {v:.0f}' for k, v in over.items())})"
-        )
-    )
-    checks.append(
-        Check(
-            guideline="cost of each response J",
-            value=f"worst {worst:.1f}",
-            limit=f"≤ {J_RESPONSE_MAX:g}",
-            grade="acceptable" if over else "good",
-            problem=problem,
-        )
-    )
-    return checks
-
-
-def _parameter_check(model: IdentifiedModel) -> Check:
-    estimated = [p for p in model.parameters if p.status == "estimated"]
-    failing = [p.name for p in estimated if _misses(p)]
-    problem = (
-        ""
-        if not failing
-        else (
-            f"{len(failing)} of {len(estimated)} estimated parameters miss CR ≤ "
-            f"{CR_MAX_PERCENT:g} % or I ≤ {INSENSITIVITY_MAX_PERCENT:g} % "
-            f"({', '.join(failing)})"
-        )
-    )
-    return Check(
-        guideline="parameter accuracy",
-        value=f"{len(estimated) - len(failing)} of {len(estimated)} within",
-        limit=f"CR ≤ {CR_MAX_PERCENT:g} %, I ≤ {INSENSITIVITY_MAX_PERCENT:g} %",
-        grade="acceptable" if failing else "good",
-        problem=problem,
-    )
-
-
-def _verification_check(verification: Verification) -> Check | None:
-    if not verification.summary:
-        return None
-    worst = max(verification.summary, key=lambda s: s.tic if math.isfinite(s.tic) else math.inf)
-    tic = worst.tic
-    grade: Grade = "good" if tic <= TIC_GOOD else "acceptable" if tic <= TIC_ACCEPTABLE else "poor"
-    shown = f"{tic:.2f}" if round(tic, 2) not in (TIC_GOOD, TIC_ACCEPTABLE) else f"{tic:.3f}"
-    problem = (
-        ""
-        if grade == "good"
-        else (
-            f"the worst doublet prediction has TIC {shown} ({worst.name}), above "
-            f"{TIC_GOOD:g}" + ("" if grade == "acceptable" else f"-{TIC_ACCEPTABLE:g}")
-        )
-    )
-    return Check(
-        guideline="prediction of doublets, worst on-axis output TIC",
-        value=f"{shown} ({worst.name})",
-        limit=f"≤ {TIC_GOOD:g}-{TIC_ACCEPTABLE:g}",
-        grade=grade,
-        problem=problem,
-    )
-
-
-def model_verdict(model: IdentifiedModel, verification: Verification | None = None) -> Verdict:
-    """Judge a model by the guidelines of DESIGN.md (Tischler & Remple).
-
-    J_ave ≤ 100 is good and ≤ 150 acceptable; any single response cost
-    above 200, or an estimated parameter with CR% > 20 or I% > 10, makes the
-    model at best acceptable; when verified, the worst output's Theil
-    inequality coefficient must be ≤ 0.25 (good) or ≤ 0.3 (acceptable); only
-    the on-axis outputs of each doublet are judged (the off-axis ones are
-    shown for information).
-
-    Parameters
-    ----------
-    model : IdentifiedModel
-        The model.
-    verification : Verification, optional
-        Its verification on doublets not used in the fit.
-
-    Returns
-    -------
-    Verdict
-    """
-    checks = _cost_checks(model) + [_parameter_check(model)]
-    verified = _verification_check(verification) if verification is not None else None
-    if verified is not None:
-        checks.append(verified)
-    grade = _worst([c.grade for c in checks])
-    n = sum(p.status == "estimated" for p in model.parameters)
-    fit_ok = all(c.grade == "good" for c in checks if c is not verified)
-    fit_text = (
-        f"J_ave = {model.cost.average:.1f} ≤ {J_AVE_GOOD:g}, every response cost ≤ {J_RESPONSE_MAX:g}, "
-        f"all {n} estimated parameters within CR ≤ {CR_MAX_PERCENT:g} % and I ≤ "
-        f"{INSENSITIVITY_MAX_PERCENT:g} %"
-    )
-    if grade == "good":
-        sentence = f"Good model by Tischler's guidelines: {fit_text}" + (
-            f", and doublets predicted with TIC ≤ {TIC_GOOD:g} (worst {verified.value})."
-            if verified is not None
-            else "; not yet verified on doublets."
-        )
-    else:
-        sentence = f"{grade.capitalize()} model: " + "; ".join(c.problem for c in checks if c.problem)
-        if fit_ok:
-            sentence += f", although the fit meets the guidelines ({fit_text})"
-        sentence += "." if verified is not None else "; not yet verified on doublets."
-    return Verdict(grade=grade, sentence=sentence, checks=tuple(checks))
 
 
 def _wind_text(model: IdentifiedModel) -> str:
@@ -275,7 +61,7 @@ def _card(
     model: IdentifiedModel, verification: Verification | None, logs_summary: Mapping[str, str] | None
 ) -> list[tuple[str, str]]:
     structure = model.structure
-    counts = {s: sum(p.status == s for p in model.parameters) for s in ("estimated", "fixed", "dropped")}
+    counts = {s: sum(p.status == s for p in model.parameters) for s in PARAMETER_STATUSES}
     facts: dict[str, str] = {
         "structure": (
             f"{model.structure_name}: {structure.description} ({len(structure.states)} states, "
@@ -297,8 +83,16 @@ def _card(
         )
     facts.setdefault(
         "parameters",
-        f"{counts['estimated']} estimated, {counts['fixed']} fixed, {counts['dropped']} dropped by structure reduction",
+        f"{counts['estimated']} estimated, {counts['fixed']} fixed, {counts['dropped']} dropped by structure reduction"
+        + (f", {counts['unidentified']} unidentified (no value)" if counts["unidentified"] else ""),
     )
+    missing = model.unidentified_axes
+    if missing:
+        facts.setdefault(
+            "axes",
+            f"identified: {', '.join(a.axis for a in model.axis_status if a.identified) or 'none'}; "
+            + "; ".join(f"unidentified, so not simulated: {a.axis} ({a.reason})" for a in missing),
+        )
     if verification is not None:
         sources = ", ".join(dict.fromkeys(r.source.name for r in verification.records))
         facts.setdefault(
@@ -327,6 +121,7 @@ class _ParameterRow:
     stage: str
     cr_flag: bool
     ins_flag: bool
+    unidentified: bool
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -341,7 +136,7 @@ class _CostRow:
     conditioned: str
 
 
-def _parameter_rows(model: IdentifiedModel) -> list[_ParameterRow]:
+def _parameter_rows(model: IdentifiedModel, guidelines: Guidelines) -> list[_ParameterRow]:
     rows = []
     for p in model.parameters:
         estimated = p.status == "estimated"
@@ -354,14 +149,15 @@ def _parameter_rows(model: IdentifiedModel) -> list[_ParameterRow]:
                 ins=p.insensitivity_percent,
                 status=p.status,
                 stage=p.stage,
-                cr_flag=estimated and p.cr_percent > CR_MAX_PERCENT,
-                ins_flag=estimated and p.insensitivity_percent > INSENSITIVITY_MAX_PERCENT,
+                cr_flag=estimated and guidelines.misses_cr(p.cr_percent),
+                ins_flag=estimated and guidelines.misses_insensitivity(p.insensitivity_percent),
+                unidentified=p.unidentified,
             )
         )
     return rows
 
 
-def _cost_rows(model: IdentifiedModel) -> list[_CostRow]:
+def _cost_rows(model: IdentifiedModel, guidelines: Guidelines) -> list[_CostRow]:
     responses: dict[str, FrequencyResponse] = {}
     for fitted in model.responses:
         responses.setdefault(fitted.pair, fitted)
@@ -380,7 +176,7 @@ def _cost_rows(model: IdentifiedModel) -> list[_CostRow]:
             _CostRow(
                 pair=pair,
                 cost=cost,
-                flag=not cost <= J_RESPONSE_MAX,
+                flag=guidelines.response_cost_exceeds(cost),
                 low=low,
                 high=high,
                 decades=decades,
@@ -436,6 +232,7 @@ def model_report_html(
     logs_summary: Mapping[str, str] | None = None,
     verification_options: Mapping[str, Any] | None = None,
     generated_utc: str | None = None,
+    verdict: Verdict | None = None,
 ) -> str:
     """The model report as HTML text.
 
@@ -456,12 +253,16 @@ def model_report_html(
         Options the verification was run with, listed under provenance.
     generated_utc : str, optional
         Time stamp of the footer; default now (pass one for a reproducible file).
+    verdict : Verdict, optional
+        The verdict to show, whose guidelines also flag the tables; default
+        :func:`sysid.fit.model_verdict` of `model` and `verification`.
 
     Returns
     -------
     str
         One self-contained HTML document (inline CSS and SVG, no scripts, no fetches).
     """
+    verdict = model_verdict(model, verification) if verdict is None else verdict
     linear = model.linear_model(include_wind=False)
     found = modes(linear)
     min_coherence = model.provenance.options.get("min_coherence")
@@ -473,7 +274,7 @@ def model_report_html(
     context: dict[str, Any] = {
         "title": title or f"Identified model: {model.structure_name}",
         "model": model,
-        "verdict": model_verdict(model, verification),
+        "verdict": verdict,
         "card": _card(model, verification, logs_summary),
         "bode": [
             _shown(f, caption)
@@ -481,23 +282,15 @@ def model_report_html(
                 model, min_coherence=float(min_coherence) if isinstance(min_coherence, (int, float)) else None
             )
         ],
-        "parameters": _parameter_rows(model),
-        "costs": _cost_rows(model),
+        "parameters": _parameter_rows(model, verdict.guidelines),
+        "costs": _cost_rows(model, verdict.guidelines),
         "correlation": _shown(correlation_figure(names, matrix), "") if len(names) >= 2 else None,
         "correlated": _correlated(names, matrix),
         "n_correlated": len(names),
         "modes": _mode_rows(found),
         "poles": _shown(pole_map_figure(found), "") if found else None,
-        "limits": {
-            "cr": CR_MAX_PERCENT,
-            "ins": INSENSITIVITY_MAX_PERCENT,
-            "j_good": J_AVE_GOOD,
-            "j_ok": J_AVE_ACCEPTABLE,
-            "j_one": J_RESPONSE_MAX,
-            "r": CORRELATION_FLAG,
-            "tic_good": TIC_GOOD,
-            "tic_ok": TIC_ACCEPTABLE,
-        },
+        "guidelines": verdict.guidelines,
+        "correlation_flag": CORRELATION_FLAG,
         "options": _flatten(model.provenance.options),
         "verification_options": _flatten(verification_options or {}),
         "files": [(f, model.provenance.sha256.get(f, "")) for f in model.provenance.files],
@@ -505,7 +298,7 @@ def model_report_html(
         "constants": [(k, v) for k, v in model.constants.items()],
         "data_text": ", ".join(Path(f).name for f in model.provenance.files) or "flight data not recorded in the file",
     }
-    context.update(verification_context(verification))
+    context.update(verification_context(verification, verdict.guidelines))
     if generated_utc is not None:
         context["generated_utc"] = generated_utc
     return render_html("model.html", **context)
@@ -520,6 +313,7 @@ def write_model_report(
     logs_summary: Mapping[str, str] | None = None,
     verification_options: Mapping[str, Any] | None = None,
     generated_utc: str | None = None,
+    verdict: Verdict | None = None,
 ) -> Path:
     """Render the model report and write it atomically.
 
@@ -539,6 +333,8 @@ def write_model_report(
         Options the verification was run with.
     generated_utc : str, optional
         Time stamp of the footer; default now.
+    verdict : Verdict, optional
+        The verdict to show; default :func:`sysid.fit.model_verdict` of `model` and `verification`.
 
     Returns
     -------
@@ -554,5 +350,6 @@ def write_model_report(
             logs_summary=logs_summary,
             verification_options=verification_options,
             generated_utc=generated_utc,
+            verdict=verdict,
         ),
     )

@@ -6,16 +6,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from sysid.fit import Grade, Guidelines
 from sysid.verify import OutputSummary, RecordVerification, Verification, mode_names
 
 from .verify_figures import display_scale, verification_figures
 
-__all__ = ["TIC_GOOD", "TIC_ACCEPTABLE", "verification_context", "sized_svg"]
-
-#: Theil inequality coefficient of a model with good predictive accuracy (Tischler & Remple; DESIGN.md).
-TIC_GOOD = 0.25
-#: Upper end of the acceptable range.
-TIC_ACCEPTABLE = 0.3
+__all__ = ["verification_context", "sized_svg"]
 
 
 def sized_svg(svg: str, caption: str) -> tuple[str, str, float]:
@@ -50,7 +46,7 @@ class _OutputRow:
     unit: str
     rmse: float
     tic: float
-    grade: str
+    grade: Grade
     prediction_rmse: float | None
     prediction_tic: float | None
     n_records: int
@@ -58,12 +54,16 @@ class _OutputRow:
 
 
 def _output_rows(
-    summaries: Sequence[OutputSummary], records: Sequence[RecordVerification], *, judged: bool = True
+    summaries: Sequence[OutputSummary],
+    records: Sequence[RecordVerification],
+    guidelines: Guidelines,
+    *,
+    judged: bool = True,
 ) -> list[_OutputRow]:
     rows = []
     for s in summaries:
         scale, unit = display_scale(s.unit)
-        grade = "good" if s.tic <= TIC_GOOD else "warn" if s.tic <= TIC_ACCEPTABLE else "bad"
+        grade = guidelines.tic_grade(s.tic)
         excited = dict.fromkeys(
             r.excited or "all inputs"
             for r in records
@@ -106,13 +106,15 @@ def _notices(records: Sequence[RecordVerification]) -> list[str]:
     return notices
 
 
-def verification_context(verification: Verification | None) -> dict[str, Any]:
+def verification_context(verification: Verification | None, guidelines: Guidelines) -> dict[str, Any]:
     """What the report template needs of a verification (nothing but ``verification=None`` without one).
 
     Parameters
     ----------
     verification : Verification or None
         The verification on doublets, if any.
+    guidelines : Guidelines
+        The TIC limits that colour each output's row (those of the verdict).
 
     Returns
     -------
@@ -123,8 +125,8 @@ def verification_context(verification: Verification | None) -> dict[str, Any]:
         return {"verification": None}
     return {
         "verification": verification,
-        "output_rows": _output_rows(verification.summary, verification.records),
-        "off_axis_rows": _output_rows(verification.off_axis, verification.records, judged=False),
+        "output_rows": _output_rows(verification.summary, verification.records, guidelines),
+        "off_axis_rows": _output_rows(verification.off_axis, verification.records, guidelines, judged=False),
         "wind_rows": [
             (
                 c.name,
@@ -136,7 +138,7 @@ def verification_context(verification: Verification | None) -> dict[str, Any]:
             for c in verification.wind_correction
         ],
         "verification_figures": [sized_svg(svg, caption) for svg, caption in verification_figures(verification)],
-        "notices": _notices(verification.records),
+        "notices": [*verification.unverified, *_notices(verification.records)],
         "offsets": [
             (r.label, dict(r.reference_shifts), {o.name: o.bias * display_scale(o.unit)[0] for o in r.outputs})
             for r in verification.records

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -12,11 +12,16 @@ from ._common import OutputPath, emit_json, json_option, progress_bar
 from ._flights import check_sources, dataset_flights
 from ._wind_options import (
     anemometer_at_option,
+    segments_from,
+    segments_option,
     transport_delay_option,
     wind_distance_option,
     wind_offset_option,
     wind_option,
 )
+
+if TYPE_CHECKING:
+    from sysid.fit import Guidelines
 
 __all__ = ["fit", "parse_assignments", "print_modes"]
 
@@ -25,6 +30,7 @@ Examples:
   sysid fit sweeps/*.bin --model hover -o model.json
   sysid fit sweeps/*.bin --wind anemometer/ --wind-distance 4.6 --model hover-wind -o model.json --json -
   sysid fit dataset.h5 --model my-structure.toml --starts 5 --set T_a=0.05 -o model.json --mat model.mat
+  sysid fit flight.ulg --segments maneuvers.toml --partial -o model.json    # the axes flown only
 """
 
 
@@ -43,6 +49,25 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
     return found
 
 
+class _GuidelineOption(click.Option):
+    """A number option whose default is a limit of :data:`sysid.fit.DEFAULT_GUIDELINES` (Tischler's).
+
+    The guidelines are imported when the default is needed (a run, or ``sysid fit --help``), not with the CLI.
+    """
+
+    def __init__(self, *args: Any, guideline: str, **kwargs: Any) -> None:
+        super().__init__(*args, default=None, **kwargs)
+        self.guideline = guideline
+
+    def get_default(self, ctx: click.Context, call: bool = True) -> Any:
+        value = super().get_default(ctx, call=call)
+        if value is None:
+            from sysid.fit import DEFAULT_GUIDELINES
+
+            value = getattr(DEFAULT_GUIDELINES, self.guideline)
+        return value
+
+
 @click.command(epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option(
@@ -59,6 +84,7 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
 @transport_delay_option("Transport delay of the wind, s.")
 @wind_offset_option("Anemometer clock minus UTC, s.")
 @click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset by cross-correlation.")
+@segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
 @click.option(
     "--kind",
     default="sweep",
@@ -92,17 +118,19 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
 @click.option("--no-reduce", is_flag=True, help="Keep every parameter (no structure reduction).")
 @click.option(
     "--max-cr",
+    cls=_GuidelineOption,
+    guideline="max_cr_percent",
     type=click.FloatRange(min=0, min_open=True),
-    default=20.0,
     show_default=True,
-    help="Cramér–Rao bound guideline, % of the value.",
+    help="Cramér–Rao bound guideline, % of the value (reduction and the report's verdict).",
 )
 @click.option(
     "--max-insensitivity",
+    cls=_GuidelineOption,
+    guideline="max_insensitivity_percent",
     type=click.FloatRange(min=0, min_open=True),
-    default=10.0,
     show_default=True,
-    help="Insensitivity guideline, % of the value.",
+    help="Insensitivity guideline, % of the value (reduction and the report's verdict).",
 )
 @click.option(
     "--max-correlation",
@@ -118,6 +146,12 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
     show_default=True,
     help="Gating threshold on the coherence (eq. 3.8).",
 )
+@click.option(
+    "--partial",
+    is_flag=True,
+    help="Write a model of the axes that can be identified, the others marked unidentified "
+    "(default: an axis without a usable maneuver is an error).",
+)
 @click.option("-o", "--out", type=OutputPath(), help="Write the identified model (versioned JSON).")
 @click.option("--mat", type=OutputPath(), help="Also write the model for MATLAB (.mat).")
 @click.option("--report", type=OutputPath(), help="Write the HTML fit report.")
@@ -132,6 +166,7 @@ def fit(
     transport_delay: float | None,
     wind_offset: float | None,
     estimate_wind_offset: bool,
+    segments_file: Path | None,
     kind: str,
     initial: dict[str, float],
     constants: dict[str, float],
@@ -141,6 +176,7 @@ def fit(
     max_insensitivity: float,
     max_correlation: float | None,
     min_coherence: float,
+    partial: bool,
     out: Path | None,
     mat: Path | None,
     report: Path | None,
@@ -150,7 +186,9 @@ def fit(
     """Identify a state-space model from the sweeps in LOGS (flight logs, or HDF5 datasets written by
     ``sysid ingest -o``): frequency responses, gating, the cost of eq. 3.9 with Cramér–Rao and
     insensitivity accuracy, structure reduction, then the wind terms on the residual of eq. 3.14.
-    Control derivatives are per unit of the logged mixer input (the unit is printed)."""
+    Control derivatives are per unit of the logged mixer input (the unit is printed). Every axis of the
+    structure needs a maneuver whose responses pass gating (exit 1 naming each that has none), unless
+    --partial: a parameter no response informs is unidentified, never given a value."""
     from flightlogs.conditioning.condition import ConditioningOptions
     from sysid.fit import (
         FitOptions,
@@ -176,6 +214,7 @@ def fit(
         min_coherence=min_coherence,
         constants=constants or None,
         initial=initial or None,
+        partial=partial,
     )
     dataset = check_sources(
         logs,
@@ -186,6 +225,7 @@ def fit(
             "--transport-delay": transport_delay,
             "--wind-offset": wind_offset,
             "--estimate-wind-offset": estimate_wind_offset,
+            "--segments": segments_file,
         },
     )
     with progress_bar("identifying", quiet=quiet) as bar:
@@ -203,6 +243,7 @@ def fit(
                 transport_delay_s=transport_delay,
                 wind_offset_s=wind_offset,
                 estimate_wind_offset=estimate_wind_offset,
+                segments=segments_from(segments_file),
             )
             model = identify_logs(
                 list(logs),
@@ -226,12 +267,17 @@ def fit(
         "report": str(report) if report else None,
     }
     if not quiet:
-        _print_fit(summary, (max_cr, max_insensitivity), to_stderr=json_path == "-")
+        _print_fit(summary, model.guidelines, to_stderr=json_path == "-")
     emit_json(summary, json_path)
 
 
 def _fmt(value: float | None, spec: str = ".3g") -> str:
     return "-" if value is None else format(value, spec)
+
+
+def _value(value: float | None) -> str:
+    """A parameter value for the table: "—" when it has none (unidentified)."""
+    return "—" if value is None or not math.isfinite(value) else format(value, ".5g")
 
 
 def print_modes(rows: list[dict[str, Any]], say: Any) -> None:
@@ -246,20 +292,26 @@ def print_modes(rows: list[dict[str, Any]], say: Any) -> None:
         )
 
 
-def _print_fit(summary: dict[str, Any], guidelines: tuple[float, float], *, to_stderr: bool) -> None:
+def _print_fit(summary: dict[str, Any], guidelines: Guidelines, *, to_stderr: bool) -> None:
     def say(text: str = "") -> None:
         click.echo(text, err=to_stderr)
 
-    say(f"model {summary['model']}: J_ave = {summary['cost']['average']:.2f} (guideline <= 100)")
-    say(f"  {'parameter':<11} {'value':>11} {'CR%':>7} {'I%':>7}  {'status':<10} unit")
+    say(
+        f"model {summary['model']}: J_ave = {summary['cost']['average']:.2f} (guideline <= {guidelines.j_average_good:g})"
+    )
+    say(f"  {'parameter':<11} {'value':>11} {'CR%':>7} {'I%':>7}  {'status':<12} unit")
     for name, p in summary["parameters"].items():
-        flag = (
-            " !" if (p["cr_percent"] or 0) > guidelines[0] or (p["insensitivity_percent"] or 0) > guidelines[1] else ""
+        misses = guidelines.misses_cr(p["cr_percent"] or 0) or guidelines.misses_insensitivity(
+            p["insensitivity_percent"] or 0
         )
+        flag = " !" if misses else ""
         say(
-            f"  {name:<11} {p['value']:>11.5g} {_fmt(p['cr_percent'], '.2f'):>7} "
-            f"{_fmt(p['insensitivity_percent'], '.2f'):>7}  {p['status'] + flag:<10} {p['unit']}"
+            f"  {name:<11} {_value(p['value']):>11} {_fmt(p['cr_percent'], '.2f'):>7} "
+            f"{_fmt(p['insensitivity_percent'], '.2f'):>7}  {p['status'] + flag:<12} {p['unit']}"
         )
+    for axis in summary["axes"]:
+        if axis["status"] != "identified":
+            say(f"  axis {axis['axis']} unidentified: {axis['reason']}; its parameters have no value")
     say("  response costs: " + ", ".join(f"{k} {v:.1f}" for k, v in summary["cost"]["responses"].items()))
     for step in summary["reduction"]:
         say(f"  reduction {step['step']}: {step['parameter']} {step['action']} ({step['reason']})")

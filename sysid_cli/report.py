@@ -113,23 +113,24 @@ def report(
     parameters, costs, correlations, modes; with VALIDATION.json (a saved verification, as 'sysid validate -o'
     and 'sysid demo' write), also the doublets predicted with and without the wind term. One self-contained file."""
     from reports.html import write_html
-    from reports.model_report import model_report_html, model_verdict
-    from sysid.fit import read_model
+    from reports.model_report import model_report_html
+    from sysid.fit import model_verdict, read_model
     from sysid.verify.io import read_verification
 
     model = read_model(model_path)
     saved = read_verification(validation_path) if validation_path is not None else None
     card = ingest_card(_read_json(ingest_path), source=str(ingest_path)) if ingest_path is not None else None
     verification = saved.verification if saved is not None else None
+    verdict = model_verdict(model, verification)  # by the guidelines the model was fitted with
     text = model_report_html(
         model,
         verification=verification,
         title=title,
         logs_summary=card,
         verification_options=saved.options if saved is not None else None,
+        verdict=verdict,
     )
     target = write_html(out if out is not None else model_path.with_suffix(".html"), text)
-    verdict = model_verdict(model, verification)
     if not quiet:
         click.echo(verdict.sentence, err=json_path == "-")
         click.echo(f"wrote {target}", err=json_path == "-")

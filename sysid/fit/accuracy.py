@@ -13,10 +13,11 @@ residual vector ``r`` whose sum of squares is the cost J of eq. 3.9. Then::
     CR_i = sqrt((H^-1)_ii)          Cramér–Rao bound (all other parameters free)
     I_i  = 1 / sqrt(H_ii)           insensitivity (all other parameters held)
 
-each reported as a percentage of ``|theta_i|``; guidelines CR% <= 20 and
-I% <= 10. ``H`` is written as Tischler & Remple write it, without the
-factor 2 of the exact Gauss–Newton Hessian of J (``2 J_r^T J_r``); with
-that factor every CR and I would be smaller by sqrt(2). The choice is ours
+each reported as a percentage of ``|theta_i|`` and judged against the CR%
+and I% limits of :class:`~sysid.fit.guidelines.Guidelines`. ``H`` is
+written as Tischler & Remple write it, without the factor 2 of the exact
+Gauss–Newton Hessian of J (``2 J_r^T J_r``); with that factor every CR and
+I would be smaller by sqrt(2). The choice is ours
 where the book's normalisation could not be checked, and it is the more
 conservative one.
 """

@@ -8,13 +8,22 @@ measured gain of their input's responses (sign included), so the same
 structure file works whatever unit the mixer inputs were logged in; more
 starts, randomly spread about that one, can be asked for. The structure is
 then reduced (:mod:`sysid.fit.reduce`) until every parameter meets the
-CR% / I% guidelines.
+CR% / I% guidelines (:mod:`sysid.fit.guidelines`), each step taken only if
+the costs stay within the guidelines' margins.
+
+A free parameter that no fitted response informs (its Jacobian column is
+zero, or no response of an input whose part of the model reads it was
+fitted: :mod:`sysid.model.axes`) is ``unidentified``: it keeps its starting
+value inside the search, where it changes nothing, and has no value (NaN) in
+the result. Each control input's axis is ``identified`` only when its
+responses informed every parameter of its part of the model
+(:mod:`sysid.fit.axes`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Literal
@@ -24,15 +33,18 @@ from scipy import optimize
 
 from flightlogs.errors import FitError
 from sysid.fit.accuracy import Accuracy, accuracy
+from sysid.fit.axes import AxisStatus, axis_name
 from sysid.fit.cost import CostSummary, CostWeights, FitPoints, ResponseModel, fit_points
+from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
 from sysid.fit.reduce import ReductionStep, worst_parameter
 from sysid.freqresp import FrequencyResponse
 from sysid.model.assemble import Assembler
+from sysid.model.axes import axis_parts
 from sysid.model.structure import ModelStructure
 
 __all__ = ["FitOptions", "FrequencyFit", "fit_frequency_responses"]
 
-Status = Literal["estimated", "fixed", "dropped"]
+Status = Literal["estimated", "fixed", "dropped", "unidentified"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -50,18 +62,23 @@ class FitOptions:
     reduce : bool
         Run structure reduction after the first fit.
     max_cr_percent : float
-        CR% guideline.
+        CR% guideline, % of ``|value|``; default Tischler's (:data:`~sysid.fit.guidelines.DEFAULT_GUIDELINES`).
     max_insensitivity_percent : float
-        I% guideline.
+        I% guideline, % of ``|value|``; default Tischler's.
     max_correlation : float or None
         Also remove one of a pair correlated beyond this; None to ignore.
     max_steps : int
         Most parameters reduction may remove.
-    max_cost_increase : float or None
-        With a value, a removal raising J_ave by more than this fraction
-        (and by more than 1) is undone and the parameter kept although it
-        misses a guideline; None (default) applies the guidelines strictly,
-        as the dissertation's procedure does.
+    reduction_cost_check : bool
+        Take a reduction step only if the costs stay within the margins
+        below; False removes every parameter that misses CR% or I%, whatever
+        the cost.
+    reduction_j_average_rise_percent : float
+        Largest rise of J_ave a reduction step may cause, % (Tischler's 2).
+    reduction_j_response_rise_percent : float
+        Largest rise of one response's J a reduction step may cause, %.
+    reduction_j_rise_floor : float
+        A rise of J up to this counts as none (cost units).
     max_evaluations : int
         Most cost evaluations per fit.
     jacobian : {"analytic", "numeric"}
@@ -74,11 +91,14 @@ class FitOptions:
     starts: int = 1
     seed: int = 0
     reduce: bool = True
-    max_cr_percent: float = 20.0
-    max_insensitivity_percent: float = 10.0
+    max_cr_percent: float = DEFAULT_GUIDELINES.max_cr_percent
+    max_insensitivity_percent: float = DEFAULT_GUIDELINES.max_insensitivity_percent
     max_correlation: float | None = None
     max_steps: int = 30
-    max_cost_increase: float | None = None
+    reduction_cost_check: bool = True
+    reduction_j_average_rise_percent: float = DEFAULT_GUIDELINES.reduction_j_average_rise_percent
+    reduction_j_response_rise_percent: float = DEFAULT_GUIDELINES.reduction_j_response_rise_percent
+    reduction_j_rise_floor: float = DEFAULT_GUIDELINES.reduction_j_rise_floor
     max_evaluations: int = 300
     jacobian: Literal["analytic", "numeric"] = "analytic"
     rescale_controls: bool = True
@@ -86,10 +106,20 @@ class FitOptions:
     def __post_init__(self) -> None:
         if self.starts < 1:
             raise ValueError(f"starts={self.starts} must be at least 1")
-        if self.max_cr_percent <= 0 or self.max_insensitivity_percent <= 0:
-            raise ValueError("the CR% and I% guidelines must be positive")
+        _ = self.guidelines  # the CR% and I% limits and the reduction margins must be positive
         if self.jacobian not in ("analytic", "numeric"):
             raise ValueError(f"jacobian={self.jacobian!r} must be 'analytic' or 'numeric'")
+
+    @property
+    def guidelines(self) -> Guidelines:
+        """The guidelines of this fit: its CR% and I% limits and reduction margins, Tischler's for the rest."""
+        return Guidelines(
+            max_cr_percent=self.max_cr_percent,
+            max_insensitivity_percent=self.max_insensitivity_percent,
+            reduction_j_average_rise_percent=self.reduction_j_average_rise_percent,
+            reduction_j_response_rise_percent=self.reduction_j_response_rise_percent,
+            reduction_j_rise_floor=self.reduction_j_rise_floor,
+        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -101,10 +131,11 @@ class FrequencyFit:
     structure : ModelStructure
         The structure fitted.
     values : Mapping[str, float]
-        Every parameter's final value (estimates, fixed and dropped values).
+        Every parameter's final value (estimates, fixed and dropped values;
+        NaN for the unidentified).
     status : Mapping[str, str]
-        ``estimated``, ``fixed`` or ``dropped`` for every parameter the fit
-        concerned (wind-step parameters are absent).
+        ``estimated``, ``fixed``, ``dropped`` or ``unidentified`` for every
+        parameter the fit concerned (wind-step parameters are absent).
     accuracy : Accuracy
         CR, I and correlations of the estimated parameters.
     cost : CostSummary
@@ -117,6 +148,8 @@ class FrequencyFit:
         The responses fitted.
     evaluations : int
         Cost evaluations spent, all fits together.
+    axes : tuple of AxisStatus
+        Each control input's axis, identified or not (with the reason).
     """
 
     structure: ModelStructure
@@ -128,6 +161,12 @@ class FrequencyFit:
     constants: Mapping[str, float]
     responses: tuple[FrequencyResponse, ...]
     evaluations: int = 0
+    axes: tuple[AxisStatus, ...] = ()
+
+    @property
+    def unidentified_axes(self) -> tuple[AxisStatus, ...]:
+        """The axes not identified."""
+        return tuple(a for a in self.axes if not a.identified)
 
 
 def fit_frequency_responses(
@@ -178,13 +217,17 @@ def fit_frequency_responses(
     }
     points = fit_points(used, weights=options.weights)
     search = _Search(structure, points, consts, options)
-    for name in search.uninformed([n for n, s in status.items() if s == "estimated"], values):
-        status[name] = "fixed"
+    parts = {signal: part.parameters for signal, part in axis_parts(structure, values).items()}
+    fitted = {r.input for r in used}
+    free = [n for n, s in status.items() if s == "estimated"]
+    for name in search.uninformed(free, values, parts, fitted):
+        status[name] = "unidentified"
     values, evaluations = search.first_fit(values, status)
     values, status, acc, cost, steps, spent = _reduce(search, values, status)
+    shown = {n: math.nan if status.get(n) == "unidentified" else v for n, v in values.items()}
     return FrequencyFit(
         structure=structure,
-        values=MappingProxyType(dict(values)),
+        values=MappingProxyType(shown),
         status=MappingProxyType(dict(status)),
         accuracy=acc,
         cost=cost,
@@ -192,14 +235,43 @@ def fit_frequency_responses(
         constants=MappingProxyType(consts),
         responses=used,
         evaluations=evaluations + spent,
+        axes=_axes(parts, status, used),
     )
+
+
+def _axes(
+    parts: Mapping[str, Sequence[str]], status: Mapping[str, Status], used: Sequence[FrequencyResponse]
+) -> tuple[AxisStatus, ...]:
+    """Each control input's axis: identified when its responses informed every parameter of its part."""
+    out = []
+    for signal, names in parts.items():
+        pairs = [r.pair for r in used if r.input == signal]
+        missing = [n for n in names if status.get(n) == "unidentified"]
+        if not pairs:
+            reason = f"no gated response of {signal} was fitted"
+        elif missing:
+            reason = (
+                f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} informed by no fitted response "
+                f"(fitted: {', '.join(pairs)})"
+            )
+        else:
+            out.append(AxisStatus(axis=axis_name(signal), input=signal, status="identified"))
+            continue
+        out.append(AxisStatus(axis=axis_name(signal), input=signal, status="unidentified", reason=reason))
+    return tuple(out)
 
 
 def _reduce(
     search: _Search, values: dict[str, float], status: dict[str, Status]
 ) -> tuple[dict[str, float], dict[str, Status], Accuracy, CostSummary, list[ReductionStep], int]:
-    """Remove the worst parameter and refit until every one meets the guidelines (see :mod:`.reduce`)."""
+    """Remove the worst parameter and refit until every one meets the guidelines (see :mod:`.reduce`).
+
+    A removal whose refit raises J_ave or a response's J beyond the
+    guidelines' margins (:meth:`Guidelines.reduction_cost_rise`) is undone:
+    the parameter is kept, the step logged as ``kept`` with the cost that rose.
+    """
     options = search.options
+    guidelines = options.guidelines
     steps: list[ReductionStep] = []
     kept: set[str] = set()
     previous: tuple[dict[str, float], dict[str, Status]] | None = None
@@ -210,25 +282,23 @@ def _reduce(
         acc = accuracy(model.jacobian(theta), theta, tuple(estimated))
         cost = model.cost(theta)
         if steps and math.isnan(steps[-1].cost_average_after):
-            steps[-1] = replace(steps[-1], cost_average_after=cost.average)
-            if previous is not None and _too_costly(steps[-1], options.max_cost_increase):
+            step = replace(steps[-1], cost_average_after=cost.average, cost_responses_after=cost.responses)
+            before = CostSummary(average=step.cost_average, responses=step.cost_responses)
+            rise = guidelines.reduction_cost_rise(before, cost) if options.reduction_cost_check else ""
+            if rise and previous is not None:
                 values, status = previous
-                kept.add(steps[-1].parameter)
+                kept.add(step.parameter)
                 steps[-1] = replace(
-                    steps[-1],
-                    action="kept",
-                    value=steps[-1].estimate,
-                    reason=steps[-1].reason + f"; removing it raised J_ave to "
-                    f"{steps[-1].cost_average_after:.3g}, so it stays",
+                    step, action="kept", value=step.estimate, reason=f"{step.reason}; removing it, {rise}, so it stays"
                 )
                 continue
+            steps[-1] = step
         worst = (
             None
             if not options.reduce or len(steps) >= options.max_steps
             else worst_parameter(
                 acc,
-                max_cr_percent=options.max_cr_percent,
-                max_insensitivity_percent=options.max_insensitivity_percent,
+                guidelines=guidelines,
                 max_correlation=options.max_correlation,
                 exclude=frozenset(kept),
             )
@@ -236,17 +306,9 @@ def _reduce(
         if worst is None:
             return values, status, acc, cost, steps, evaluations
         previous = (dict(values), dict(status))
-        steps.append(_remove(search.structure, worst, acc, values, status, cost.average, len(steps) + 1))
+        steps.append(_remove(search.structure, worst, acc, values, status, cost, len(steps) + 1))
         values, spent = search.refit(values, status)
         evaluations += spent
-
-
-def _too_costly(step: ReductionStep, tolerance: float | None) -> bool:
-    """Whether removing the step's parameter raised J_ave beyond the tolerance (relative, and by more than 1)."""
-    if tolerance is None:
-        return False
-    rise = step.cost_average_after - step.cost_average
-    return rise > 1.0 and rise > tolerance * step.cost_average
 
 
 def _remove(
@@ -255,7 +317,7 @@ def _remove(
     acc: Accuracy,
     values: dict[str, float],
     status: dict[str, Status],
-    cost_average: float,
+    cost: CostSummary,
     step: int,
 ) -> ReductionStep:
     name, reason = worst
@@ -275,7 +337,8 @@ def _remove(
         cr_percent=float(acc.cramer_rao_percent[k]),
         insensitivity_percent=float(acc.insensitivity_percent[k]),
         reason=reason,
-        cost_average=cost_average,
+        cost_average=cost.average,
+        cost_responses=cost.responses,
     )
 
 
@@ -291,13 +354,30 @@ class _Search:
         assembler = Assembler(self.structure, free=free, fixed=values, constants=self.constants, include_wind=False)
         return ResponseModel(assembler, self.points, weights=self.options.weights)
 
-    def uninformed(self, free: Sequence[str], values: Mapping[str, float]) -> list[str]:
-        """Parameters no fitted response depends on (their Jacobian column is zero)."""
+    def uninformed(
+        self,
+        free: Sequence[str],
+        values: Mapping[str, float],
+        parts: Mapping[str, Sequence[str]],
+        fitted: Collection[str],
+    ) -> list[str]:
+        """Parameters no fitted response informs.
+
+        Those whose Jacobian column is zero, and those read only by the parts
+        of inputs (`parts`, by signal) of which no response was fitted: such a
+        parameter can reach the others' responses only through the trim terms
+        that couple the axes weakly, which do not measure it.
+        """
         if not free:
             return []
         model = self.model(free, values)
         jac = model.jacobian(np.array([values[n] for n in free]))
-        return [n for n, column in zip(free, jac.T) if not np.any(column)]
+        out = []
+        for name, column in zip(free, jac.T):
+            owners = [signal for signal, names in parts.items() if name in names]
+            if not np.any(column) or (owners and not any(signal in fitted for signal in owners)):
+                out.append(name)
+        return out
 
     def first_fit(self, values: dict[str, float], status: Mapping[str, Status]) -> tuple[dict[str, float], int]:
         free = [n for n, s in status.items() if s == "estimated"]

@@ -2,7 +2,14 @@
 
 The JSON holds everything :class:`IdentifiedModel` holds, so that a report can
 be rebuilt from the file alone, plus the matrices and eigenvalues for readers
-outside Python. NaN is written as ``null``. Files are written atomically.
+outside Python. NaN is written as ``null`` (the value of an unidentified
+parameter). ``axes`` records each control input's axis, identified or not
+and why; a file without it reads with the axes derived from the parameters
+(:attr:`IdentifiedModel.axis_status`). ``linear_model`` and ``eigenvalues``
+are those of the identified axes. Files are written atomically.
+The guideline limits a fit applied travel in its provenance options
+(``provenance.options.fit.max_cr_percent``); a file without them reads with
+Tischler's (:attr:`IdentifiedModel.guidelines`).
 """
 
 from __future__ import annotations
@@ -22,10 +29,12 @@ from sysid._json import float_array as _vector
 from sysid._json import json_floats as _array
 from sysid._json import read_json_object, write_json
 from sysid._json import value_text as _show
-from sysid.fit._json import parameter_entry
+from sysid.fit._json import axis_entry, parameter_entry
+from sysid.fit.axes import AxisStatus
 from sysid.fit.cost import CostSummary
+from sysid.fit.guidelines import Guidelines
 from sysid.fit.reduce import ReductionStep
-from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance, WindFit
+from sysid.fit.result import PARAMETER_STATUSES, IdentifiedModel, ParameterEstimate, Provenance, WindFit
 from sysid.freqresp import FrequencyResponse
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "model_to_dict", "model_from_dict", "write_model", "read_model", "write_mat"]
@@ -64,6 +73,7 @@ def model_to_dict(model: IdentifiedModel) -> dict[str, Any]:
         "constants": {k: _num(v) for k, v in model.constants.items()},
         "input_units": dict(model.input_units),
         "notes": list(model.notes),
+        "axes": [axis_entry(a) for a in model.axis_status],
         "reduction": [
             {
                 "step": s.step,
@@ -76,6 +86,8 @@ def model_to_dict(model: IdentifiedModel) -> dict[str, Any]:
                 "reason": s.reason,
                 "cost_average": _num(s.cost_average),
                 "cost_average_after": _num(s.cost_average_after),
+                "cost_responses": {k: _num(v) for k, v in s.cost_responses.items()},
+                "cost_responses_after": {k: _num(v) for k, v in s.cost_responses_after.items()},
             }
             for s in model.reduction
         ],
@@ -222,14 +234,17 @@ def _parameters(doc: Mapping[str, Any], f: _Fields) -> tuple[ParameterEstimate, 
         where = f"parameter {name}"
         p = f.check(p, where, dict)
         status, stage = f.get(p, "status", where, str), f.get(p, "stage", where, str, "frequency")
-        if status not in ("estimated", "fixed", "dropped"):
-            raise f.fail(f"{where}: status is {status!r}, not estimated, fixed or dropped")
+        if status not in PARAMETER_STATUSES:
+            raise f.fail(f"{where}: status is {status!r}, not {', '.join(PARAMETER_STATUSES[:-1])} or unidentified")
+        value = f.number(p, "value", where, finite=status != "unidentified")
+        if status == "unidentified" and math.isfinite(value):
+            raise f.fail(f"{where}: an unidentified parameter has no value (null), not {_show(p['value'])}")
         if stage not in ("frequency", "wind"):
             raise f.fail(f"{where}: stage is {stage!r}, not frequency or wind")
         out.append(
             ParameterEstimate(
                 name=name,
-                value=f.number(p, "value", where, finite=True),
+                value=value,
                 cr_percent=f.number(p, "cr_percent", where),
                 insensitivity_percent=f.number(p, "insensitivity_percent", where),
                 status=status,
@@ -280,9 +295,35 @@ def _reduction(doc: Mapping[str, Any], f: _Fields) -> tuple[ReductionStep, ...]:
                 reason=f.get(s, "reason", where, str),
                 cost_average=n["cost_average"],
                 cost_average_after=n["cost_average_after"],
+                cost_responses=f.table(s, "cost_responses", where),
+                cost_responses_after=f.table(s, "cost_responses_after", where),
             )
         )
     return tuple(steps)
+
+
+def _axes(doc: Mapping[str, Any], f: _Fields) -> tuple[AxisStatus, ...]:
+    """The recorded axis statuses; none in a file written before they were (then derived from the parameters)."""
+    out = []
+    for k, a in enumerate(f.get(doc, "axes", "the file", list, [])):
+        where = f"axis entry {k + 1}"
+        a = f.check(a, where, dict)
+        status = f.get(a, "status", where, str)
+        if status not in ("identified", "unidentified"):
+            raise f.fail(f"{where}: status is {status!r}, not identified or unidentified")
+        reason = f.get(a, "reason", where, str, "")
+        if status == "unidentified" and not reason:
+            raise f.fail(f"{where}: an unidentified axis needs a reason")
+        out.append(
+            AxisStatus(
+                axis=f.get(a, "axis", where, str),
+                input=f.get(a, "input", where, str),
+                status=status,
+                reason=reason,
+                remedy=f.get(a, "remedy", where, str, ""),
+            )
+        )
+    return tuple(out)
 
 
 def _wind(doc: Mapping[str, Any], f: _Fields) -> WindFit | None:
@@ -315,8 +356,8 @@ def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Identi
     ------
     ModelError
         If the document is not an identified model of a known schema version, or a field is missing, of the
-        wrong type or (for parameter values and trim constants) not finite; the message names `source` and
-        the field.
+        wrong type or (for parameter values and trim constants) not finite, or a guideline limit recorded in
+        the provenance options is not a positive number; the message names `source` and the field.
     """
     schema = doc.get("schema")
     if schema is None:
@@ -358,12 +399,17 @@ def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Identi
             wind=_wind(doc, f),
             input_units=dict(f.get(doc, "input_units", "the file", dict, {})),
             notes=tuple(f.get(doc, "notes", "the file", list, [])),
+            axes=_axes(doc, f),
         )
     except (TypeError, ValueError) as err:
         if isinstance(err, ModelError):
             raise
         raise ModelError(f"{source}: model file is inconsistent: {err}") from None
     _check_structure(model, f)
+    try:
+        Guidelines.from_options(model.provenance.options)
+    except ValueError as err:
+        raise f.fail(f"provenance: {err}") from None
     return model
 
 
@@ -380,6 +426,10 @@ def _check_structure(model: IdentifiedModel, f: _Fields) -> None:
     extra = sorted(have - set(structure.parameter_names))
     if extra:
         raise f.fail(f"parameter {', '.join(extra)} is not a parameter of structure {structure.name}")
+    controls = {c.signal for c in structure.control_inputs}
+    stray = [a.input for a in model.axes if a.input not in controls]
+    if stray:
+        raise f.fail(f"axis input {', '.join(stray)} is not a control input of structure {structure.name}")
     try:
         model.linear_model()
     except ModelError as err:
@@ -444,6 +494,8 @@ def write_mat(path: str | Path, model: IdentifiedModel) -> Path:
     (cell arrays), ``input_delays_s``, ``parameter_names``,
     ``parameter_values``, ``cr_percent``, ``insensitivity_percent``,
     ``parameter_status``, ``cost_average``, ``structure`` (the TOML text).
+    An unidentified parameter's value is NaN, and the matrices are those of
+    the identified axes (:meth:`IdentifiedModel.linear_model`).
     """
     linear = model.linear_model()
     content = {

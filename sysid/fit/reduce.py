@@ -4,31 +4,37 @@ Tischler & Remple's procedure (ch. 11): after each fit, the worst parameter
 beyond the guidelines leaves the model, and the model is refitted, until
 every remaining parameter satisfies them. The worst is, in this order:
 
-1. the largest insensitivity, if any I% exceeds `max_insensitivity_percent`
-   (the cost hardly depends on it);
-2. the largest Cramér–Rao bound, if any CR% exceeds `max_cr_percent`
-   (it cannot be told apart from the others);
+1. the largest insensitivity, if any I% exceeds the guideline's
+   `max_insensitivity_percent` (the cost hardly depends on it);
+2. the largest Cramér–Rao bound, if any CR% exceeds the guideline's
+   `max_cr_percent` (it cannot be told apart from the others);
 3. with `max_correlation` set, of the most correlated pair beyond it, the
    member with the larger CR%.
 
 A parameter whose structure says ``reduce = "drop"`` is set to its
 ``drop_value`` (0: the term leaves the model); ``reduce = "fix"`` holds it
-at its current estimate (a time constant such as T_a). On request
-(``FitOptions.max_cost_increase``), a removal that raises J_ave by more
-than a tolerance is undone: the parameter matters to the fit although its
-CR% or I% miss the guideline, so it is kept (logged as ``kept``) and not
+at its current estimate (a time constant such as T_a). A step is taken
+only if the costs stay acceptable: when the refit without the parameter
+raises J_ave, or the cost of any one response, beyond the margins of
+:class:`~sysid.fit.guidelines.Guidelines` (Tischler & Remple, ch. 10:
+J_ave by about 2 %, no response markedly), the removal is undone: the
+parameter matters to the fit although its CR% or I% miss the guideline,
+so it is kept (logged as ``kept``, with the costs that rose) and not
 considered again.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Literal
 
 import numpy as np
 
 from sysid.fit.accuracy import Accuracy
+from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
 
 __all__ = ["ReductionStep", "worst_parameter"]
 
@@ -45,7 +51,7 @@ class ReductionStep:
         Name of the parameter removed.
     action : {"dropped", "fixed", "kept"}
         Set to its drop value, held at its estimate, or restored because
-        removing it raised the cost too much.
+        removing it raised the cost too much (`reason` says which).
     value : float
         Value it has from now on (for ``kept``: its estimate).
     estimate : float
@@ -55,11 +61,15 @@ class ReductionStep:
     insensitivity_percent : float
         Its I% in that fit.
     reason : str
-        Which guideline it failed, in words.
+        Which guideline it failed, in words; for ``kept`` also which cost rose.
     cost_average : float
         J_ave of the fit that condemned it.
     cost_average_after : float
         J_ave after refitting without it (NaN if no refit followed).
+    cost_responses : Mapping[str, float]
+        J of each response in the fit that condemned it, by pair name.
+    cost_responses_after : Mapping[str, float]
+        J of each response after refitting without it (empty if no refit followed).
     """
 
     step: int
@@ -72,13 +82,19 @@ class ReductionStep:
     reason: str
     cost_average: float
     cost_average_after: float = math.nan
+    cost_responses: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+    cost_responses_after: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+
+    def __post_init__(self) -> None:
+        for name in ("cost_responses", "cost_responses_after"):
+            table = getattr(self, name)
+            object.__setattr__(self, name, MappingProxyType({str(k): float(v) for k, v in table.items()}))
 
 
 def worst_parameter(
     acc: Accuracy,
     *,
-    max_cr_percent: float = 20.0,
-    max_insensitivity_percent: float = 10.0,
+    guidelines: Guidelines = DEFAULT_GUIDELINES,
     max_correlation: float | None = None,
     exclude: frozenset[str] = frozenset(),
 ) -> tuple[str, str] | None:
@@ -88,10 +104,8 @@ def worst_parameter(
     ----------
     acc : Accuracy
         Accuracy of the current fit.
-    max_cr_percent : float, optional
-        CR% guideline.
-    max_insensitivity_percent : float, optional
-        I% guideline.
+    guidelines : Guidelines, optional
+        The CR% and I% limits (`max_cr_percent`, `max_insensitivity_percent`); default Tischler's.
     max_correlation : float or None, optional
         Largest acceptable |correlation| between two parameters; None to
         ignore correlation.
@@ -109,16 +123,18 @@ def worst_parameter(
     >>> acc = accuracy(np.array([[10.0, 0.0], [0.0, 10.0]]), np.array([1.0, 0.001]), ("X_u", "N_r"))
     >>> worst_parameter(acc)
     ('N_r', 'I% = 1e+04 > 10')
+    >>> worst_parameter(acc, guidelines=Guidelines(max_insensitivity_percent=1e5))
+    ('N_r', 'CR% = 1e+04 > 20')
     """
     allowed = np.array([name not in exclude for name in acc.names], dtype=bool)
     cr = np.where(allowed, acc.cramer_rao_percent, -np.inf)
     ins = np.where(allowed, acc.insensitivity_percent, -np.inf)
-    if acc.names and np.max(ins) > max_insensitivity_percent:
+    if acc.names and guidelines.misses_insensitivity(float(np.max(ins))):
         k = int(np.argmax(ins))
-        return acc.names[k], f"I% = {ins[k]:.3g} > {max_insensitivity_percent:g}"
-    if acc.names and np.max(cr) > max_cr_percent:
+        return acc.names[k], f"I% = {ins[k]:.3g} > {guidelines.max_insensitivity_percent:g}"
+    if acc.names and guidelines.misses_cr(float(np.max(cr))):
         k = int(np.argmax(cr))
-        return acc.names[k], f"CR% = {cr[k]:.3g} > {max_cr_percent:g}"
+        return acc.names[k], f"CR% = {cr[k]:.3g} > {guidelines.max_cr_percent:g}"
     if max_correlation is not None and len(acc.names) > 1:
         corr = np.abs(np.nan_to_num(acc.correlation, nan=0.0)) * np.outer(allowed, allowed)
         np.fill_diagonal(corr, 0.0)

@@ -11,15 +11,22 @@ from typing import Any, Literal
 import numpy as np
 
 from flightlogs.errors import ModelError
+from sysid.fit.axes import AxisStatus, axes_from_parameters
 from sysid.fit.cost import CostSummary
+from sysid.fit.guidelines import Guidelines
 from sysid.fit.reduce import ReductionStep
 from sysid.freqresp import FrequencyResponse
 from sysid.model.assemble import Assembler
+from sysid.model.axes import axis_parts, restrict_model
 from sysid.model.statespace import DelayedStateSpace
-from sysid.model.structure import ModelStructure
+from sysid.model.structure import InputChannel, ModelStructure
 from sysid.model.toml_format import parse_structure
 
-__all__ = ["ParameterEstimate", "WindFit", "Provenance", "IdentifiedModel"]
+__all__ = ["ParameterStatus", "PARAMETER_STATUSES", "ParameterEstimate", "WindFit", "Provenance", "IdentifiedModel"]
+
+ParameterStatus = Literal["estimated", "fixed", "dropped", "unidentified"]
+#: Every parameter status, in the order tables list them.
+PARAMETER_STATUSES: tuple[ParameterStatus, ...] = ("estimated", "fixed", "dropped", "unidentified")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -31,14 +38,16 @@ class ParameterEstimate:
     name : str
         Parameter name (``X_u``, ``tau_lon``, ``X_w_lon``).
     value : float
-        Final value, in `unit`.
+        Final value, in `unit`; NaN when unidentified.
     cr_percent : float
         Cramér–Rao bound as % of ``|value|`` (NaN unless estimated).
     insensitivity_percent : float
         Insensitivity as % of ``|value|`` (NaN unless estimated).
-    status : {"estimated", "fixed", "dropped"}
-        Estimated, held at a given value, or removed by structure reduction
-        (set to its drop value, normally 0).
+    status : {"estimated", "fixed", "dropped", "unidentified"}
+        Estimated; held at a value the structure gives (not free, or fixed
+        by structure reduction); removed by structure reduction (set to its
+        drop value, normally 0); or unidentified: no gated response informed
+        it, so it has no value.
     unit : str
         Unit, with control derivatives per unit of the logged input
         (``rad/s^2 per normalised (-1..1)``).
@@ -51,15 +60,17 @@ class ParameterEstimate:
     value: float
     cr_percent: float = math.nan
     insensitivity_percent: float = math.nan
-    status: Literal["estimated", "fixed", "dropped"] = "estimated"
+    status: ParameterStatus = "estimated"
     unit: str = ""
     stage: Literal["frequency", "wind"] = "frequency"
 
     def __post_init__(self) -> None:
-        if self.status not in ("estimated", "fixed", "dropped"):
-            raise ValueError(f"status={self.status!r} must be 'estimated', 'fixed' or 'dropped'")
+        if self.status not in PARAMETER_STATUSES:
+            raise ValueError(f"status={self.status!r} must be one of {', '.join(PARAMETER_STATUSES)}")
         if self.stage not in ("frequency", "wind"):
             raise ValueError(f"stage={self.stage!r} must be 'frequency' or 'wind'")
+        if self.unidentified != math.isnan(self.value):
+            raise ValueError(f"parameter {self.name}: the value is NaN exactly when it is unidentified")
 
     @property
     def fixed(self) -> bool:
@@ -70,6 +81,11 @@ class ParameterEstimate:
     def dropped(self) -> bool:
         """Removed by structure reduction."""
         return self.status == "dropped"
+
+    @property
+    def unidentified(self) -> bool:
+        """Informed by no gated response: it has no value."""
+        return self.status == "unidentified"
 
     @property
     def cramer_rao(self) -> float:
@@ -114,7 +130,9 @@ class Provenance:
     sha256 : Mapping[str, str]
         SHA-256 of each file, by path.
     options : Mapping[str, Any]
-        Options of the identification (JSON-compatible values).
+        Options of the identification (JSON-compatible values); those of the
+        fit under ``fit``, with the CR% and I% limits it applied
+        (``max_cr_percent``, ``max_insensitivity_percent``).
     versions : Mapping[str, str]
         Versions of flight-sysid, numpy, scipy.
     created_utc : str
@@ -163,6 +181,10 @@ class IdentifiedModel:
         Unit of each logged input signal (``delta_lon``: ``normalised (-1..1)``).
     notes : tuple of str
         Remarks of the identification (responses dropped by gating and why).
+    axes : tuple of AxisStatus
+        Each control input's axis, identified or not and why; empty for a
+        model that does not record them (then :attr:`axis_status` derives them:
+        an axis with an estimated parameter and none unidentified is identified).
     """
 
     structure_name: str
@@ -179,6 +201,7 @@ class IdentifiedModel:
     wind: WindFit | None = None
     input_units: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     notes: tuple[str, ...] = ()
+    axes: tuple[AxisStatus, ...] = ()
 
     def __post_init__(self) -> None:
         n = len(self.correlation_names)
@@ -196,9 +219,43 @@ class IdentifiedModel:
         return parse_structure(self.structure_text, source=self.structure_name)
 
     @property
+    def guidelines(self) -> Guidelines:
+        """The guidelines the model was identified with, to judge it by.
+
+        The CR% and I% limits of its fit, as `provenance` records them
+        (:meth:`Guidelines.from_options`); Tischler's for the other limits,
+        and for a model whose options do not say (a file written before
+        they were recorded, a model assembled without provenance).
+
+        Raises
+        ------
+        ValueError
+            If the recorded limits are not positive numbers.
+        """
+        return Guidelines.from_options(self.provenance.options)
+
+    @property
     def values(self) -> dict[str, float]:
-        """Every parameter's value, by name."""
+        """Every parameter's value, by name (NaN for the unidentified)."""
         return {p.name: p.value for p in self.parameters}
+
+    @property
+    def axis_status(self) -> tuple[AxisStatus, ...]:
+        """Each control input's axis: `axes` as recorded, or derived from the parameters for a file without them."""
+        if self.axes:
+            return self.axes
+        parts = {signal: part.parameters for signal, part in axis_parts(self.structure, self._usable_values()).items()}
+        return axes_from_parameters(parts, {p.name: p.status for p in self.parameters})
+
+    @property
+    def unidentified_axes(self) -> tuple[AxisStatus, ...]:
+        """The axes not identified (the model is not simulated on them)."""
+        return tuple(a for a in self.axis_status if not a.identified)
+
+    def _usable_values(self) -> dict[str, float]:
+        """Values to assemble with: an unidentified parameter at the structure's starting value (cut away later)."""
+        declared = self.structure.values()
+        return {p.name: declared[p.name] if p.unidentified else p.value for p in self.parameters}
 
     def parameter(self, name: str) -> ParameterEstimate:
         """The estimate of parameter `name`.
@@ -232,10 +289,64 @@ class IdentifiedModel:
         -------
         DelayedStateSpace
             States, inputs and outputs named as in the structure; `trim`
-            holds the flight's trim.
+            holds the flight's trim. A model with unidentified axes is the
+            model of its identified axes only: the states and outputs of the
+            others' parts (:func:`sysid.model.axes.axis_parts`), their inputs,
+            and the wind inputs with an unidentified parameter are left out.
+
+        Raises
+        ------
+        ModelError
+            If no axis is identified, or the identified axes' part reads an unidentified parameter.
         """
         structure = self.structure
-        assembler = Assembler(
-            structure, free=(), fixed=self.values, constants=self.constants, include_wind=include_wind
-        )
-        return assembler.state_space(np.zeros(0), trim=self.trim)
+        if not any(p.unidentified for p in self.parameters):
+            assembler = Assembler(
+                structure, free=(), fixed=self.values, constants=self.constants, include_wind=include_wind
+            )
+            return assembler.state_space(np.zeros(0), trim=self.trim)
+        return self._identified_part(include_wind)
+
+    def _identified_part(self, include_wind: bool) -> DelayedStateSpace:
+        """The model of the identified axes: assembled with placeholders, cut, and checked not to read them."""
+        structure = self.structure
+        unidentified = {p.name for p in self.parameters if p.unidentified}
+        missing = {a.input for a in self.unidentified_axes}
+        parts = axis_parts(structure, self._usable_values())
+        kept = [signal for signal in parts if signal not in missing]
+        if not kept:
+            raise ModelError(f"model {self.structure_name} has no identified axis to simulate")
+        states = {s for signal in kept for s in parts[signal].states}
+        outputs = {o for signal in kept for o in parts[signal].outputs}
+        channels = [c for c in structure.inputs if include_wind or not c.wind]  # the assembled model's inputs
+        inputs = [
+            k
+            for k, c in enumerate(channels)
+            if (c.wind and not self._wind_channel_reads(structure, c, unidentified))
+            or (not c.wind and c.signal not in missing)
+        ]
+        cuts = []
+        for shift in (0.0, 1.0):  # a placeholder that moved the cut model would be a parameter it reads
+            values = self._usable_values() | {n: structure.values()[n] + shift for n in unidentified}
+            assembler = Assembler(structure, free=(), fixed=values, constants=self.constants, include_wind=include_wind)
+            whole = assembler.state_space(np.zeros(0), trim=self.trim)
+            cuts.append(restrict_model(whole, states=states, outputs=outputs, inputs=inputs))
+        first, second = cuts
+        if not all(
+            np.array_equal(getattr(first, m), getattr(second, m)) for m in ("a", "b", "c", "d", "input_delays_s")
+        ):
+            raise ModelError(
+                f"model {self.structure_name}: its identified axes read unidentified parameters "
+                f"({', '.join(sorted(unidentified))})"
+            )
+        return first
+
+    @staticmethod
+    def _wind_channel_reads(structure: ModelStructure, channel: InputChannel, names: set[str]) -> bool:
+        """Whether a wind channel's delay or G_w column reads one of `names`."""
+        column = structure.inputs.index(channel)
+        read = set(channel.delay.names)
+        for entry in structure.entries:
+            if entry.matrix == "G_w" and entry.column == column:
+                read |= entry.expression.names
+        return bool(read & names)

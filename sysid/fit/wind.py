@@ -19,11 +19,22 @@ Cramér–Rao bounds are those of the weighted least squares, corrected for
 the residual's autocorrelation by an effective number of independent
 samples (N_eff = N / (1 + 2 sum rho_k), Bartlett); insensitivities come from
 the diagonal of the same information matrix.
+
+The regression needs the wind where the vehicle meets it. When the
+anemometer's clock is off by more than the wind delays can take up (the
+conditioning measures the residual offset against the autopilot's wind
+estimate, but applies it only when asked), the wind and the residual do not
+line up: every G_w term comes out insensitive and would be dropped as if the
+wind did nothing. :func:`wind_misalignment` detects it, and the wind
+parameters are then left ``unidentified`` (:func:`unfitted_wind`) with the
+offset to give. Outputs of an unidentified axis have no residual to fit; a
+wind parameter that only they would inform is unidentified too.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -33,15 +44,22 @@ import numpy as np
 from scipy import optimize
 from scipy import signal as sps
 
-from flightlogs.errors import FitError
+from flightlogs.conditioning.condition import ConditionedFlight
+from flightlogs.errors import FitError, FitWarning
 from flightlogs.record import Record
 from sysid.fit.accuracy import Accuracy, accuracy
+from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
 from sysid.fit.reduce import ReductionStep, worst_parameter
 from sysid.fit.result import WindFit
 from sysid.model.assemble import Assembler, SystemMatrices
+from sysid.model.axes import axis_parts
 from sysid.model.structure import ModelStructure
 
-__all__ = ["WindStepResult", "fit_wind"]
+__all__ = ["WindStepResult", "fit_wind", "wind_misalignment", "unfitted_wind"]
+
+WindStatus = Literal["estimated", "dropped", "unidentified"]
+#: Smallest cross-correlation peak (anemometer against the autopilot's wind estimate) trusted as a clock offset.
+_MIN_OFFSET_CORRELATION = 0.8
 
 _SCAN_STEP_S = 0.002
 
@@ -53,23 +71,23 @@ class WindStepResult:
     Parameters
     ----------
     values : Mapping[str, float]
-        Values of the wind parameters (G_w entries, 1/s; delays, s).
+        Values of the wind parameters (G_w entries, 1/s; delays, s); NaN for the unidentified.
     status : Mapping[str, str]
-        ``estimated`` or ``dropped`` for each wind parameter.
+        ``estimated``, ``dropped`` or ``unidentified`` for each wind parameter.
     accuracy : Accuracy
         CR bounds (autocorrelation-corrected), insensitivities and
         correlations of the estimated ones.
-    fit : WindFit
-        Residual RMS before and after, per output.
+    fit : WindFit or None
+        Residual RMS before and after, per output; None when nothing was fitted.
     reduction : tuple of ReductionStep
         Wind parameters dropped (J_ave columns hold the weighted residual
         sum of squares per sample).
     """
 
     values: Mapping[str, float]
-    status: Mapping[str, Literal["estimated", "dropped"]]
+    status: Mapping[str, WindStatus]
     accuracy: Accuracy
-    fit: WindFit
+    fit: WindFit | None
     reduction: tuple[ReductionStep, ...] = ()
 
 
@@ -308,8 +326,8 @@ def fit_wind(
     *,
     outputs: Sequence[str] = ("ax", "az"),
     reduce: bool = True,
-    max_cr_percent: float = 20.0,
-    max_insensitivity_percent: float = 10.0,
+    max_cr_percent: float = DEFAULT_GUIDELINES.max_cr_percent,
+    max_insensitivity_percent: float = DEFAULT_GUIDELINES.max_insensitivity_percent,
 ) -> WindStepResult:
     """Fit the wind parameters of `structure` to the residual of eq. 3.14.
 
@@ -330,41 +348,47 @@ def fit_wind(
     reduce : bool, optional
         Drop wind parameters beyond the guidelines, one at a time.
     max_cr_percent : float, optional
-        CR% guideline.
+        CR% guideline, % of ``|value|``; default Tischler's (:data:`~sysid.fit.guidelines.DEFAULT_GUIDELINES`).
     max_insensitivity_percent : float, optional
-        I% guideline.
+        I% guideline, % of ``|value|``; default Tischler's.
 
     Returns
     -------
     WindStepResult
+        A wind parameter that no fitted output's row reads, or whose outputs
+        belong to unidentified axes (parameters in `values` that are NaN), is
+        ``unidentified``.
 
     Raises
     ------
     FitError
         If the structure has no wind parameter, or no record carries every
         signal needed.
+    ValueError
+        If a guideline is not a positive number.
     """
     names = structure.wind_parameters
     if not names:
         raise FitError(f"model {structure.name} has no wind parameters to fit")
+    values, outputs, lost = _identified_outputs(structure, values, outputs)
+    if not outputs:
+        return unfitted_wind(structure, f"the outputs of the wind step belong to unidentified axes ({lost})")
     needed = {c.signal for c in structure.inputs} | set(outputs)
     usable = [r for r in records if needed <= set(r.signals)]
     if not usable:
         raise FitError(f"no record has every signal the wind step needs ({', '.join(sorted(needed))})")
     current = dict(values) | {n: values.get(n, structure.parameter(n).value) for n in names}
     data = _prediction_data(structure, current, constants, usable, outputs)
-    status: dict[str, Literal["estimated", "dropped"]] = {n: "estimated" for n in names}
+    informed = _informed(structure, current, constants, data.rows, names)
+    status: dict[str, WindStatus] = {n: "estimated" if n in informed else "unidentified" for n in names}
     steps: list[ReductionStep] = []
+    guidelines = Guidelines(max_cr_percent=max_cr_percent, max_insensitivity_percent=max_insensitivity_percent)
     while True:
         free = [n for n in names if status[n] == "estimated"]
         current, acc, cost, after = _fit_free(structure, current, constants, data, free)
         if steps:
             steps[-1] = replace(steps[-1], cost_average_after=cost)
-        worst = (
-            worst_parameter(acc, max_cr_percent=max_cr_percent, max_insensitivity_percent=max_insensitivity_percent)
-            if reduce
-            else None
-        )
+        worst = worst_parameter(acc, guidelines=guidelines) if reduce else None
         if worst is None:
             break
         name, reason = worst
@@ -393,9 +417,128 @@ def fit_wind(
         samples=int(sum(a.shape[0] for a in after)),
     )
     return WindStepResult(
-        values=MappingProxyType({n: current[n] for n in names}),
+        values=MappingProxyType({n: math.nan if status[n] == "unidentified" else current[n] for n in names}),
         status=MappingProxyType(status),
         accuracy=acc,
         fit=fit,
         reduction=tuple(steps),
+    )
+
+
+def _identified_outputs(
+    structure: ModelStructure, values: Mapping[str, float], outputs: Sequence[str]
+) -> tuple[dict[str, float], list[str], str]:
+    """Values with each unidentified (NaN) parameter at its starting value, the outputs of identified axes only,
+    and the axes left out (for a message)."""
+    unknown = {k for k, v in values.items() if not math.isfinite(v)}
+    if not unknown:
+        return dict(values), list(outputs), ""
+    parts = axis_parts(structure, values)
+    lost = {signal: part for signal, part in parts.items() if unknown & set(part.parameters)}
+    gone = {o for part in lost.values() for o in part.outputs}
+    declared = structure.values()
+    kept = {k: declared[k] if k in unknown else v for k, v in values.items()}
+    return kept, [o for o in outputs if o not in gone], ", ".join(lost)
+
+
+def _informed(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    constants: Mapping[str, float],
+    rows: Sequence[int],
+    names: Sequence[str],
+) -> set[str]:
+    """Wind parameters the fitted outputs' rows read (a G_w entry in them, or the delay of a column that has one)."""
+    assembler = Assembler(structure, free=names, fixed=values, constants=constants, include_wind=True)
+    theta = np.array([values[n] for n in names])
+    m = assembler.matrices(theta)
+    dm = assembler.derivatives(theta, m)
+    columns = [j for j, c in enumerate(assembler.channels) if c.wind]
+    reaching = [j for j in columns if np.any(m.d[list(rows), j] != 0) or np.any(dm.d[:, list(rows), j] != 0)]
+    return {
+        n
+        for k, n in enumerate(names)
+        if np.any(dm.d[k][np.ix_(list(rows), columns)] != 0) or np.any(dm.delays[k, reaching] != 0)
+    }
+
+
+def unfitted_wind(structure: ModelStructure, reason: str) -> WindStepResult:
+    """The wind step's result when it cannot be run: every wind parameter unidentified, and a warning saying why.
+
+    Parameters
+    ----------
+    structure : ModelStructure
+        The structure, with wind parameters.
+    reason : str
+        Why the wind terms cannot be identified, and what to do; raised as a :class:`FitWarning`.
+
+    Returns
+    -------
+    WindStepResult
+        Values NaN, status ``unidentified``, no accuracy, no residual fit.
+
+    Warns
+    -----
+    FitWarning
+        With `reason`.
+    """
+    names = structure.wind_parameters
+    warnings.warn(FitWarning(f"wind terms {', '.join(names)} not identified: {reason}"), stacklevel=2)
+    return WindStepResult(
+        values=MappingProxyType(dict.fromkeys(names, math.nan)),
+        status=MappingProxyType(dict.fromkeys(names, "unidentified")),
+        accuracy=accuracy(np.zeros((1, 0)), np.zeros(0), ()),
+        fit=None,
+    )
+
+
+def wind_misalignment(flights: Sequence[ConditionedFlight], structure: ModelStructure) -> str:
+    """Why the flights' wind cannot be regressed on: its clock is off by more than the wind delays take up; or "".
+
+    The conditioning measures the residual clock offset of each flight's
+    anemometer against the autopilot's wind estimate (or attitude) and
+    applies it only when asked (``--estimate-wind-offset``). An offset
+    found with a clear correlation peak and larger than the largest delay
+    the structure allows a wind input (``tau_w`` bounds, 0.5 s for
+    ``hover-wind``) leaves the wind and the residual of eq. 3.14 apart by
+    more than the wind step can align.
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        The flights, with their wind alignment.
+    structure : ModelStructure
+        The structure, with wind inputs.
+
+    Returns
+    -------
+    str
+        The logs, the offset found and the option that corrects it; "" when the wind is aligned (or not measured).
+    """
+    bound = max(
+        (structure.parameter(n).upper for c in structure.wind_inputs for n in c.delay.names),
+        default=0.0,
+    )
+    bound = bound if math.isfinite(bound) else 0.5
+    off = [
+        f
+        for f in flights
+        if f.wind is not None
+        and f.wind.clock_offset_source != "estimated"
+        and f.wind.residual is not None
+        and abs(f.wind.residual.correlation) >= _MIN_OFFSET_CORRELATION
+        and abs(f.wind.residual.lag_s) > bound
+    ]
+    if not off:
+        return ""
+    lags = [f.wind.residual.lag_s for f in off if f.wind is not None and f.wind.residual is not None]
+    offsets = [f.wind.clock_offset_s - lag for f, lag in zip(off, lags) if f.wind is not None]
+    against = off[0].wind.residual_against if off[0].wind is not None else None
+    names = ", ".join(f.source.name for f in off[:3]) + (" ..." if len(off) > 3 else "")
+    return (
+        f"the anemometer's clock is off by {-float(np.median(lags)):+.2f} s in {len(off)} of {len(flights)} logs "
+        f"({names}): the wind correlates best with the {against or 'vehicle'} {float(np.median(lags)):+.2f} s from "
+        f"where it was placed, more than the {bound:g} s the wind delays can take up, so the wind does not line up "
+        f"with the residual of eq. 3.14 (nor u v w with the flight); give --estimate-wind-offset, or "
+        f"--wind-offset {float(np.median(offsets)):.2f}"
     )

@@ -48,6 +48,7 @@ import numpy as np
 
 from flightlogs.errors import DataError
 from flightlogs.record import Record
+from sysid.model.axes import reachable
 from sysid.model.modes import state_modes
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify._discrete import DiscreteModel, delayed_inputs, discretize, predict_one_step, simulate
@@ -61,7 +62,7 @@ from sysid.verify.results import (
     rms_error,
     theil_inequality,
 )
-from sysid.verify.submodel import driven_part, reachable
+from sysid.verify.submodel import driven_part
 
 __all__ = ["VerificationOptions", "verify_record", "verify"]
 
@@ -458,7 +459,8 @@ def verify(
     Raises
     ------
     DataError
-        If there are no records, or a record lacks a model input or every output to judge.
+        If there are no records, `excited` has not one entry per record, or a record lacks a model input or every
+        output to judge.
     ModelError
         If an excited input is not a model input.
     """
@@ -466,7 +468,9 @@ def verify(
         raise DataError("no records to verify the model on")
     picks = list(excited) if excited is not None else [None] * len(records)
     if len(picks) != len(records):
-        raise ValueError(f"excited has {len(picks)} entries for {len(records)} records")
+        raise DataError(
+            f"excited has {len(picks)} entries for {len(records)} records: one per record, None for all outputs"
+        )
     judged: dict[str, tuple[str, ...]] = {}
     for pick in dict.fromkeys(p for p in picks if p is not None):
         judged[pick] = tuple(axes[pick]) if axes is not None and pick in axes else driven_part(model, pick).outputs

@@ -59,8 +59,9 @@ def theil_inequality(measured: np.ndarray, simulated: np.ndarray) -> float:
 
     Notes
     -----
-    Tischler & Remple, section 15.3 (Jategaonkar 2006, eq. 11.12): TIC below
-    0.25-0.3 marks a model with good predictive accuracy.
+    Tischler & Remple, section 15.3 (Jategaonkar 2006, eq. 11.12). The limits
+    of good predictive accuracy are `tic_good` and `tic_acceptable` of
+    :class:`sysid.fit.Guidelines`.
 
     Examples
     --------
@@ -362,6 +363,9 @@ class Verification:
     off_axis : tuple of OutputSummary, optional
         Per output, pooled over the records where it is off-axis: for
         information, not judged.
+    unverified : tuple of str, optional
+        One sentence per axis of the model not verified, and why (``"lat: no
+        doublet in 2 logs; not verified"``; an unidentified axis is never verified).
     """
 
     records: tuple[RecordVerification, ...]
@@ -371,6 +375,7 @@ class Verification:
     without_wind: tuple[RecordVerification, ...] = ()
     wind_correction: tuple[WindCorrection, ...] = ()
     off_axis: tuple[OutputSummary, ...] = ()
+    unverified: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.without_wind and len(self.without_wind) != len(self.records):

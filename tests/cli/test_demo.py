@@ -11,9 +11,8 @@ from click.testing import CliRunner
 from markupsafe import escape
 
 from flightlogs.store.dataset import read_dataset
-from reports.model_report import model_verdict
 from simulator.campaign.demo_flight import write_demo_flight
-from sysid.fit import read_model
+from sysid.fit import model_verdict, read_model
 from sysid.verify import axis_outputs
 from sysid.verify.io import read_verification
 from sysid_cli.main import cli

@@ -60,12 +60,18 @@ def test_fit_writes_a_model_and_the_summary(runner: CliRunner, flights: Path, tm
     assert len(model.provenance.files) == 8 and model.provenance.options["fit"]["starts"] == 1
 
 
-def test_report_option(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
-    report = tmp_path / "fit.html"
+def test_report_option_judges_by_the_limits_given(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
+    """The --max-cr and --max-insensitivity of the fit travel with the model, into its report and its file."""
+    report, out = tmp_path / "fit.html", tmp_path / "model.json"
     logs = [str(p) for p in sorted(flights.glob("*lon*.bin"))]
-    result = runner.invoke(cli, ["fit", *logs, "--report", str(report), "-q"])
+    command = ["fit", *logs, "--max-cr", "35", "--max-insensitivity", "12", "-o", str(out), "--report", str(report)]
+    result = runner.invoke(cli, [*command, "-q"])
     assert result.exit_code == 0, result.output
-    assert report.read_text(encoding="utf-8").lstrip().lower().startswith("<!doctype html>")
+    page = report.read_text(encoding="utf-8")
+    assert page.lstrip().lower().startswith("<!doctype html>")
+    assert "guidelines CR ≤ 35 % and I ≤ 12 %" in page and "CR ≤ 20 %" not in page
+    guidelines = read_model(out).guidelines
+    assert (guidelines.max_cr_percent, guidelines.max_insensitivity_percent) == (35.0, 12.0)
 
 
 def test_fit_reads_an_ingested_dataset(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
@@ -103,3 +109,5 @@ def test_fit_errors(runner: CliRunner, flights: Path, extra: list[str], code: in
 def test_help_has_an_example(runner: CliRunner) -> None:
     result = runner.invoke(cli, ["fit", "--help"])
     assert result.exit_code == 0 and "sysid fit sweeps/*.bin" in result.output
+    help_text = " ".join(result.output.split())
+    assert "[default: 20.0; x>0]" in help_text and "[default: 10.0; x>0]" in help_text  # Tischler's CR% and I%

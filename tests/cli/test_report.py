@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 from pathlib import Path
@@ -169,6 +170,20 @@ def test_fit_report_hook_writes_the_model_report(
     _, _, model, _ = saved
     assert write_model_report(tmp_path / "fit.html", model) == tmp_path / "fit.html"
     assert _FOOTER.sub("", (tmp_path / "fit.html").read_text()) == _FOOTER.sub("", model_report_html(model))
+
+
+@pytest.mark.parametrize(("max_cr", "verdict"), [(20.0, "acceptable"), (30.0, "good")])
+def test_report_judges_by_the_max_cr_the_model_was_fitted_with(max_cr: float, verdict: str, tmp_path: Path) -> None:
+    """Issue 13: the same model (X_u at CR 25 %) fitted with ``--max-cr 20`` or ``30``; the verdict followed 20 always."""
+    model = builders.small_model(responses=False, accuracy={"X_u": (25.0, 3.0)})
+    options = {"fit": {"max_cr_percent": max_cr, "max_insensitivity_percent": 10.0}}
+    model = dataclasses.replace(model, provenance=dataclasses.replace(model.provenance, options=options))
+    path = write_model(tmp_path / "model.json", model)
+    result = CliRunner().invoke(cli, ["report", str(path), "--json", "-"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert summary["verdict"] == verdict
+    assert f"CR ≤ {max_cr:g} %" in summary["sentence"] and f"CR ≤ {max_cr:g} %" in result.stderr
 
 
 def test_report_help_has_an_example() -> None:

@@ -106,6 +106,39 @@ def test_bad_model_files_are_refused(model: IdentifiedModel, tmp_path) -> None:
         read_model(tmp_path / "text.json")
 
 
+def test_a_file_without_the_fit_limits_reads_with_tischlers(model: IdentifiedModel, tmp_path) -> None:
+    """Model files written before the limits were read from the options (and files without provenance) still read."""
+    doc = json.loads(write_model(tmp_path / "model.json", model).read_text())
+    assert "fit" not in doc["provenance"]["options"]  # this model was assembled without the fit's options
+    del doc["provenance"]
+    (tmp_path / "old.json").write_text(json.dumps(doc))
+    old = read_model(tmp_path / "old.json")
+    assert old.parameters == model.parameters
+    assert (old.guidelines.max_cr_percent, old.guidelines.max_insensitivity_percent) == (20.0, 10.0)
+
+
+def test_the_fit_limits_travel_with_the_model(model: IdentifiedModel, tmp_path) -> None:
+    options = {"fit": {"max_cr_percent": 30.0, "max_insensitivity_percent": 12.5}}
+    fitted = dataclasses.replace(model, provenance=dataclasses.replace(model.provenance, options=options))
+    back = read_model(write_model(tmp_path / "model.json", fitted))
+    assert (back.guidelines.max_cr_percent, back.guidelines.max_insensitivity_percent) == (30.0, 12.5)
+
+
+@pytest.mark.parametrize(
+    ("limits", "message"),
+    [
+        ({"max_cr_percent": "20"}, "provenance: options fit.max_cr_percent is '20', not a number"),
+        ({"max_insensitivity_percent": 0}, "provenance: max_insensitivity_percent=0.0 must be a positive number"),
+    ],
+)
+def test_bad_fit_limits_are_refused(model: IdentifiedModel, tmp_path, limits: dict[str, object], message: str) -> None:
+    doc = json.loads(write_model(tmp_path / "model.json", model).read_text())
+    doc["provenance"]["options"] = {"fit": limits}
+    (tmp_path / "bad.json").write_text(json.dumps(doc))
+    with pytest.raises(ModelError, match=f"bad.json: {message}"):
+        read_model(tmp_path / "bad.json")
+
+
 def test_mat_file_holds_the_matrices(model: IdentifiedModel, tmp_path) -> None:
     content = sio.loadmat(write_mat(tmp_path / "model.mat", model))
     linear = model.linear_model()
@@ -161,3 +194,100 @@ def test_control_names_are_unique_for_a_signal_entering_twice(model: IdentifiedM
     with pytest.raises(TypeError):
         to_statespace(object())
     assert math.isfinite(model.cost.average)
+
+
+@pytest.fixture(scope="module")
+def partial() -> IdentifiedModel:
+    """Pitch and roll responses only: the yaw and heave axes are unidentified."""
+    structure = load_structure("hover-wind")
+    truth, _ = structure_model(structure, dict(CALM_HOVER))
+    responses = synthetic_responses(truth, PAIRS[:4], noise_db=0.5, noise_deg=3.0, fit_range=(0.8, 50.0))
+    return model_from_fit(fit_frequency_responses(structure, responses, options=FitOptions(max_steps=2)))
+
+
+def test_a_partial_model_has_no_value_for_what_was_not_measured(partial: IdentifiedModel, tmp_path) -> None:
+    assert [a.axis for a in partial.unidentified_axes] == ["yaw", "thr"]
+    for name in ("N_yaw", "tau_yaw", "Z_thr", "tau_thr", "Z_w", "N_r"):
+        p = partial.parameter(name)
+        assert p.unidentified and math.isnan(p.value) and math.isnan(p.cr_percent), name
+    path = write_model(tmp_path / "partial.json", partial)
+    doc = json.loads(path.read_text())
+    assert doc["parameters"]["N_yaw"]["value"] is None and doc["parameters"]["N_yaw"]["status"] == "unidentified"
+    assert {a["axis"]: a["status"] for a in doc["axes"]} == {
+        "lat": "identified",
+        "lon": "identified",
+        "yaw": "unidentified",
+        "thr": "unidentified",
+    }
+    assert doc["axes"][2]["reason"] == "no gated response of delta_yaw was fitted"
+    assert doc["linear_model"]["inputs"] == ["delta_lat", "delta_lon", "wind_lon", "wind_lon"]
+    assert "r" not in doc["linear_model"]["states"] and "az" not in doc["linear_model"]["outputs"]
+    back = read_model(path)
+    assert back.axes == partial.axes
+    assert [(p.name, p.status) for p in back.parameters] == [(p.name, p.status) for p in partial.parameters]
+    summary = fit_summary(partial)
+    assert summary["parameters"]["N_yaw"]["value"] is None and "N_yaw" in summary["unidentified"]
+    json.dumps(summary, allow_nan=False)
+
+
+def test_a_partial_model_is_simulated_on_its_identified_axes_only(partial: IdentifiedModel, tmp_path) -> None:
+    """linear_model, the .mat file and python-control get the lat and lon parts, equal to the whole model's there."""
+    linear = partial.linear_model(include_wind=False)
+    assert linear.inputs == ("delta_lat", "delta_lon")
+    assert linear.states == ("u", "v", "p", "q", "phi", "theta", "d_lat", "d_lon")
+    assert linear.outputs == ("u", "v", "p", "q", "phi", "theta", "ax", "ay")
+    omega = np.geomspace(0.5, 30.0, 7)
+    whole = dataclasses.replace(
+        partial,
+        parameters=tuple(
+            dataclasses.replace(p, status="fixed", value=1.0) if p.unidentified else p for p in partial.parameters
+        ),
+        axes=(),
+    ).linear_model(include_wind=False)
+    pick = [whole.outputs.index(o) for o in linear.outputs]
+    assert np.allclose(linear.frequency_response(omega), whole.frequency_response(omega)[:, pick, :2])
+    content = sio.loadmat(write_mat(tmp_path / "partial.mat", partial))
+    assert content["A"].shape == (8, 8)
+    names = [str(s[0]) for s in content["parameter_names"].ravel()]
+    assert np.isnan(content["parameter_values"].ravel()[names.index("N_yaw")])
+    assert to_statespace(partial).ninputs == 4  # delta_lat, delta_lon and the two wind channels
+
+
+def test_nothing_builds_matrices_from_an_unidentified_parameter(partial: IdentifiedModel) -> None:
+    with pytest.raises(ModelError, match="N_yaw has no value"):
+        structure_model(load_structure("hover"), {"N_yaw": math.nan})
+    nothing = dataclasses.replace(
+        partial,
+        parameters=tuple(
+            dataclasses.replace(
+                p, status="unidentified", value=math.nan, cr_percent=math.nan, insensitivity_percent=math.nan
+            )
+            for p in partial.parameters
+        ),
+        axes=(),
+    )
+    with pytest.raises(ModelError, match="no identified axis"):
+        nothing.linear_model()
+
+
+def test_an_old_file_without_axes_reads_with_them_derived(model: IdentifiedModel, tmp_path) -> None:
+    doc = json.loads(write_model(tmp_path / "model.json", model).read_text())
+    del doc["axes"]
+    for step in doc["reduction"]:
+        del step["cost_responses"], step["cost_responses_after"]
+    (tmp_path / "old.json").write_text(json.dumps(doc))
+    old = read_model(tmp_path / "old.json")
+    assert old.axes == () and all(a.identified for a in old.axis_status) and len(old.axis_status) == 4
+    assert old.reduction[0].cost_responses == {}
+
+
+def test_a_kept_reduction_step_round_trips(model: IdentifiedModel, tmp_path) -> None:
+    kept = dataclasses.replace(
+        model.reduction[0],
+        action="kept",
+        reason="I% = 11.2 > 10; removing it, the cost of r/delta_yaw rose from 2.8 to 83 (allowed: up to 4.8), so it stays",
+        cost_responses={"r/delta_yaw": 2.8},
+        cost_responses_after={"r/delta_yaw": 83.0},
+    )
+    back = read_model(write_model(tmp_path / "model.json", dataclasses.replace(model, reduction=(kept,))))
+    assert back.reduction == (kept,)

@@ -556,6 +556,14 @@ def test_missing_signals_are_named() -> None:
         )
 
 
+def test_excited_inputs_not_one_per_record_are_a_data_error() -> None:
+    """A project error (a SysidError, so the CLI says it in one sentence), still a ValueError for callers."""
+    record = _record({"delta_lon": np.zeros(10), "wind_lon": np.zeros(10), "q": np.zeros(10)})
+    with pytest.raises(DataError, match="excited has 2 entries for 1 records") as caught:
+        verify(_second_order(), [record], excited=["delta_lon", "delta_lon"])
+    assert isinstance(caught.value, ValueError)
+
+
 def test_theil_inequality_bounds() -> None:
     y = np.sin(np.linspace(0, 6, 50))
     assert theil_inequality(y, y) == 0.0
