@@ -4,6 +4,9 @@ The core types are re-exported here: the errors (:mod:`flightlogs.errors`), the
 canonical signal names (:mod:`flightlogs.signals`), :class:`FlightLog` and
 :class:`Signal` (:mod:`flightlogs.flightlog`), :class:`Record`
 (:mod:`flightlogs.record`) and the frame conversions (:mod:`flightlogs.frames`).
+Two small modules of the core are namespaces of their own: the geodesy on the
+mean Earth sphere (:mod:`flightlogs.geo`) and the runs of True in a boolean
+mask (:mod:`flightlogs.masks`).
 The subpackages are namespaces of their own (``from flightlogs.readers import
 read_log``): :mod:`flightlogs.readers`, :mod:`flightlogs.writers`,
 :mod:`flightlogs.maneuvers`, :mod:`flightlogs.conditioning` and
@@ -14,13 +17,18 @@ import importlib as _importlib
 from types import ModuleType as _ModuleType
 
 from flightlogs.errors import (
+    CollectedWarnings,
     DataError,
+    DataQualityWarning,
     FitError,
+    FitWarning,
+    LogCorruptionWarning,
     LogFormatError,
     MissingSignalError,
     ModelError,
     SysidError,
     SysidWarning,
+    collected_warnings,
 )
 from flightlogs.flightlog import Autopilot, FlightLog, LogFormat, Signal, SystemIdRun
 from flightlogs.frames import air_velocity_body, earth_to_body, quaternion_to_euler, wind_to_body_axes
@@ -43,6 +51,11 @@ __all__ = [
     "ModelError",
     "FitError",
     "SysidWarning",
+    "DataQualityWarning",
+    "LogCorruptionWarning",
+    "FitWarning",
+    "CollectedWarnings",
+    "collected_warnings",
     "SignalSpec",
     "CANONICAL_SIGNALS",
     "LOGGED_SIGNALS",

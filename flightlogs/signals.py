@@ -4,6 +4,15 @@ All signals after ingest are named and scaled as in ``DESIGN.md``: SI units,
 radians, FRD body axes and NED earth axes (PX4 conventions). Mixer inputs,
 motor commands and the excitation keep the unit they were logged in, and the
 unit is recorded with them.
+
+The references the autopilot logs (:data:`REFERENCE_SIGNALS`) are optional:
+rate and attitude setpoints in SI units and radians, and the pilot's sticks
+normalised (unit ``"1"``), each positive in the sense of the positive body
+rate it asks for (``stick_lat`` right → ``+p``, ``stick_lon`` back, nose up →
+``+q``, ``stick_yaw`` right → ``+r``, ``stick_thr`` up → more thrust).
+``stick_lat stick_lon stick_yaw`` span -1..1; ``stick_thr`` spans 0..1, or
+-1..1 where the autopilot logs it so (PX4 ``manual_control_setpoint.throttle``,
+v1.14 on).
 """
 
 from __future__ import annotations
@@ -16,6 +25,7 @@ __all__ = [
     "CANONICAL_SIGNALS",
     "LOGGED_SIGNALS",
     "ESTIMATOR_SIGNALS",
+    "REFERENCE_SIGNALS",
     "is_canonical",
     "describe",
 ]
@@ -71,6 +81,16 @@ _SPECS = (
     SignalSpec("est_wind_e", "autopilot's own east wind estimate", "m/s"),
     SignalSpec("latitude", "WGS-84 latitude of the vehicle (GNSS receiver or estimator)", "rad"),
     SignalSpec("longitude", "WGS-84 longitude of the vehicle (GNSS receiver or estimator)", "rad"),
+    SignalSpec("p_ref", "body roll rate setpoint", "rad/s"),
+    SignalSpec("q_ref", "body pitch rate setpoint", "rad/s"),
+    SignalSpec("r_ref", "body yaw rate setpoint", "rad/s"),
+    SignalSpec("phi_ref", "roll angle setpoint", "rad"),
+    SignalSpec("theta_ref", "pitch angle setpoint", "rad"),
+    SignalSpec("psi_ref", "yaw angle (heading) setpoint", "rad"),
+    SignalSpec("stick_lat", "pilot's roll stick, right positive (-1..1)", "1"),
+    SignalSpec("stick_lon", "pilot's pitch stick, back (nose up) positive (-1..1)", "1"),
+    SignalSpec("stick_yaw", "pilot's yaw stick, right positive (-1..1)", "1"),
+    SignalSpec("stick_thr", "pilot's throttle stick, up positive (0..1, or -1..1 as logged)", "1"),
 )
 
 #: Every canonical signal with a fixed name, by name.
@@ -103,6 +123,22 @@ LOGGED_SIGNALS: tuple[str, ...] = (
 #: and ``longitude`` locate the vehicle for the anemometer's transport delay;
 #: they are not dynamic signals and stay out of conditioned records.
 ESTIMATOR_SIGNALS: tuple[str, ...] = ("excitation", "est_wind_n", "est_wind_e", "latitude", "longitude")
+
+#: Optional references a reader adds when the autopilot logs them (the inputs
+#: a piloted or injected maneuver gives the feedback loops); like the
+#: estimator's signals they are never reported missing.
+REFERENCE_SIGNALS: tuple[str, ...] = (
+    "p_ref",
+    "q_ref",
+    "r_ref",
+    "phi_ref",
+    "theta_ref",
+    "psi_ref",
+    "stick_lat",
+    "stick_lon",
+    "stick_yaw",
+    "stick_thr",
+)
 
 _MOTOR = re.compile(r"motor_([1-9][0-9]?)")
 

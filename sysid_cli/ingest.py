@@ -9,6 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, emit_json, json_option, progress_bar
+from ._warnings import mark_reported
 from ._wind_options import (
     anemometer_at_option,
     parse_position,
@@ -217,5 +218,6 @@ def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
             )
         for warning in entry["warnings"]:
             say(f"  warning: {warning}")
+        mark_reported(entry["warnings"])
     if summary["output"]:
         say(f"wrote {summary['output']}")

@@ -1,4 +1,4 @@
-"""The ``sysid`` command group: options shared by all commands, and error mapping."""
+"""The ``sysid`` command group: options shared by all commands, error mapping, warnings printed once."""
 
 from __future__ import annotations
 
@@ -7,7 +7,9 @@ import sys
 
 import click
 
-from flightlogs.errors import SysidError
+from flightlogs.errors import SysidError, SysidWarning
+
+from ._warnings import warnings_printed_once
 
 __all__ = ["cli"]
 
@@ -19,17 +21,28 @@ Examples:
 
 
 class _SysidGroup(click.Group):
-    """Turn project errors into one sentence and exit code 1 (traceback only with --debug)."""
+    """Turn project errors into one sentence and exit code 1 (traceback only with --debug).
+
+    The project's warnings raised while the command runs are printed after
+    it, once each, as ``warning: <message>`` (see :mod:`sysid_cli._warnings`);
+    one made an error by ``-W error`` ends the command like an error.
+    """
 
     def invoke(self, ctx: click.Context) -> object:
         try:
-            return super().invoke(ctx)
+            with warnings_printed_once(ctx.meta):
+                return super().invoke(ctx)
         except (click.exceptions.Exit, click.ClickException, click.Abort):
             raise
         except SysidError as err:
             if ctx.meta.get("sysid.debug"):
                 raise
             click.secho(f"error: {err}", fg="red", err=True)
+            ctx.exit(1)
+        except SysidWarning as err:  # -W error
+            if ctx.meta.get("sysid.debug"):
+                raise
+            click.secho(f"error: {err} ({type(err).__name__}, an error under -W error)", fg="red", err=True)
             ctx.exit(1)
         except (KeyboardInterrupt, BrokenPipeError):
             raise

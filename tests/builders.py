@@ -6,6 +6,7 @@ Importable from any test as ``import builders`` (``tests`` is on pytest's ``pyth
   angle P, rate PI), with the injected excitation known exactly, and the inputs flown in it.
 - The hover structure at Table 3.3's values with chosen costs and accuracies (for reports).
 - A small simulated verification of a pitch-like model on two noisy doublets (for reports).
+- A read whose project warnings are checked against the result's ``warnings`` (for real logs).
 """
 
 from __future__ import annotations
@@ -13,13 +14,16 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
-from collections.abc import Mapping
+import warnings
+from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 import pandas as pd
 
+from flightlogs.errors import SysidWarning
 from flightlogs.record import Record
 from simulator.vehicle.identified import CALM_HOVER
 from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate, Provenance, ReductionStep, synthetic_responses
@@ -274,3 +278,23 @@ def sample_verification(*, seed: int = 0) -> Verification:
         excited=["delta_lon", "delta_lon"],
         axes={"delta_lon": ("q", "theta", "ax")},
     )
+
+
+# ------------------------------------------------------------------ warnings kept in results
+
+_T = TypeVar("_T")
+
+
+def read_warned(read: Callable[..., _T], *args: object, **kwargs: object) -> _T:
+    """``read(*args, **kwargs)``, checking that the project warnings it raises are its result's ``warnings``.
+
+    For tests on real logs, whose warnings (dropouts, samples flagged
+    invalid, GNSS without a fix) are not what they test: each warning must
+    still be raised to the caller and kept in the result, in order. Any
+    other warning stays an error, as the test configuration makes it.
+    """
+    with warnings.catch_warnings(record=True) as raised:
+        warnings.simplefilter("always", SysidWarning)
+        result = read(*args, **kwargs)
+    assert tuple(str(w.message) for w in raised) == tuple(result.warnings)  # type: ignore[attr-defined]
+    return result

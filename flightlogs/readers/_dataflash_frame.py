@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import bisect
 import struct
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
@@ -21,7 +22,7 @@ from typing import cast
 import numpy as np
 from pymavlink.DFReader import FORMAT_TO_STRUCT, DFFormat
 
-from flightlogs.errors import LogFormatError
+from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError
 
 __all__ = ["MessageFormat"]
 
@@ -93,9 +94,7 @@ _FMT_DEF = _Definition(
 )
 
 
-def frame_messages(
-    buf: np.ndarray, path: Path, warnings: list[str]
-) -> tuple[list[tuple[str, MessageFormat, np.ndarray]], int]:
+def frame_messages(buf: np.ndarray, path: Path) -> tuple[list[tuple[str, MessageFormat, np.ndarray]], int]:
     """``(table key, format, offsets)`` of the messages DFReader would decode, per layout; bytes skipped.
 
     The FMT messages on the chain of messages define the chain (types and
@@ -117,8 +116,8 @@ def frame_messages(
     if len(by_type) == 1:
         kind = "a text DataFlash log" if buf[:4].tobytes() == b"FMT," else "no DataFlash FMT message"
         raise LogFormatError(f"{path}: holds {kind} (searched {buf.size} bytes from byte offset 0).")
-    offsets, skipped = _account(buf, starts, ends, decodes, path, warnings)
-    return _layouts(buf, offsets, by_type, path, warnings), skipped
+    offsets, skipped = _account(buf, starts, ends, decodes, path)
+    return _layouts(buf, offsets, by_type, path), skipped
 
 
 def _by_type(defs: list[_Definition]) -> dict[int, list[_Definition]]:
@@ -170,35 +169,38 @@ def _walk(
 
 
 def _account(
-    buf: np.ndarray, starts: np.ndarray, ends: np.ndarray, decodes: np.ndarray, path: Path, warnings: list[str]
+    buf: np.ndarray, starts: np.ndarray, ends: np.ndarray, decodes: np.ndarray, path: Path
 ) -> tuple[np.ndarray, int]:
-    """Offsets of the decodable, complete messages; the rest reported in `warnings`."""
+    """Offsets of the decodable, complete messages; the rest warned about (:class:`LogCorruptionWarning`)."""
     size, name = buf.size, path.name
+    found = []
     if not decodes.all():
         types = ", ".join(sorted({str(t) for t in buf[starts[~decodes] + 2].tolist()}))
-        warnings.append(
+        found.append(
             f"{name}: {int((~decodes).sum())} messages of type(s) {types} have a FMT length "
             "that disagrees with their format; skipped."
         )
     truncated = ends > size
     if truncated.any():
         at = int(starts[truncated][0])
-        warnings.append(
+        found.append(
             f"{name}: truncated final message (type {buf[at + 2]}) at byte offset {at}: "
             f"{size - at} bytes left of {int(ends[truncated][0]) - at}."
         )
     gap_at = np.concatenate([[0], np.minimum(ends, size)])
     gap_len = np.concatenate([starts, [size]]) - gap_at
     shown = np.flatnonzero(gap_len > 0)
-    warnings.extend(f"{name}: skipped {int(gap_len[k])} bytes at offset {int(gap_at[k])}." for k in shown[:LISTED])
+    found.extend(f"{name}: skipped {int(gap_len[k])} bytes at offset {int(gap_at[k])}." for k in shown[:LISTED])
     if shown.size > LISTED:
-        warnings.append(f"{name}: skipped bytes at {shown.size - LISTED} more places.")
+        found.append(f"{name}: skipped bytes at {shown.size - LISTED} more places.")
+    for message in found:
+        warnings.warn(LogCorruptionWarning(message), stacklevel=2)
     skipped = int(gap_len.sum() + 3 * (~decodes).sum() + (size - starts[truncated]).sum())
     return starts[decodes & ~truncated], skipped
 
 
 def _layouts(
-    buf: np.ndarray, offsets: np.ndarray, by_type: dict[int, list[_Definition]], path: Path, warnings: list[str]
+    buf: np.ndarray, offsets: np.ndarray, by_type: dict[int, list[_Definition]], path: Path
 ) -> list[tuple[str, MessageFormat, np.ndarray]]:
     """Group message offsets by layout (name, format, columns) under their table key."""
     types = buf[offsets + 2]
@@ -221,9 +223,8 @@ def _layouts(
         seen[key[0]] = seen.get(key[0], -1) + 1
         label = key[0] if seen[key[0]] == 0 else f"{key[0]}@{seen[key[0]]}"
         if seen[key[0]]:
-            warnings.append(
-                f"{path.name}: {key[0]} is redefined with format {key[1]!r}; those messages are in {label!r}."
-            )
+            message = f"{path.name}: {key[0]} is redefined with format {key[1]!r}; those messages are in {label!r}."
+            warnings.warn(DataQualityWarning(message), stacklevel=2)
         parts = layouts[key]
         result.append((label, formats[key], parts[0] if len(parts) == 1 else np.sort(np.concatenate(parts))))
     return result

@@ -8,12 +8,13 @@ checksum, status); times and values are converted by the caller.
 from __future__ import annotations
 
 import re
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from flightlogs.errors import DataError, LogFormatError
+from flightlogs.errors import DataError, DataQualityWarning, LogCorruptionWarning, LogFormatError
 
 __all__: list[str] = []
 
@@ -33,7 +34,6 @@ class Readings:
     directions_deg: np.ndarray  # (n,) direction the wind comes FROM, deg
     lines: list[int]  # 1-based line of each reading
     time_column: str  # header of the timestamp column, "field 1" without a header
-    warnings: tuple[str, ...]  # lines dropped
 
 
 def is_responseone(rows: list[list[str]]) -> bool:
@@ -50,7 +50,7 @@ def _checksum(text: str) -> int:
 
 
 def read_readings(path: Path, rows: list[list[str]], numbers: list[int]) -> Readings:
-    """Readings of ``<time>,<ResponseONE polar line>`` rows; a bad checksum or status drops a line."""
+    """Readings of ``<time>,<ResponseONE polar line>`` rows; a bad checksum or status drops a line, with a warning."""
     has_header = not (len(rows[0]) >= 2 and RESPONSEONE.match(rows[0][-1]))
     times, speeds, directions, lines = [], [], [], []
     failed_sum, flagged = [], []
@@ -70,21 +70,21 @@ def read_readings(path: Path, rows: list[list[str]], numbers: list[int]) -> Read
             speeds.append(float(match.group(2)))
             directions.append(float(match.group(3)))
             lines.append(line)
-    warnings = [
-        f"dropped {len(bad)} ResponseONE lines {why} (first: line {bad[0]})"
-        for bad, why in ((failed_sum, "failing the checksum"), (flagged, "with a non-zero status code"))
-        if bad
-    ]
     if not times:
         raise DataError(
             f"{path}: no valid ResponseONE reading ({len(failed_sum)} failed the "
             f"checksum, {len(flagged)} had a non-zero status)"
         )
+    for bad, why, category in (
+        (failed_sum, "failing the checksum", LogCorruptionWarning),
+        (flagged, "with a non-zero status code", DataQualityWarning),
+    ):
+        if bad:
+            warnings.warn(category(f"dropped {len(bad)} ResponseONE lines {why} (first: line {bad[0]})"), stacklevel=2)
     return Readings(
         times=times,
         speeds=np.array(speeds),
         directions_deg=np.array(directions),
         lines=lines,
         time_column=rows[0][0] if has_header else "field 1",
-        warnings=tuple(warnings),
     )

@@ -2,20 +2,21 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
+from flightlogs.errors import DataQualityWarning
 from flightlogs.flightlog import Signal
 
 __all__: list[str] = []
 
 
-def make_signal(
-    name: str, time_s: np.ndarray, values: np.ndarray, unit: str, source: str, warnings: list[str]
-) -> Signal | None:
+def make_signal(name: str, time_s: np.ndarray, values: np.ndarray, unit: str, source: str) -> Signal | None:
     """Build a Signal, dropping non-finite samples and out-of-order timestamps.
 
-    Drops are reported once per signal in `warnings`; a signal with no sample
-    left is omitted (it will be reported missing).
+    Drops are warned about once per signal (:class:`DataQualityWarning`); a
+    signal with no sample left is omitted (it will be reported missing).
     """
     time_s = np.asarray(time_s, dtype=np.float64)
     values = np.asarray(values, dtype=np.float64)
@@ -28,9 +29,10 @@ def make_signal(
         keep &= forward
     dropped = int(time_s.size - keep.sum())
     if dropped:
-        warnings.append(
+        message = (
             f"{source}: dropped {dropped} of {time_s.size} samples (non-finite values or timestamps not increasing)"
         )
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     if not keep.any():
         return None
     return Signal(name=name, time_s=time_s[keep], values=values[keep], unit=unit, source=source)

@@ -38,6 +38,15 @@ FIELDS: dict[str, tuple[str, ...]] = {
     "PARAM_VALUE": ("param_id", "param_value"),
     "STATUSTEXT": ("text",),
     "AUTOPILOT_VERSION": ("flight_sw_version",),
+    "ATTITUDE_TARGET": (
+        "time_boot_ms",
+        "type_mask",
+        "body_roll_rate",
+        "body_pitch_rate",
+        "body_yaw_rate",
+        *(f"q[{i}]" for i in range(4)),
+    ),
+    "RC_CHANNELS": ("time_boot_ms", *(f"chan{i}_raw" for i in range(1, 19))),
 }
 
 Key = tuple[int, int]  # (system id, component id)
@@ -111,10 +120,18 @@ def _keep(scan: Scan, msg: Any) -> None:
     if fields is None:
         return
     key = (msg.get_srcSystem(), msg.get_srcComponent())
-    row = (msg._timestamp, *(getattr(msg, f, 0) for f in fields))
+    row = (msg._timestamp, *(_field(msg, f) for f in fields))
     scan.rows.setdefault(key, {}).setdefault(name, []).append(row)
     if name == "HEARTBEAT":
         scan.heartbeats.append((key, int(msg.type), int(msg.autopilot)))
+
+
+def _field(msg: Any, name: str) -> Any:
+    """A field's value; ``"q[2]"`` is an element of the array field ``q``."""
+    if name.endswith("]"):
+        array, index = name[:-1].split("[")
+        return getattr(msg, array)[int(index)]
+    return getattr(msg, name, 0)
 
 
 def message_table(name: str, rows: list[tuple[Any, ...]]) -> dict[str, np.ndarray]:

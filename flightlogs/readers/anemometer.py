@@ -34,7 +34,9 @@ Two layouts are recognised:
 
 from __future__ import annotations
 
+import dataclasses
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -45,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from flightlogs.errors import DataError, LogFormatError
+from flightlogs.errors import DataError, DataQualityWarning, LogFormatError, collected_warnings
 from flightlogs.readers._anemometer_text import Table, check_increasing, load_rows, parse_time_columns, parse_times
 from flightlogs.readers._responseone import is_responseone, read_readings
 
@@ -150,7 +152,8 @@ class WindMeasurement:
     layout : {"columns", "responseone"}
         The layout recognised.
     warnings : tuple of str
-        Assumptions made and lines dropped.
+        Assumptions made and lines dropped (the messages of the warnings
+        raised while reading).
     """
 
     path: Path
@@ -244,6 +247,15 @@ def read_anemometer_csv(
     ValueError
         If `columns` has an unknown key or `speed_unit` is unknown.
 
+    Warns
+    -----
+    DataQualityWarning
+        When m/s is assumed for speeds without a unit, or ResponseONE lines
+        flagged by the sensor are dropped.
+    LogCorruptionWarning
+        When ResponseONE lines failing their checksum are dropped; every
+        message is also in ``warnings``.
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -263,12 +275,27 @@ def read_anemometer_csv(
             raise ValueError(f"columns has unknown keys {unknown}; use {list(_KEYS)}")
     default_unit = _speed_unit_name(speed_unit) if speed_unit is not None else None
     rows, line_numbers = load_rows(path)
-    if columns is None and is_responseone(rows):
-        return _read_responseone(path, rows, line_numbers, utc_offset_hours, default_unit)
+    with collected_warnings() as caught:
+        if columns is None and is_responseone(rows):
+            wind = _read_responseone(path, rows, line_numbers, utc_offset_hours, default_unit)
+        else:
+            wind = _read_columns(path, rows, line_numbers, columns or {}, utc_offset_hours, default_unit)
+    return dataclasses.replace(wind, warnings=caught.messages)
+
+
+def _read_columns(
+    path: Path,
+    rows: list[list[str]],
+    line_numbers: list[int],
+    columns: Mapping[str, str],
+    utc_offset_hours: float,
+    default_unit: str | None,
+) -> WindMeasurement:
+    """The ``columns`` layout: a header row, then one sample a row."""
     header, data, lines = rows[0], rows[1:], line_numbers[1:]
     if not data:
         raise LogFormatError(f"{path}: no data rows below the header (line {line_numbers[0]})")
-    used = _resolve_columns(path, header, columns or {})
+    used = _resolve_columns(path, header, columns)
     table = Table(path=path, header=header, rows=data, lines=lines)
     utc_s = parse_time_columns(table, used, utc_offset_hours)
     return _wind_from_columns(table, used, utc_s, default_unit)
@@ -355,12 +382,11 @@ def _speed_unit_name(unit: str) -> str:
 def _wind_from_columns(
     table: Table, used: dict[str, str], utc_s: np.ndarray, default_unit: str | None
 ) -> WindMeasurement:
-    warnings: list[str] = []
     path, kind = table.path, ("speed" if "speed" in used else "u")
-    unit, factor = _column_unit(path, used[kind], default_unit, warnings)
+    unit, factor = _column_unit(path, used[kind], default_unit, warn=True)
     wind_d = None
     if "w" in used:
-        wind_d = -table.numbers(used["w"]) * _column_unit(path, used["w"], default_unit, [])[1]
+        wind_d = -table.numbers(used["w"]) * _column_unit(path, used["w"], default_unit)[1]
     if kind == "speed":
         direction_unit = _split_unit(used["direction"])[1] or "deg"
         speed, direction = _checked_polar(
@@ -375,10 +401,9 @@ def _wind_from_columns(
             columns=used,
             unit=unit,
             layout="columns",
-            warnings=tuple(warnings),
         )
     wind_e = table.numbers(used["u"]) * factor
-    wind_n = table.numbers(used["v"]) * _column_unit(path, used["v"], default_unit, [])[1]
+    wind_n = table.numbers(used["v"]) * _column_unit(path, used["v"], default_unit)[1]
     direction = np.mod(np.arctan2(-wind_e, -wind_n), 2.0 * np.pi)
     return WindMeasurement(
         path=path,
@@ -391,7 +416,6 @@ def _wind_from_columns(
         columns=used,
         unit=unit,
         layout="columns",
-        warnings=tuple(warnings),
     )
 
 
@@ -417,12 +441,12 @@ def _from_polar(
     )
 
 
-def _column_unit(path: Path, column: str, default_unit: str | None, warnings: list[str]) -> tuple[str, float]:
-    """Speed unit of a column from its header, and its factor to m/s."""
+def _column_unit(path: Path, column: str, default_unit: str | None, *, warn: bool = False) -> tuple[str, float]:
+    """Speed unit of a column from its header, and its factor to m/s; `warn` when m/s is assumed."""
     unit = _split_unit(column)[1]
     if unit is None:
-        if default_unit is None:
-            warnings.append(f"column {column!r} names no unit; m/s assumed")
+        if default_unit is None and warn:
+            warnings.warn(DataQualityWarning(f"column {column!r} names no unit; m/s assumed"), stacklevel=2)
         unit = default_unit or "m/s"
     if unit not in SPEED_UNITS:
         raise LogFormatError(f"{path}: column {column!r} is in {unit!r}, not a speed unit ({', '.join(SPEED_UNITS)})")
@@ -464,9 +488,9 @@ def _read_responseone(
     utc_s = parse_times(path, found.times, found.lines, "1", utc_offset_hours)
     check_increasing(path, utc_s, found.times, found.lines)
     speed, direction = _checked_polar(path, found.speeds, found.directions_deg, "deg", found.lines, {})
-    warnings = list(found.warnings)
     if default_unit is None:
-        warnings.append("ResponseONE readings carry no unit; m/s assumed (pass speed_unit=)")
+        message = "ResponseONE readings carry no unit; m/s assumed (pass speed_unit=)"
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     unit = default_unit or "m/s"
     columns = {
         "time": found.time_column,
@@ -482,5 +506,4 @@ def _read_responseone(
         columns=columns,
         unit=unit,
         layout="responseone",
-        warnings=tuple(warnings),
     )

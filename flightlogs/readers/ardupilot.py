@@ -17,7 +17,16 @@ canonical                     DataFlash source
 ``est_wind_n/e``              XKF2 / NKF2 / EKF2 VWN VWE (core 0)
 ``latitude longitude``        GPS Lat, Lng (instance 0, Status ≥ 3, deg → rad)
 ``excitation``                SIDD Targ
+``p_ref q_ref r_ref``         RATE RDes, PDes, YDes (deg/s, Copter ≤3.3
+                              cdeg/s → rad/s)
+``phi_ref`` .. ``psi_ref``    ATT DesRoll, DesPitch, DesYaw (deg → rad, yaw
+                              in (-π, π])
+``stick_lat/lon/yaw/thr``     RCIN C(RCMAP_ROLL/PITCH/YAW/THROTTLE),
+                              normalised with RCn_MIN/TRIM/MAX
 ============================  ================================================
+
+The references (``*_ref``, ``stick_*``) are optional and never reported
+missing; :mod:`flightlogs.readers._references` maps them.
 
 Times are ``TimeUS`` / 1e6 or, in logs before Copter 3.4, ``TimeMS`` / 1e3.
 The System ID maneuvers (SIDS messages) are not signals; they are in
@@ -28,14 +37,18 @@ The System ID maneuvers (SIDS messages) are not signals; they are in
 from __future__ import annotations
 
 import calendar
+import dataclasses
 import re
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import cast
 
 import numpy as np
 
+from flightlogs.errors import DataQualityWarning, collected_warnings
 from flightlogs.flightlog import FlightLog, Signal, SystemIdRun
+from flightlogs.readers._references import dataflash_references
 from flightlogs.readers._series import make_signal
 from flightlogs.readers.dataflash import DataFlashMessages, MessageTable, read_messages
 
@@ -61,6 +74,7 @@ _TYPES = (
     "SIDS",
     "PARM",
     "MSG",
+    "RCIN",
 )
 _GPS_FIX_3D = 3  # GPS.Status: 3 = 3-D fix, 4-6 DGPS and RTK
 _GPS_EPOCH_UNIX = 315964800  # 1980-01-06T00:00:00Z
@@ -139,6 +153,12 @@ def read_dataflash(path: str | Path, *, progress: Callable[[int, int], None] | N
     ------
     LogFormatError
         If the file is not a readable DataFlash log.
+
+    Warns
+    -----
+    LogCorruptionWarning, DataQualityWarning
+        As :func:`~flightlogs.readers.dataflash.decode_messages` and
+        :func:`flightlog_from_messages`.
     """
     return flightlog_from_messages(read_messages(path, types=_TYPES, progress=progress))
 
@@ -158,12 +178,25 @@ def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
         mapped when their layouts differ (the later ones are in ``NAME@1``
         tables); a warning says so. Samples whose time does not move forward
         (appended logs of one layout) are dropped with a warning.
+        ``warnings`` holds those of `messages`, then these.
+
+    Warns
+    -----
+    DataQualityWarning
+        For appended logs not mapped, samples dropped, an EKF wind estimate
+        that is zero throughout, GNSS samples without a 3-D fix.
     """
-    warnings = list(messages.warnings)
+    with collected_warnings() as caught:
+        log = _flightlog(messages)
+    return dataclasses.replace(log, warnings=messages.warnings + caught.messages)
+
+
+def _flightlog(messages: DataFlashMessages) -> FlightLog:
     if any("@" in key for key in messages.tables):
-        warnings.append(
+        message = (
             f"{messages.path.name}: appended logs with other layouts are not mapped; only the first log's messages are."
         )
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     parameters = _parameters(messages)
     signals: dict[str, Signal] = {}
 
@@ -178,7 +211,7 @@ def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
         time_s, values = table.time_s, table[column].astype(np.float64)
         if time_s is None:
             return
-        signal = make_signal(name, time_s, convert(values) if convert else values, unit, source, warnings)
+        signal = make_signal(name, time_s, convert(values) if convert else values, unit, source)
         if signal is not None:
             signals[name] = signal
 
@@ -186,10 +219,11 @@ def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
     _map_mixer(messages, add)
     n_motors = _map_motors(messages, parameters, add)
     _map_battery_height(messages, add)
-    _map_estimator(messages, parameters, add, warnings)
-    _map_position(messages, add, warnings)
+    _map_estimator(messages, parameters, add)
+    _map_position(messages, add)
     runs = system_id_runs(messages)
     _map_excitation(messages, runs, add)
+    dataflash_references(messages, parameters, add, wrap_yaw=_wrap_deg)
     return FlightLog(
         path=messages.path,
         log_format="dataflash",
@@ -198,7 +232,6 @@ def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
         vehicle=_vehicle(messages, parameters, n_motors),
         parameters=parameters,
         utc_offset_s=_utc_offset(messages),
-        warnings=tuple(warnings),
         system_id_runs=runs,
     )
 
@@ -321,7 +354,7 @@ def _map_battery_height(messages: DataFlashMessages, add: _Add) -> None:
         add("height_agl", ctun, "Alt", "m", "CTUN.Alt (altitude above home; no rangefinder)")
 
 
-def _map_estimator(messages: DataFlashMessages, parameters: dict[str, float], add: _Add, warnings: list[str]) -> None:
+def _map_estimator(messages: DataFlashMessages, parameters: dict[str, float], add: _Add) -> None:
     """EKF velocity and wind, from the EKF the AHRS uses when the log says so."""
     order = ("XKF", "NKF", "EKF") if parameters.get("AHRS_EKF_TYPE") == 3 else ("NKF", "XKF", "EKF")
     for prefix in order:
@@ -336,11 +369,12 @@ def _map_estimator(messages: DataFlashMessages, parameters: dict[str, float], ad
             add("est_wind_n", wind[0], "VWN", "m/s", f"{wind[1]}.VWN")
             add("est_wind_e", wind[0], "VWE", "m/s", f"{wind[1]}.VWE")
             if not np.any(wind[0]["VWN"]) and not np.any(wind[0]["VWE"]):
-                warnings.append(f"{wind[1]}: the EKF wind estimate is zero throughout (not estimated).")
+                message = f"{wind[1]}: the EKF wind estimate is zero throughout (not estimated)."
+                warnings.warn(DataQualityWarning(message), stacklevel=2)
         return
 
 
-def _map_position(messages: DataFlashMessages, add: _Add, warnings: list[str]) -> None:
+def _map_position(messages: DataFlashMessages, add: _Add) -> None:
     """GNSS latitude and longitude where the receiver has a 3-D fix (Status ≥ 3)."""
     found = _first_instance(messages, "GPS")
     if found is None or not {"Status", "Lat", "Lng"} <= set(found[0].columns):
@@ -348,12 +382,14 @@ def _map_position(messages: DataFlashMessages, add: _Add, warnings: list[str]) -
     table, label = found
     fixed = table["Status"] >= _GPS_FIX_3D
     if not fixed.any():
-        warnings.append(f"{label}: the receiver never had a 3-D fix (Status < 3); no position read.")
+        message = f"{label}: the receiver never had a 3-D fix (Status < 3); no position read."
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
         return
     if not fixed.all():
-        warnings.append(
+        message = (
             f"{label}.Lat, Lng: dropped {int((~fixed).sum())} of {fixed.size} samples without a 3-D fix (Status < 3)."
         )
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     table = table.select(fixed)
     add("latitude", table, "Lat", "rad", f"{label}.Lat (deg→rad, Status ≥ 3)", np.deg2rad)
     add("longitude", table, "Lng", "rad", f"{label}.Lng (deg→rad, Status ≥ 3)", np.deg2rad)

@@ -36,6 +36,7 @@ Values equal those of pymavlink's ``DFReader_binary`` read with
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,7 +46,7 @@ from typing import cast
 import numpy as np
 from pymavlink.DFReader import FORMAT_TO_STRUCT, MULT_TO_PREFIX
 
-from flightlogs.errors import LogFormatError
+from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError, collected_warnings
 from flightlogs.readers._dataflash_frame import (  # noqa: F401  (kept importable from here)
     FMT_TYPE,
     HEAD1,
@@ -143,7 +144,8 @@ class DataFlashMessages:
     counts : Mapping[str, int]
         Messages found per name, decoded or not.
     warnings : tuple of str
-        Recovered problems: skipped bytes, truncation, time resets.
+        Recovered problems: skipped bytes, truncation, time resets (the
+        messages of the warnings raised while decoding).
     bytes_skipped : int
         Bytes that were not part of any decoded message.
     """
@@ -265,6 +267,15 @@ def decode_messages(
     LogFormatError
         If `data` is empty, a ULog, or holds no FMT message.
 
+    Warns
+    -----
+    LogCorruptionWarning
+        For bytes skipped, a truncated last message, formats that disagree
+        with their length.
+    DataQualityWarning
+        For appended logs (a type redefined, the clock going back); every
+        message is also in ``warnings``.
+
     Examples
     --------
     >>> from flightlogs.writers.dataflash import MessageBlock, MessageSpec, encode_dataflash
@@ -286,33 +297,34 @@ def decode_messages(
         raise LogFormatError(
             f"{path}: is a PX4 ULog file, not an ArduPilot DataFlash log (ULog magic at byte offset 0)."
         )
-    warnings: list[str] = []
-    groups, skipped = frame_messages(buf, path, warnings)
-    done = 0
-    if progress is not None:
-        progress(0, size)
-    meta = {k: _decode_table(buf, f, o, warnings) for k, f, o in groups if k in ("FMTU", "UNIT", "MULT")}
-    units = _unit_context(meta)
-    tables: dict[str, MessageTable] = {}
-    counts: dict[str, int] = {}
-    for key, fmt, offsets in groups:
-        counts[fmt.name] = counts.get(fmt.name, 0) + offsets.size
-        if types is None or fmt.name in types or key in meta:
-            fmt = _with_units(fmt, *units) if units else fmt
-            tables[key] = (
-                MessageTable(format=fmt, columns=meta[key].columns, offsets=offsets)
-                if key in meta
-                else _decode_table(buf, fmt, offsets, warnings)
-            )
-            done += offsets.size * fmt.length
-            if progress is not None:
-                progress(min(done, size), size)
-    warnings.extend(_time_resets(tables))
-    if progress is not None:
-        progress(size, size)
-    return DataFlashMessages(
-        path=path, file_size=size, tables=tables, counts=counts, warnings=tuple(warnings), bytes_skipped=skipped
-    )
+    with collected_warnings() as caught:
+        groups, skipped = frame_messages(buf, path)
+        done = 0
+        if progress is not None:
+            progress(0, size)
+        meta = {k: _decode_table(buf, f, o) for k, f, o in groups if k in ("FMTU", "UNIT", "MULT")}
+        units = _unit_context(meta)
+        tables: dict[str, MessageTable] = {}
+        counts: dict[str, int] = {}
+        for key, fmt, offsets in groups:
+            counts[fmt.name] = counts.get(fmt.name, 0) + offsets.size
+            if types is None or fmt.name in types or key in meta:
+                fmt = _with_units(fmt, *units) if units else fmt
+                tables[key] = (
+                    MessageTable(format=fmt, columns=meta[key].columns, offsets=offsets)
+                    if key in meta
+                    else _decode_table(buf, fmt, offsets)
+                )
+                done += offsets.size * fmt.length
+                if progress is not None:
+                    progress(min(done, size), size)
+        for message in _time_resets(tables):
+            warnings.warn(DataQualityWarning(message), stacklevel=2)
+        if progress is not None:
+            progress(size, size)
+        return DataFlashMessages(
+            path=path, file_size=size, tables=tables, counts=counts, warnings=caught.messages, bytes_skipped=skipped
+        )
 
 
 def message_dtype(fmt: str) -> np.dtype:
@@ -338,15 +350,16 @@ def message_dtype(fmt: str) -> np.dtype:
     return layout(fmt, None)[0]
 
 
-def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray, warnings: list[str]) -> MessageTable:
+def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray) -> MessageTable:
     dtype, chars = layout(fmt.format, fmt.length)
     rec = gather(buf, offsets, fmt.length).view(dtype).ravel()
     names = fmt.columns[: len(chars)]
     if len(set(names)) != len(names) or len(fmt.columns) != len(chars):
-        warnings.append(
+        message = (
             f"{fmt.name}: {len(fmt.columns)} column names for {len(chars)} fields "
             f"{fmt.columns}; as in DFReader, a repeated name keeps its last field."
         )
+        warnings.warn(LogCorruptionWarning(message), stacklevel=2)
     columns = {name: _column(rec[f"f{i}"], chars[i], fmt.name) for i, name in enumerate(names)}
     return MessageTable(format=fmt, columns=columns, offsets=offsets)
 
@@ -413,7 +426,7 @@ def _with_units(
 
 
 def _time_resets(tables: dict[str, MessageTable]) -> list[str]:
-    """Warn where the log clock jumps back by more than a second (logs appended)."""
+    """A sentence saying where the log clock jumps back by more than a second (logs appended), if it does."""
     best: tuple[int, str, list[tuple[int, float, float]]] | None = None
     last_time: dict[str, float] = {}
     for key, table in tables.items():

@@ -21,6 +21,15 @@ Choices made here:
   the estimator's ``dist_bottom`` when ``dist_bottom_valid`` is set in every
   sample (it is terrain-relative, where ``-z`` is relative to the origin the
   estimator started at), then ``-vehicle_local_position.z``.
+* The references (:data:`flightlogs.signals.REFERENCE_SIGNALS`):
+  ``p_ref q_ref r_ref`` from ``vehicle_rates_setpoint``; ``phi_ref theta_ref
+  psi_ref`` from ``vehicle_attitude_setpoint.roll_body/pitch_body/yaw_body``
+  (logs before about v1.9), else its quaternion ``q_d``; the sticks from
+  ``manual_control_setpoint`` (``roll pitch yaw throttle`` from v1.14 on,
+  ``y x r z`` before). PX4 logs the pitch stick positive forward (nose down):
+  ``stick_lon`` is its negative, positive back (nose up) like ``q``; the
+  source string carries the minus sign. ``stick_thr`` is kept as logged:
+  ``throttle`` spans -1..1, the older ``z`` 0..1.
 """
 
 from __future__ import annotations
@@ -279,6 +288,49 @@ PX4_GROUPS: tuple[SignalGroup, ...] = (
                 at_least=_FIX_3D,
             ),
             TopicSource(topic="vehicle_gps_position", fields=("lat", "lon"), conversion="degrees_e7", at_least=_FIX_3D),
+        ),
+    ),
+    # references the controllers follow, and the pilot's sticks: optional, never reported missing
+    SignalGroup(
+        ("p_ref", "q_ref", "r_ref"),
+        "rad/s",
+        (TopicSource(topic="vehicle_rates_setpoint", fields=("roll", "pitch", "yaw")),),
+    ),
+    SignalGroup(
+        ("phi_ref", "theta_ref", "psi_ref"),
+        "rad",
+        (
+            TopicSource(topic="vehicle_attitude_setpoint", fields=("roll_body", "pitch_body", "yaw_body")),  # old
+            TopicSource(
+                topic="vehicle_attitude_setpoint",
+                fields=tuple(f"q_d[{i}]" for i in range(4)),
+                conversion="quaternion_to_euler",
+                valid=("q_d_valid",) * 3,
+            ),
+        ),
+    ),
+    SignalGroup(
+        ("stick_lat", "stick_yaw"),
+        "1",
+        (
+            TopicSource(topic="manual_control_setpoint", fields=("roll", "yaw"), valid=("valid",) * 2),  # v1.14 on
+            TopicSource(topic="manual_control_setpoint", fields=("y", "r")),
+        ),
+    ),
+    SignalGroup(
+        ("stick_lon",),
+        "1",
+        (
+            TopicSource(topic="manual_control_setpoint", fields=("pitch",), conversion="negate", valid=("valid",)),
+            TopicSource(topic="manual_control_setpoint", fields=("x",), conversion="negate"),
+        ),
+    ),
+    SignalGroup(
+        ("stick_thr",),
+        "1",
+        (
+            TopicSource(topic="manual_control_setpoint", fields=("throttle",), valid=("valid",)),  # -1..1
+            TopicSource(topic="manual_control_setpoint", fields=("z",)),  # 0..1
         ),
     ),
 )

@@ -23,7 +23,15 @@ canonical                  MAVLink source                                   conv
 ``battery_v``              ``SYS_STATUS.voltage_battery``                   mV / 1000
 ``latitude longitude``     ``GLOBAL_POSITION_INT.lat/lon`` (not 0, 0);      1e-7 deg → rad
                            else ``GPS_RAW_INT.lat/lon`` (``fix_type`` ≥ 3)
+``p_ref q_ref r_ref``      ``ATTITUDE_TARGET.body_roll_rate..``             rad/s
+``phi_ref`` .. ``psi_ref`` ``ATTITUDE_TARGET.q``                            quaternion → Euler
+``stick_*``                ``RC_CHANNELS.chanN_raw``, N from ``RCMAP_*``    normalised with
+                           (ArduPilot) or ``RC_MAP_*`` (PX4)                ``RCn_MIN/TRIM/MAX``
 =========================  ===============================================  ===========
+
+The references (``*_ref``, ``stick_*``) are optional, never reported missing;
+:mod:`flightlogs.readers._references` maps them. PX4 streams
+``ATTITUDE_TARGET``; ArduPilot mostly does not.
 
 Mixer inputs (``delta_*``) are not in the telemetry stream and are reported
 missing.
@@ -31,6 +39,7 @@ missing.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from os import PathLike
@@ -39,8 +48,9 @@ from typing import Any, cast
 
 import numpy as np
 
-from flightlogs.errors import LogFormatError
+from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError, collected_warnings
 from flightlogs.flightlog import FlightLog, Signal
+from flightlogs.readers._references import tlog_references
 from flightlogs.readers._series import make_signal
 from flightlogs.readers._tlog_scan import FIELDS, Key, Scan, message_table, scan_tlog
 
@@ -105,6 +115,14 @@ def read_tlog(path: str | PathLike[str], *, progress: Callable[[int, int], None]
     FileNotFoundError
         If `path` does not exist.
 
+    Warns
+    -----
+    LogCorruptionWarning
+        When bytes were skipped as corrupt or truncated.
+    DataQualityWarning
+        For reboots, samples dropped and signals left out; every message is
+        also in ``warnings``.
+
     Notes
     -----
     Decoding goes through pymavlink's ``mavutil.mavlogfile`` with a MAVLink 2
@@ -142,38 +160,47 @@ def read_tlog(path: str | PathLike[str], *, progress: Callable[[int, int], None]
         raise LogFormatError(f"{path}: no intact MAVLink message found; not a telemetry log")
     key, mav_type, autopilot = _vehicle(scan, path)
     rows = scan.rows.get(key, {})
-    warnings: list[str] = []
-    skipped = size - scan.known_bytes - scan.other_bytes
-    if skipped:
-        warnings.append(
-            f"{path.name}: skipped {skipped} of {size} bytes as corrupt or truncated "
-            f"({100.0 * skipped / size:.2g}%); read the {scan.n_known} intact messages"
-            + (f" ({scan.stopped})" if scan.stopped else "")
+    with collected_warnings() as caught:
+        skipped = size - scan.known_bytes - scan.other_bytes
+        if skipped:
+            message = (
+                f"{path.name}: skipped {skipped} of {size} bytes as corrupt or truncated "
+                f"({100.0 * skipped / size:.2g}%); read the {scan.n_known} intact messages"
+                + (f" ({scan.stopped})" if scan.stopped else "")
+            )
+            warnings.warn(LogCorruptionWarning(message), stacklevel=2)
+        tables = {name: message_table(name, rows.get(name, [])) for name in FIELDS}
+        clock = _BootClock.from_tables(tables)
+        parameters = _parameters(rows.get("PARAM_VALUE", []))
+        signals: dict[str, Signal] = {}
+        if clock.reboots:
+            message = (
+                f"{path.name}: the autopilot rebooted {clock.reboots} time(s) during the log; later "
+                "boot sessions are placed on the first one's clock through the receive time"
+            )
+            warnings.warn(DataQualityWarning(message), stacklevel=2)
+        for builder in (_attitude, _imu, _velocity, _height):
+            builder(tables, clock, signals)
+        _motors(tables, clock, mav_type, autopilot, parameters, signals)
+        _battery(tables, clock, signals)
+        _position(tables, clock, signals)
+        tlog_references(
+            tables,
+            lambda table: clock.log_time_s(table["time_boot_ms"] * 1e-3, table["rx"]),
+            autopilot,  # type: ignore[arg-type]
+            parameters,
+            lambda *series: _add(signals, *series),
         )
-    tables = {name: message_table(name, rows.get(name, [])) for name in FIELDS}
-    clock = _BootClock.from_tables(tables)
-    parameters = _parameters(rows.get("PARAM_VALUE", []))
-    signals: dict[str, Signal] = {}
-    if clock.reboots:
-        warnings.append(
-            f"{path.name}: the autopilot rebooted {clock.reboots} time(s) during the log; later "
-            "boot sessions are placed on the first one's clock through the receive time"
+        return FlightLog(
+            path=path,
+            log_format="tlog",
+            autopilot=autopilot,  # type: ignore[arg-type]
+            signals=signals,
+            vehicle=_vehicle_string(rows, mav_type),
+            parameters=parameters,
+            utc_offset_s=_utc_offset(tables, clock),
+            warnings=caught.messages,
         )
-    for builder in (_attitude, _imu, _velocity, _height):
-        builder(tables, clock, signals, warnings)
-    _motors(tables, clock, mav_type, autopilot, parameters, signals, warnings)
-    _battery(tables, clock, signals, warnings)
-    _position(tables, clock, signals, warnings)
-    return FlightLog(
-        path=path,
-        log_format="tlog",
-        autopilot=autopilot,  # type: ignore[arg-type]
-        signals=signals,
-        vehicle=_vehicle_string(rows, mav_type),
-        parameters=parameters,
-        utc_offset_s=_utc_offset(tables, clock),
-        warnings=tuple(warnings),
-    )
 
 
 # --------------------------------------------------------------------------- vehicle and clock
@@ -262,15 +289,13 @@ def _log_time(table: dict[str, np.ndarray], msg: str, clock: _BootClock) -> np.n
 # --------------------------------------------------------------------------- signals
 
 
-def _add(
-    signals: _Signals, warnings: list[str], name: str, time_s: np.ndarray, values: np.ndarray, unit: str, source: str
-) -> None:
-    signal = make_signal(name, time_s, values, unit, source, warnings)
+def _add(signals: _Signals, name: str, time_s: np.ndarray, values: np.ndarray, unit: str, source: str) -> None:
+    signal = make_signal(name, time_s, values, unit, source)
     if signal is not None:
         signals[name] = signal
 
 
-def _attitude(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: list[str]) -> None:
+def _attitude(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:
     table = tables["ATTITUDE"]
     if not table["rx"].size:
         return
@@ -284,10 +309,10 @@ def _attitude(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: l
         ("r", "yawspeed"),
     ):
         unit = "rad" if name in ("phi", "theta", "psi") else "rad/s"
-        _add(signals, warnings, name, time_s, table[field_name], unit, f"ATTITUDE.{field_name}")
+        _add(signals, name, time_s, table[field_name], unit, f"ATTITUDE.{field_name}")
 
 
-def _imu(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: list[str]) -> None:
+def _imu(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:
     for msg in ("HIGHRES_IMU", "SCALED_IMU", "RAW_IMU", "SCALED_IMU2", "SCALED_IMU3"):
         table = tables[msg]
         if not table["rx"].size:
@@ -295,36 +320,36 @@ def _imu(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: list[s
         time_s = _log_time(table, msg, clock)
         gain, note = (1.0, "") if msg == "HIGHRES_IMU" else (_G0 * 1e-3, " (mG × 0.00980665)")
         for axis in "xyz":
-            _add(signals, warnings, f"a{axis}", time_s, table[f"{axis}acc"] * gain, "m/s^2", f"{msg}.{axis}acc{note}")
+            _add(signals, f"a{axis}", time_s, table[f"{axis}acc"] * gain, "m/s^2", f"{msg}.{axis}acc{note}")
         return
 
 
-def _velocity(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: list[str]) -> None:
+def _velocity(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:
     for msg, gain, note in (("LOCAL_POSITION_NED", 1.0, ""), ("GLOBAL_POSITION_INT", 0.01, " (cm/s / 100)")):
         table = tables[msg]
         if not table["rx"].size:
             continue
         time_s = _log_time(table, msg, clock)
         for name, field_name in (("vn", "vx"), ("ve", "vy"), ("vd", "vz")):
-            _add(signals, warnings, name, time_s, table[field_name] * gain, "m/s", f"{msg}.{field_name}{note}")
+            _add(signals, name, time_s, table[field_name] * gain, "m/s", f"{msg}.{field_name}{note}")
         return
 
 
-def _height(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: list[str]) -> None:
+def _height(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:
     table = tables["DISTANCE_SENSOR"]
     down = table["orientation"] == 25  # MAV_SENSOR_ROTATION_PITCH_270
     if down.any():
         dist = table["current_distance"][down]
         valid = (dist >= table["min_distance"][down]) & (dist <= table["max_distance"][down])
         if (~valid).any():
-            warnings.append(
+            message = (
                 f"DISTANCE_SENSOR.current_distance: dropped {int((~valid).sum())} "
                 f"of {dist.size} readings outside the sensor's range"
             )
+            warnings.warn(DataQualityWarning(message), stacklevel=2)
         time_s = _log_time(table, "DISTANCE_SENSOR", clock)[down][valid]
         _add(
             signals,
-            warnings,
             "height_agl",
             time_s,
             dist[valid] * 0.01,
@@ -340,7 +365,6 @@ def _height(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: lis
         if table["rx"].size:
             _add(
                 signals,
-                warnings,
                 "height_agl",
                 _log_time(table, msg, clock),
                 table[field_name] * gain,
@@ -371,14 +395,14 @@ def _motors(
     autopilot: str,
     parameters: dict[str, float],
     signals: _Signals,
-    warnings: list[str],
 ) -> None:
     table = tables["SERVO_OUTPUT_RAW"]
     if not table["rx"].size:
         return
     n_motors = _MOTORS_BY_MAV_TYPE.get(mav_type)
     if n_motors is None:
-        warnings.append(f"SERVO_OUTPUT_RAW: MAV_TYPE {mav_type} is not a known multirotor; motor outputs not mapped")
+        message = f"SERVO_OUTPUT_RAW: MAV_TYPE {mav_type} is not a known multirotor; motor outputs not mapped"
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
         return
     main = table["port"] == 0
     rx = table["rx"][main]
@@ -389,35 +413,33 @@ def _motors(
     time_s = clock.log_time_s(boot_s, rx)
     for motor, channel in enumerate(_motor_channels(n_motors, autopilot, parameters), start=1):
         field_name = f"servo{channel}_raw"
-        _add(
-            signals, warnings, f"motor_{motor}", time_s, table[field_name][main], "us", f"SERVO_OUTPUT_RAW.{field_name}"
-        )
+        _add(signals, f"motor_{motor}", time_s, table[field_name][main], "us", f"SERVO_OUTPUT_RAW.{field_name}")
 
 
-def _battery(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: list[str]) -> None:
+def _battery(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:
     table = tables["SYS_STATUS"]
     if not table["rx"].size:
         return
     millivolts = table["voltage_battery"]
     monitored = (millivolts != 0) & (millivolts != 65535)
     if not monitored.any():
-        warnings.append("SYS_STATUS.voltage_battery is 0 or 65535 throughout (no battery monitor); battery_v omitted")
+        message = "SYS_STATUS.voltage_battery is 0 or 65535 throughout (no battery monitor); battery_v omitted"
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
         return
     boot_s = clock.boot_time_s(table["rx"])
     if boot_s is None:
-        warnings.append(
-            "SYS_STATUS has no time field and no timed message maps it to the boot clock; battery_v omitted"
-        )
+        message = "SYS_STATUS has no time field and no timed message maps it to the boot clock; battery_v omitted"
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
         return
     if (~monitored).any():
-        warnings.append(
+        message = (
             f"SYS_STATUS.voltage_battery: dropped {int((~monitored).sum())} of "
             f"{millivolts.size} samples reading 0 or 65535 (no monitor)"
         )
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     time_s = clock.log_time_s(boot_s, table["rx"])
     _add(
         signals,
-        warnings,
         "battery_v",
         time_s[monitored],
         millivolts[monitored] * 1e-3,
@@ -426,13 +448,12 @@ def _battery(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: li
     )
 
 
-def _position(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: list[str]) -> None:
+def _position(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:
     """Latitude and longitude: the estimator's global position, else the receiver's with a 3-D fix."""
     table = tables["GLOBAL_POSITION_INT"]
     if (known := _not_null_island(table)).any():
         _add_position(
             signals,
-            warnings,
             "GLOBAL_POSITION_INT",
             table,
             _log_time(table, "GLOBAL_POSITION_INT", clock),
@@ -447,7 +468,6 @@ def _position(tables: _Tables, clock: _BootClock, signals: _Signals, warnings: l
     if fixed.any() and boot_s is not None:
         _add_position(
             signals,
-            warnings,
             "GPS_RAW_INT",
             table,
             clock.log_time_s(boot_s, table["rx"]),
@@ -464,7 +484,6 @@ def _not_null_island(table: dict[str, np.ndarray]) -> np.ndarray:
 
 def _add_position(
     signals: _Signals,
-    warnings: list[str],
     msg: str,
     table: dict[str, np.ndarray],
     time_s: np.ndarray,
@@ -473,11 +492,11 @@ def _add_position(
     note: str,
 ) -> None:
     if (~keep).any():
-        warnings.append(f"{msg}.lat, lon: dropped {int((~keep).sum())} of {keep.size} samples {why}")
+        message = f"{msg}.lat, lon: dropped {int((~keep).sum())} of {keep.size} samples {why}"
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     for name, field_name in (("latitude", "lat"), ("longitude", "lon")):
         _add(
             signals,
-            warnings,
             name,
             time_s[keep],
             np.deg2rad(table[field_name][keep] * 1e-7),

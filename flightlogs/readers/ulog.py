@@ -2,9 +2,10 @@
 
 pyulog parses; this module wraps it so that a bad file raises
 :class:`~flightlogs.errors.LogFormatError` with one sentence naming the file,
-recoverable damage becomes sentences in ``FlightLog.warnings`` (pyulog only
-sets a flag and prints), and topics become canonical signals through the
-table in :mod:`flightlogs.readers.px4_topics`.
+recoverable damage becomes a :class:`~flightlogs.errors.LogCorruptionWarning`
+whose sentence is kept in ``FlightLog.warnings`` (pyulog only sets a flag and
+prints), and topics become canonical signals through the table in
+:mod:`flightlogs.readers.px4_topics`.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import numpy as np
 from pyulog import ULog
 from pyulog.exceptions import ULogException, ULogIncompatibleFlagException
 
-from flightlogs.errors import LogFormatError
+from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError, collected_warnings
 from flightlogs.flightlog import FlightLog, Signal
 from flightlogs.frames import quaternion_to_euler
 from flightlogs.readers._series import make_signal
@@ -85,6 +86,15 @@ def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], No
         If the file cannot be opened, is empty, is not a ULog, is cut inside
         its header, or holds no data message pyulog could read.
 
+    Warns
+    -----
+    LogCorruptionWarning
+        For each kind of damage read past (truncation, unknown message ids,
+        unreadable bytes or parameters, pyulog's own complaints).
+    DataQualityWarning
+        For logging dropouts, samples dropped as invalid, and signals or
+        motors that could not be read; every message is also in ``warnings``.
+
     Notes
     -----
     Topics map to signals through :data:`flightlogs.readers.px4_topics.PX4_GROUPS`
@@ -107,34 +117,36 @@ def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], No
     size = _check_header(path)
     if progress is not None:
         progress(0, size)
-    ulog, notes = _parse(path, size, progress)
-    datasets: _Datasets = {}
-    for dataset in ulog.data_list:
-        if "timestamp" in dataset.data:  # a damaged format may have lost it
-            datasets.setdefault(dataset.name, {})[dataset.multi_id] = dataset.data
-    if not datasets:
-        detail = f" ({notes[0]})" if notes else ""
-        raise LogFormatError(
-            f"{path}: holds no readable data message ({size} bytes): it is truncated or damaged "
-            f"before the first one{detail}."
+    with collected_warnings() as caught:
+        ulog = _parse(path, size, progress)
+        datasets: _Datasets = {}
+        for dataset in ulog.data_list:
+            if "timestamp" in dataset.data:  # a damaged format may have lost it
+                datasets.setdefault(dataset.name, {})[dataset.multi_id] = dataset.data
+        if not datasets:
+            detail = f" ({caught.messages[0]})" if caught.messages else ""
+            caught.discard()  # the error names the damage
+            raise LogFormatError(
+                f"{path}: holds no readable data message ({size} bytes): it is truncated or damaged "
+                f"before the first one{detail}."
+            )
+        parameters = _parameters(ulog.initial_parameters)
+        signals: dict[str, Signal] = {}
+        with np.errstate(invalid="ignore"):  # damaged floats (signalling NaN) become NaN, then dropped
+            for group in PX4_GROUPS:
+                signals.update(_map_group(group, datasets))
+            signals.update(_map_motors(datasets, parameters))
+            utc_offset_s = _utc_offset(datasets)
+        log = FlightLog(
+            path=path,
+            log_format="ulog",
+            autopilot="px4",
+            signals=signals,
+            vehicle=describe_vehicle(ulog.msg_info_dict, parameters),
+            parameters=parameters,
+            utc_offset_s=utc_offset_s,
+            warnings=caught.messages,
         )
-    parameters = _parameters(ulog.initial_parameters, notes)
-    signals: dict[str, Signal] = {}
-    with np.errstate(invalid="ignore"):  # damaged floats (signalling NaN) become NaN, then dropped
-        for group in PX4_GROUPS:
-            signals.update(_map_group(group, datasets, notes))
-        signals.update(_map_motors(datasets, parameters, notes))
-        utc_offset_s = _utc_offset(datasets)
-    log = FlightLog(
-        path=path,
-        log_format="ulog",
-        autopilot="px4",
-        signals=signals,
-        vehicle=describe_vehicle(ulog.msg_info_dict, parameters),
-        parameters=parameters,
-        utc_offset_s=utc_offset_s,
-        warnings=tuple(notes),
-    )
     if progress is not None:
         progress(size, size)
     return log
@@ -278,8 +290,8 @@ class _CountingULog(ULog):  # type: ignore[misc]
         return corrupt
 
 
-def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None) -> tuple[ULog, list[str]]:
-    """Run pyulog with its prints and warnings captured; turn its errors into LogFormatError."""
+def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None) -> ULog:
+    """Run pyulog with its prints and warnings captured as our warnings; turn its errors into LogFormatError."""
     tracked = _TrackedFile(path, size, progress)
     printed = io.StringIO()
     try:
@@ -294,14 +306,21 @@ def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None) -
         ) from err
     finally:
         tracked.close()
-    notes = _damage_notes(ulog, tracked, size, path.name)
-    notes += [f"pyulog: {line.strip()}" for line in printed.getvalue().splitlines() if line.strip()]
-    notes += [f"pyulog: {w.message}" for w in caught if not issubclass(w.category, DeprecationWarning)]
-    return ulog, notes
+    for note in _damage_notes(ulog, tracked, size, path.name):
+        _warnings.warn(LogCorruptionWarning(note), stacklevel=2)
+    if ulog.dropouts:
+        lost_ms = sum(int(dropout.duration) for dropout in ulog.dropouts)
+        message = f"{len(ulog.dropouts)} logging dropout(s): the logger lost {lost_ms} ms of data"
+        _warnings.warn(DataQualityWarning(message), stacklevel=2)
+    said = [line.strip() for line in printed.getvalue().splitlines() if line.strip()]
+    said += [str(w.message) for w in caught if not issubclass(w.category, DeprecationWarning)]
+    for text in said:
+        _warnings.warn(LogCorruptionWarning(f"pyulog: {text}"), stacklevel=2)
+    return ulog
 
 
 def _damage_notes(ulog: _CountingULog, tracked: _TrackedFile, size: int, name: str) -> list[str]:
-    """Sentences saying what pyulog skipped, from our counters, its flag and its dropouts."""
+    """Sentences saying what pyulog skipped, from our counters and its flag."""
     notes = []
     if tracked.stalled_at is not None:
         notes.append(
@@ -332,53 +351,55 @@ def _damage_notes(ulog: _CountingULog, tracked: _TrackedFile, size: int, name: s
         )
     if ulog.file_corruption and not notes:
         notes.append("pyulog flagged the file as corrupt; messages it could not parse were skipped")
-    if ulog.dropouts:
-        lost_ms = sum(int(dropout.duration) for dropout in ulog.dropouts)
-        notes.append(f"{len(ulog.dropouts)} logging dropout(s): the logger lost {lost_ms} ms of data")
     return notes
 
 
-def _map_group(group: SignalGroup, datasets: _Datasets, notes: list[str]) -> dict[str, Signal]:
+def _map_group(group: SignalGroup, datasets: _Datasets) -> dict[str, Signal]:
     """Signals of one group from its first usable source and instance."""
     for source in group.sources:
         for instance, data in sorted(datasets.get(source.topic, {}).items()):
-            found = _read_source(group, source, instance, data, notes)
+            found = _read_source(group, source, instance, data)
             if found:
                 if instance:
-                    notes.append(
-                        f"{source.topic}[0] is empty or invalid; {', '.join(found)} read from instance {instance}"
-                    )
+                    message = f"{source.topic}[0] is empty or invalid; {', '.join(found)} read from instance {instance}"
+                    _warnings.warn(DataQualityWarning(message), stacklevel=2)
                 return found
     return {}
 
 
 def _read_source(
-    group: SignalGroup, source: TopicSource, instance: int, data: Mapping[str, np.ndarray], notes: list[str]
+    group: SignalGroup, source: TopicSource, instance: int, data: Mapping[str, np.ndarray]
 ) -> dict[str, Signal]:
-    """Signals from one topic instance, or {} if none has enough usable samples."""
+    """Signals from one topic instance, or {} if none has enough usable samples.
+
+    What was dropped is warned about only when the instance is used.
+    """
     if not all(field in data for field in source.fields):
         return {}
     stamps = np.asarray(data["timestamp"])
     columns, in_range = _convert(source, data)
     label = f"{source.topic}[{instance}]"
     signals: dict[str, Signal] = {}
-    found_notes: list[str] = []
     unused: list[str] = []
-    for k, name in enumerate(group.names):
-        text = _source_text(source, label, k)
-        keep, valid_fraction, reasons = _usable(source, k, data, in_range, stamps)
-        why = "; ".join(reasons) or "fewer than 2 samples"
-        if keep.sum() < 2 or valid_fraction < source.min_valid_fraction:
-            unused.append(f"{text}: no usable samples ({why}); {name} missing")
-            continue
-        if reasons:
-            dropped = stamps.size - int(keep.sum())
-            found_notes.append(f"{text}: dropped {dropped} of {stamps.size} samples ({why})")
-        signal = make_signal(name, stamps[keep] / 1e6, columns[k][keep], group.unit, text, found_notes)
-        if signal is not None and signal.samples >= 2:
-            signals[name] = signal
-    if signals:
-        notes.extend(found_notes + unused)
+    with collected_warnings() as caught:
+        for k, name in enumerate(group.names):
+            text = _source_text(source, label, k)
+            keep, valid_fraction, reasons = _usable(source, k, data, in_range, stamps)
+            why = "; ".join(reasons) or "fewer than 2 samples"
+            if keep.sum() < 2 or valid_fraction < source.min_valid_fraction:
+                unused.append(f"{text}: no usable samples ({why}); {name} missing")
+                continue
+            if reasons:
+                dropped = stamps.size - int(keep.sum())
+                message = f"{text}: dropped {dropped} of {stamps.size} samples ({why})"
+                _warnings.warn(DataQualityWarning(message), stacklevel=2)
+            signal = make_signal(name, stamps[keep] / 1e6, columns[k][keep], group.unit, text)
+            if signal is not None and signal.samples >= 2:
+                signals[name] = signal
+        if not signals:
+            caught.discard()  # this instance is not used: what it dropped does not matter
+    for message in unused if signals else ():
+        _warnings.warn(DataQualityWarning(message), stacklevel=2)
     return signals
 
 
@@ -448,34 +469,36 @@ def _source_text(source: TopicSource, label: str, k: int) -> str:
     return f"{sign}{label}.{field}{unit}"
 
 
-def _map_motors(datasets: _Datasets, parameters: Mapping[str, float], notes: list[str]) -> dict[str, Signal]:
+def _map_motors(datasets: _Datasets, parameters: Mapping[str, float]) -> dict[str, Signal]:
     """``motor_1..n`` from the first motor topic and instance whose motor count is known."""
     for source in PX4_MOTOR_SOURCES:
         for instance, data in sorted(datasets.get(source.topic, {}).items()):
             label = f"{source.topic}[{instance}]"
             channels = _motor_channels(source, data, parameters)
             if channels is None:
-                notes.append(
+                message = (
                     f"{label}: cannot tell which outputs drive motors (no CA_ROTOR_COUNT, "
                     "and MAV_TYPE/SYS_AUTOSTART name no multirotor); motor signals not read"
                 )
+                _warnings.warn(DataQualityWarning(message), stacklevel=2)
                 continue
             stamps = np.asarray(data["timestamp"])
             keep = stamps > 0
             if keep.sum() < 2:
                 continue
-            found: list[str] = []
             signals = {}
-            for i in channels:
-                field = source.field_pattern.format(i=i)
-                name = f"motor_{i + 1}"
-                signal = make_signal(
-                    name, stamps[keep] / 1e6, np.asarray(data[field])[keep], source.unit, f"{label}.{field}", found
-                )
-                if signal is not None and signal.samples >= 2:
-                    signals[name] = signal
+            with collected_warnings() as caught:
+                for i in channels:
+                    field = source.field_pattern.format(i=i)
+                    name = f"motor_{i + 1}"
+                    signal = make_signal(
+                        name, stamps[keep] / 1e6, np.asarray(data[field])[keep], source.unit, f"{label}.{field}"
+                    )
+                    if signal is not None and signal.samples >= 2:
+                        signals[name] = signal
+                if not signals:
+                    caught.discard()  # this instance is not used: what it dropped does not matter
             if signals:
-                notes.extend(found)
                 return signals
     return {}
 
@@ -516,7 +539,7 @@ def _utc_offset(datasets: _Datasets) -> float | None:
     return None
 
 
-def _parameters(initial: Mapping[str, Any], notes: list[str]) -> dict[str, float]:
+def _parameters(initial: Mapping[str, Any]) -> dict[str, float]:
     """Initial parameters as floats; values a damaged file left unreadable are skipped."""
     parameters = {}
     unreadable = []
@@ -526,5 +549,6 @@ def _parameters(initial: Mapping[str, Any], notes: list[str]) -> dict[str, float
         else:
             unreadable.append(str(key))
     if unreadable:
-        notes.append(f"ignored {len(unreadable)} parameter(s) with unreadable values (first: {unreadable[0]!r})")
+        message = f"ignored {len(unreadable)} parameter(s) with unreadable values (first: {unreadable[0]!r})"
+        _warnings.warn(LogCorruptionWarning(message), stacklevel=2)
     return parameters

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from flightlogs.conditioning.align import pair_winds
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions, condition_flight
-from flightlogs.errors import DataError, LogFormatError
+from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
 from flightlogs.flightlog import FlightLog
 from flightlogs.readers.anemometer import WindMeasurement, read_anemometer_csv
 from flightlogs.readers.dispatch import read_log
@@ -113,6 +114,12 @@ def ingest_campaign(
     ------
     LogFormatError, DataError
         On a file that cannot be read, or wind that cannot be aligned.
+
+    Warns
+    -----
+    DataQualityWarning
+        For a log (without wind) that cannot be conditioned; the reason is
+        also in ``notes``. The readers' and the conditioning's own warnings go on.
     """
     logs = []
     for path in log_paths:
@@ -134,5 +141,7 @@ def ingest_campaign(
             if wind is not None:
                 raise  # the user asked for wind alignment: its failure is the answer
             conditioned.append(None)
-            notes.append((f"not conditioned: {err}",))
+            message = f"not conditioned: {err}"
+            warnings.warn(DataQualityWarning(message), stacklevel=2)
+            notes.append((message,))
     return Campaign(logs=tuple(logs), winds=tuple(winds), conditioned=tuple(conditioned), notes=tuple(notes))

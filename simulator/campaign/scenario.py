@@ -256,8 +256,8 @@ def _scenario_from(raw: dict[str, Any], path: Path) -> Scenario:
         _check_table(path, kind, table, where, tuple(inner or ()))
         try:
             return kind(**table, **(inner or {}))
-        except TypeError:
-            raise DataError(f"{path}: [{where}] has a value of the wrong type") from None
+        except TypeError as err:
+            raise DataError(f"{path}: [{where}] has a value of the wrong type") from err
         except DataError as err:
             raise DataError(f"{path}: [{where}] {err}") from None
 
@@ -267,11 +267,11 @@ def _scenario_from(raw: dict[str, Any], path: Path) -> Scenario:
         if "utc_start" in head and isinstance(head["utc_start"], str):
             try:
                 head["utc_start"] = datetime.fromisoformat(head["utc_start"].replace("Z", "+00:00"))
-            except ValueError:
+            except ValueError as err:
                 raise DataError(
                     f"{path}: [scenario] utc_start {head['utc_start']!r} is not an ISO 8601 time "
                     "(e.g. 2024-05-01T10:00:00Z)"
-                ) from None
+                ) from err
         if isinstance(head.get("formats", ()), (list, tuple)):
             head["formats"] = tuple(head.get("formats", ("dataflash",)))
         head.setdefault("name", path.stem)

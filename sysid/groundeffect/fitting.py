@@ -34,13 +34,13 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import cast
 
 import numpy as np
 from scipy import optimize, stats
 
-from flightlogs.errors import FitError
+from flightlogs.errors import FitError, FitWarning, collected_warnings
 from sysid.groundeffect import formulas
 from sysid.groundeffect.models import (
     MODEL_NAMES,
@@ -105,6 +105,14 @@ def fit_ground_effect(data: ThrustRatioData, config: FitConfig | None = None) ->
     FitError
         If there are fewer than three points or no family can be chosen.
 
+    Warns
+    -----
+    FitWarning
+        For each note on the family chosen, named (``"piecewise_linear:
+        breakpoint ... extrapolated"``). The notes on the other families stay
+        in their :class:`ModelFit` only: a family not chosen is no caveat on
+        the result.
+
     Examples
     --------
     >>> x = np.linspace(1.2, 9.0, 30)
@@ -119,9 +127,12 @@ def fit_ground_effect(data: ThrustRatioData, config: FitConfig | None = None) ->
         if data.n_points == 1:
             what = what.replace("steps", "step").replace("points", "point").replace("were", "was")
         raise FitError(f"{data.source or 'data'}: {data.n_points} {what}; at least 3 are needed to fit")
-    fits = tuple(
-        fit_model(name, data.height_ratio, data.thrust_ratio, confidence=config.confidence) for name in config.models
-    )
+    with collected_warnings() as caught:
+        fits = tuple(
+            fit_model(name, data.height_ratio, data.thrust_ratio, confidence=config.confidence)
+            for name in config.models
+        )
+        caught.discard()  # kept in each family's notes; those of the family chosen are raised below
     scores = np.array([f.criterion(config.criterion) for f in fits])
     scores = np.where(np.isnan(scores), np.inf, scores)  # -inf (an exact fit) stays the best
     if np.all(scores == np.inf):
@@ -129,8 +140,12 @@ def fit_ground_effect(data: ThrustRatioData, config: FitConfig | None = None) ->
             f"{data.source or 'data'}: {data.n_points} points are too few for {config.criterion} "
             f"to compare {', '.join(config.models)}"
         )
-    best = fits[int(np.argmin(scores))].name
-    return GroundEffectFit(data=data, models=fits, best=best, criterion=config.criterion, confidence=config.confidence)
+    best = fits[int(np.argmin(scores))]
+    for note in best.notes:
+        warnings.warn(FitWarning(f"{best.name}: {note}"), stacklevel=2)
+    return GroundEffectFit(
+        data=data, models=fits, best=best.name, criterion=config.criterion, confidence=config.confidence
+    )
 
 
 def fit_model(name: str, height_ratio: np.ndarray, thrust_ratio: np.ndarray, *, confidence: float = 0.95) -> ModelFit:
@@ -150,6 +165,14 @@ def fit_model(name: str, height_ratio: np.ndarray, thrust_ratio: np.ndarray, *, 
     Returns
     -------
     ModelFit
+        With ``notes``: the messages of the warnings below.
+
+    Warns
+    -----
+    FitWarning
+        When the optimiser does not converge, a parameter ends at a bound of
+        its range, the breakpoint is not identified or extrapolated, or the
+        covariance is singular.
 
     Examples
     --------
@@ -161,17 +184,19 @@ def fit_model(name: str, height_ratio: np.ndarray, thrust_ratio: np.ndarray, *, 
     y = np.asarray(thrust_ratio, dtype=np.float64)
     if name not in _FITTERS:
         raise ValueError(f"unknown ground-effect model {name!r}; choose from {MODEL_NAMES}")
-    free, jacobian, notes = _FITTERS[name](x, y)
-    return _summarise(name, x, y, free, jacobian, notes, confidence)
+    with collected_warnings() as caught:
+        free, jacobian = _FITTERS[name](x, y)
+        fit = _summarise(name, x, y, free, jacobian, confidence)
+    return replace(fit, notes=caught.messages)
 
 
 # --------------------------------------------------------------------------- the families
 
-_Fitted = tuple[np.ndarray, np.ndarray, list[str]]  # free parameters, Jacobian (n, p), notes
+_Fitted = tuple[np.ndarray, np.ndarray]  # free parameters, Jacobian (n, p)
 
 
 def _fit_cheeseman_bennett(x: np.ndarray, y: np.ndarray) -> _Fitted:
-    return np.zeros(0), np.zeros((x.size, 0)), []
+    return np.zeros(0), np.zeros((x.size, 0))
 
 
 def _fit_corrected(x: np.ndarray, y: np.ndarray) -> _Fitted:
@@ -186,10 +211,10 @@ def _fit_corrected(x: np.ndarray, y: np.ndarray) -> _Fitted:
         return cast(np.ndarray, (u * formulas.corrected(x, p[0]) ** 2)[:, None])
 
     result = optimize.least_squares(residual, [start], jac=jac, bounds=([-np.inf], [upper]), method="trf")
-    notes = [] if result.success else [f"optimiser: {result.message}"]
+    _warn_unconverged(result)
     if result.x[0] > upper * 0.999:
-        notes.append("rho at the bound where eq. 2.2 diverges at the lowest point")
-    return result.x, jac(result.x), notes
+        warnings.warn(FitWarning("rho at the bound where eq. 2.2 diverges at the lowest point"), stacklevel=2)
+    return result.x, jac(result.x)
 
 
 def _fit_exponential(x: np.ndarray, y: np.ndarray) -> _Fitted:
@@ -219,10 +244,10 @@ def _fit_exponential(x: np.ndarray, y: np.ndarray) -> _Fitted:
         return np.column_stack([e, p[0] * e * x / p[1] ** 2])
 
     result = optimize.least_squares(residual, [a0, b0], jac=jac, bounds=bounds, method="trf")
-    notes = [] if result.success else [f"optimiser: {result.message}"]
+    _warn_unconverged(result)
     if result.x[1] >= bounds[1][1] * 0.999 or result.x[1] <= bounds[0][1] * 1.001:
-        notes.append("decay length b at a bound of its search range")
-    return result.x, jac(result.x), notes
+        warnings.warn(FitWarning("decay length b at a bound of its search range"), stacklevel=2)
+    return result.x, jac(result.x)
 
 
 def _fit_piecewise_linear(x: np.ndarray, y: np.ndarray) -> _Fitted:
@@ -243,14 +268,20 @@ def _fit_piecewise_linear(x: np.ndarray, y: np.ndarray) -> _Fitted:
         np.union1d(np.linspace(lo, hi_bp, _GRID), x),
     )
     slope = float(linear_fit(np.array(bp))[0][0])
-    notes = []
     below = int(np.sum(x < bp))
     if below < 2:
-        notes.append(f"breakpoint {bp:.3g} leaves {below} of {x.size} points below it: not identified by the data")
+        message = f"breakpoint {bp:.3g} leaves {below} of {x.size} points below it: not identified by the data"
+        warnings.warn(FitWarning(message), stacklevel=2)
     elif bp >= hi:
-        notes.append(f"breakpoint {bp:.3g} lies past the largest Z/R {hi:.3g}: extrapolated, the data show no plateau")
+        message = f"breakpoint {bp:.3g} lies past the largest Z/R {hi:.3g}: extrapolated, the data show no plateau"
+        warnings.warn(FitWarning(message), stacklevel=2)
     jacobian = np.column_stack([np.minimum(x - bp, 0.0), np.where(x < bp, -slope, 0.0)])
-    return np.array([slope, bp]), jacobian, notes
+    return np.array([slope, bp]), jacobian
+
+
+def _warn_unconverged(result: optimize.OptimizeResult) -> None:
+    if not result.success:
+        warnings.warn(FitWarning(f"optimiser: {result.message}"), stacklevel=2)
 
 
 def _profile(cost: Callable[[float], float], costs: Callable[[np.ndarray], np.ndarray], grid: np.ndarray) -> float:
@@ -280,15 +311,15 @@ _FITTERS: dict[str, Callable[[np.ndarray, np.ndarray], _Fitted]] = {
 
 
 def _summarise(
-    name: str, x: np.ndarray, y: np.ndarray, free: np.ndarray, jacobian: np.ndarray, notes: list[str], confidence: float
+    name: str, x: np.ndarray, y: np.ndarray, free: np.ndarray, jacobian: np.ndarray, confidence: float
 ) -> ModelFit:
-    """Values, covariance, intervals and goodness of fit of a fitted family."""
+    """Values, covariance, intervals and goodness of fit of a fitted family (its notes left empty)."""
     n, p = x.size, free.size
     values = free if name != "piecewise_linear" else np.array([free[0], 1.0 - free[0] * free[1], free[1]])
     residuals = y - evaluate_model(name, values, x)
     rss = float(np.dot(residuals, residuals))
     dof = n - p
-    covariance = _covariance(jacobian, rss / dof if dof > 0 else math.nan, notes)
+    covariance = _covariance(jacobian, rss / dof if dof > 0 else math.nan)
     if name == "piecewise_linear":  # intercept = 1 - slope bp, by the delta method
         gradient = np.array([[1.0, 0.0], [-free[1], -free[0]], [0.0, 1.0]])
         finite = bool(np.all(np.isfinite(covariance)))
@@ -315,11 +346,10 @@ def _summarise(
         r2=1.0 - rss / tss if tss > 0 else math.nan,
         aicc=aicc,
         bic=bic,
-        notes=tuple(notes),
     )
 
 
-def _covariance(jacobian: np.ndarray, variance: float, notes: list[str]) -> np.ndarray:
+def _covariance(jacobian: np.ndarray, variance: float) -> np.ndarray:
     """s^2 (J^T J)^-1; infinite where J^T J is singular."""
     p = jacobian.shape[1]
     if p == 0:
@@ -329,6 +359,6 @@ def _covariance(jacobian: np.ndarray, variance: float, notes: list[str]) -> np.n
         warnings.simplefilter("ignore", RuntimeWarning)
         condition = np.linalg.cond(information)
     if not np.isfinite(condition) or condition > 1e14 or not np.isfinite(variance):
-        notes.append("covariance singular: parameters not identified by the data")
+        warnings.warn(FitWarning("covariance singular: parameters not identified by the data"), stacklevel=2)
         return np.full((p, p), np.inf)
     return variance * np.linalg.inv(information)

@@ -61,6 +61,12 @@ class Assembler:
     include_wind : bool, optional
         Keep the wind channels (columns of ``G_w``) as inputs.
 
+    Raises
+    ------
+    ModelError
+        If a parameter the entries read has no value, or a value that is not
+        finite (an unidentified parameter).
+
     Examples
     --------
     >>> from sysid.model import load_structure
@@ -98,6 +104,12 @@ class Assembler:
         missing = sorted(needed - set(base))
         if missing:
             raise ModelError(f"structure {structure.name}: no value for {', '.join(missing)}")
+        unknown = [p.name for p in structure.parameters if p.name in needed and not np.isfinite(base[p.name])]
+        if unknown:
+            raise ModelError(
+                f"structure {structure.name}: {', '.join(unknown)} {'has' if len(unknown) == 1 else 'have'} no value "
+                "(unidentified), so the matrices that read it cannot be built"
+            )
         self._base = MappingProxyType(base)
         self._reads = tuple(tuple(e for e in self._entries if name in e.expression.names) for name in self.free)
         self._delay_reads = tuple(
@@ -245,8 +257,8 @@ class Assembler:
             return rhs.copy()
         try:
             return np.linalg.solve(m, rhs)
-        except np.linalg.LinAlgError:
-            raise ModelError(f"structure {self.structure.name}: the mass matrix M is singular") from None
+        except np.linalg.LinAlgError as err:
+            raise ModelError(f"structure {self.structure.name}: the mass matrix M is singular") from err
 
 
 def structure_model(
@@ -282,7 +294,8 @@ def structure_model(
     Raises
     ------
     ModelError
-        If a value names no parameter of the structure, or a constant no trim constant of it.
+        If a value names no parameter of the structure or is not finite (an
+        unidentified parameter has no value), or a constant names no trim constant of it.
 
     Examples
     --------

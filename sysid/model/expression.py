@@ -84,7 +84,7 @@ class Expression:
         except KeyError as err:
             raise ModelError(f"expression {self.text!r} reads {err.args[0]!r}, which has no value") from None
         except (ZeroDivisionError, OverflowError) as err:
-            raise ModelError(f"expression {self.text!r} cannot be evaluated ({err})") from None
+            raise ModelError(f"expression {self.text!r} cannot be evaluated ({err})") from err
 
     @property
     def constant(self) -> bool:
@@ -131,7 +131,7 @@ def parse_expression(text: str | float | int, *, where: str = "") -> Expression:
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as err:
-        raise ModelError(f"{label}entry {text!r} is not a valid expression ({err.msg})") from None
+        raise ModelError(f"{label}entry {text!r} is not a valid expression ({err.msg})") from err
     names: set[str] = set()
     function = _compile(tree.body, text, label, names)
     return Expression(text, frozenset(names), function)

@@ -93,7 +93,7 @@ def parse_structure(text: str, *, source: str = "<text>") -> ModelStructure:
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise ModelError(f"{source}: not valid TOML ({err})") from None
+        raise ModelError(f"{source}: not valid TOML ({err})") from err
     unknown = sorted(set(doc) - _TOP_KEYS)
     if unknown:
         raise ModelError(f"{source}: unknown key {unknown[0]!r} (expected {', '.join(sorted(_TOP_KEYS))})")
@@ -142,7 +142,7 @@ def read_structure(path: str | Path) -> ModelStructure:
     try:
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as err:
-        raise ModelError(f"{path}: cannot read the model structure ({err})") from None
+        raise ModelError(f"{path}: cannot read the model structure ({err})") from err
     return parse_structure(text, source=str(path))
 
 
@@ -247,7 +247,7 @@ def _parameter(name: str, spec: Any, source: str) -> Parameter:
             input=spec.get("input"),
         )
     except (TypeError, ValueError) as err:
-        raise ModelError(f"{source}: parameter {name}: {err}") from None
+        raise ModelError(f"{source}: parameter {name}: {err}") from err
 
 
 def _constant(name: str, spec: Any, source: str) -> Constant:

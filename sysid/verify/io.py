@@ -157,6 +157,7 @@ def verification_to_dict(
             {"name": c.name, "unit": c.unit, "rmse_without": _num(c.rmse_without), "rmse_with": _num(c.rmse_with)}
             for c in v.wind_correction
         ],
+        "unverified": list(v.unverified),
     }
 
 
@@ -257,6 +258,7 @@ def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") ->
                 for c in doc.get("wind_correction", [])
             ),
             off_axis=tuple(_summary_from_dict(s) for s in doc.get("off_axis", [])),
+            unverified=tuple(str(text) for text in doc.get("unverified", [])),
         )
         return SavedVerification(
             verification=verification,
@@ -265,7 +267,7 @@ def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") ->
             created_utc=str(doc.get("created_utc", "")),
         )
     except (KeyError, TypeError, ValueError, AttributeError) as err:
-        raise DataError(f"{source}: verification file is incomplete or damaged ({type(err).__name__}: {err})") from None
+        raise DataError(f"{source}: verification file is incomplete or damaged ({type(err).__name__}: {err})") from err
 
 
 def write_verification(

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import shutil
+import sys
+import warnings
 from pathlib import Path
 
 import pytest
@@ -92,6 +94,35 @@ def test_json_to_file(runner: CliRunner, real_data: Path, tmp_path: Path) -> Non
     assert result.exit_code == 0, result.output
     summary = json.loads(target.read_text())
     assert summary["signals"]["battery_v"]["unit"] == "V"
+
+
+CORRUPT_LOG = "px4-ulog-rs/corrupt_unregistered_msg_id.ulg"
+SKIPPED = "skipped 1 data message(s) with message id 32812, which no subscription declares (corrupt bytes)"
+
+
+def test_each_warning_is_printed_once(runner: CliRunner, real_data: Path) -> None:
+    """The table lists the log's warnings; the group prints none of them again, and no Python warning line."""
+    result = runner.invoke(cli, ["ingest", str(real_data / CORRUPT_LOG)])
+    assert result.exit_code == 0, result.output
+    assert f"  warning: {SKIPPED}" in result.stdout.splitlines()
+    assert result.output.count(SKIPPED) == 1 and "Warning:" not in result.output.replace("pyulog: Warning:", "")
+    quiet = runner.invoke(cli, ["ingest", str(real_data / CORRUPT_LOG), "-q", "--json", "-"])
+    assert quiet.exit_code == 0, quiet.output
+    assert f"warning: {SKIPPED}" in quiet.stderr.splitlines() and quiet.stderr.count(SKIPPED) == 1
+    summary = json.loads(quiet.stdout)
+    assert SKIPPED in summary["warnings"]  # the JSON keeps its warnings list
+    assert quiet.stderr.splitlines() == [f"warning: {w}" for w in summary["warnings"]]
+
+
+def test_under_w_error_a_warning_fails_the_command(
+    runner: CliRunner, real_data: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(sys, "warnoptions", ["error"])  # as python -W error, or PYTHONWARNINGS=error
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = runner.invoke(cli, ["ingest", str(real_data / CORRUPT_LOG)])
+    assert result.exit_code == 1 and result.stdout == ""
+    assert result.stderr.splitlines() == [f"error: {SKIPPED} (LogCorruptionWarning, an error under -W error)"]
 
 
 def _bad_files(real_data: Path, tmp_path: Path) -> dict[str, tuple[Path, str]]:

@@ -96,6 +96,7 @@ def test_a_closed_loop_3211_is_recovered_and_found_to_the_sample(
 
 
 @pytest.mark.slow  # about 15 s, most of it simulating the four trials
+@pytest.mark.filterwarnings("ignore:no wind given:flightlogs.errors.DataQualityWarning")  # u v w are not used here
 def test_the_nonlinear_octocopter_3211s_are_3211s(tmp_path: Path) -> None:
     """One 3-2-1-1 per axis (7 s, 1 s unit, from 5 s into the trial) and a multisine, closed loop.
 

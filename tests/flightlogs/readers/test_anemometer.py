@@ -7,6 +7,7 @@ the real NMT file). Fixtures under tests/data/anemometer/ are hand-written.
 
 from __future__ import annotations
 
+import contextlib
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -16,7 +17,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from flightlogs.errors import DataError, LogFormatError
+from flightlogs.errors import DataError, DataQualityWarning, LogCorruptionWarning, LogFormatError
 from flightlogs.readers.anemometer import SPEED_UNITS, WindMeasurement, read_anemometer_csv
 
 DATA = Path(__file__).resolve().parents[2] / "data" / "anemometer"
@@ -52,7 +53,9 @@ def test_iso_zulu_speed_and_direction_analytic():
 
 def test_u_v_components_give_the_same_wind_as_speed_and_direction():
     polar = read_anemometer_csv(DATA / "iso_utc_speed_dir.csv")
-    cartesian = read_anemometer_csv(DATA / "epoch_ms_uv.csv")  # epoch milliseconds
+    with pytest.warns(DataQualityWarning, match="column 'u' names no unit; m/s assumed"):  # once, not for v
+        cartesian = read_anemometer_csv(DATA / "epoch_ms_uv.csv")  # epoch milliseconds
+    assert cartesian.warnings == ("column 'u' names no unit; m/s assumed",)
     assert dict(cartesian.columns) == {"time": "timestamp", "u": "u", "v": "v"}
     np.testing.assert_allclose(cartesian.utc_s, polar.utc_s[:4], atol=1e-6)
     for name in ("wind_n", "wind_e", "speed_m_s", "direction_from_rad"):
@@ -123,7 +126,8 @@ def test_speed_units_from_the_header(tmp_path, header, unit, factor):
 
 def test_missing_unit_is_assumed_m_s_with_a_warning_or_taken_from_speed_unit(tmp_path):
     path = _write(tmp_path, "time,ws,wd\n2024-05-01T10:00:00Z,10,0\n")
-    assert "m/s assumed" in read_anemometer_csv(path).warnings[0]
+    with pytest.warns(DataQualityWarning, match="column 'ws' names no unit; m/s assumed"):
+        assert "m/s assumed" in read_anemometer_csv(path).warnings[0]
     wind = read_anemometer_csv(path, speed_unit="knots")
     assert wind.unit == "kn" and wind.warnings == ()
     assert wind.speed_m_s[0] == pytest.approx(10 * KNOT, rel=1e-6)
@@ -133,7 +137,8 @@ def test_missing_unit_is_assumed_m_s_with_a_warning_or_taken_from_speed_unit(tmp
 
 def test_explicit_columns_override_detection(tmp_path):
     path = _write(tmp_path, "clock,a,b,ws,wd\n1714557600,3,0,1,1\n1714557601,4,90,1,1\n")
-    wind = read_anemometer_csv(path, columns={"time": "clock", "speed": "a", "direction": "B"})
+    with pytest.warns(DataQualityWarning, match="column 'a' names no unit"):
+        wind = read_anemometer_csv(path, columns={"time": "clock", "speed": "a", "direction": "B"})
     assert dict(wind.columns) == {"time": "clock", "speed": "a", "direction": "b"}
     np.testing.assert_allclose(wind.speed_m_s, [3, 4])
     with pytest.raises(ValueError, match="unknown keys"):
@@ -144,13 +149,20 @@ def test_explicit_columns_override_detection(tmp_path):
 
 def test_speed_and_direction_preferred_to_u_and_v(tmp_path):
     path = _write(tmp_path, "time,ws,wd,u,v\n1714557600,5,0,9,9\n")
-    assert set(read_anemometer_csv(path).columns) == {"time", "speed", "direction"}
-    wind = read_anemometer_csv(path, columns={"u": "u", "v": "v"})
+    with pytest.warns(DataQualityWarning, match="column 'ws' names no unit"):
+        assert set(read_anemometer_csv(path).columns) == {"time", "speed", "direction"}
+    with pytest.warns(DataQualityWarning, match="column 'u' names no unit"):
+        wind = read_anemometer_csv(path, columns={"u": "u", "v": "v"})
     assert set(wind.columns) == {"time", "u", "v"} and wind.wind_n[0] == 9
 
 
 def test_responseone_92000_layout():
-    wind = read_anemometer_csv(DATA / "responseone_92000.csv")
+    with (
+        pytest.warns(DataQualityWarning, match="with a non-zero status code|m/s assumed"),
+        pytest.warns(LogCorruptionWarning, match="1 ResponseONE lines failing the checksum") as raised,
+    ):
+        wind = read_anemometer_csv(DATA / "responseone_92000.csv")
+    assert [str(w.message) for w in raised] == list(wind.warnings)
     assert wind.layout == "responseone" and wind.columns["time"] == "logger_time_utc"
     np.testing.assert_allclose(wind.utc_s, T0 + np.array([0, 0.25, 0.5, 0.75, 1.0]), atol=1e-6)
     np.testing.assert_allclose(np.c_[wind.wind_n, wind.wind_e][:4], FROM_NESW, atol=1e-12)
@@ -206,6 +218,7 @@ def test_real_nmt_file_is_refused_by_auto_detection_with_the_columns_listed(nmt_
         assert column in message
 
 
+@pytest.mark.filterwarnings("ignore::flightlogs.errors.DataQualityWarning")  # the NMT columns name no unit
 def test_real_nmt_file_with_explicit_columns_matches_pandas(nmt_csv):
     wind = read_anemometer_csv(nmt_csv, columns=REAL_COLUMNS)
     frame = pd.read_csv(nmt_csv)
@@ -341,7 +354,11 @@ def test_round_trip_speed_direction_and_components(tmp_path, rows, unit, start):
     lines = [f"{t!r},{a!r},{b!r}" for t, a, b in zip(times.tolist(), u.tolist(), v.tolist())]
     header = {"m/s": "u,v", "kn": "u_kn,v_kn", "km/h": "u[km/h],v[km/h]", "mph": "u mph,v mph"}[unit]
     uv_text = f"epoch,{header}\n" + "\n".join(lines)
-    cartesian = read_anemometer_csv(_write(tmp_path, uv_text, "uv.csv"))
+    without_unit = unit == "m/s"
+    with (
+        pytest.warns(DataQualityWarning, match="column 'u' names no unit") if without_unit else contextlib.nullcontext()
+    ):
+        cartesian = read_anemometer_csv(_write(tmp_path, uv_text, "uv.csv"))
     np.testing.assert_allclose(cartesian.utc_s, times, rtol=0, atol=1e-6)
     for name in ("wind_n", "wind_e", "speed_m_s"):
         np.testing.assert_allclose(getattr(cartesian, name), getattr(polar, name), rtol=1e-9, atol=1e-9, err_msg=name)

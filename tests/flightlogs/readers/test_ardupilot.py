@@ -14,10 +14,13 @@ import numpy as np
 import pytest
 from pymavlink.DFReader import DFReader_binary
 
+from flightlogs.errors import DataQualityWarning
 from flightlogs.readers.ardupilot import gps_leap_seconds, read_dataflash, system_id_runs
 from flightlogs.readers.dataflash import decode_messages, read_messages
 from flightlogs.readers.dispatch import read_log
 from flightlogs.writers.dataflash import encode_dataflash, standard_block
+
+from builders import read_warned
 
 SAMPLE = ("ardupilot-log-diagnosis", "sample.bin")  # ArduCopter 3.6.4
 LOG171 = ("dronekit-la-testdata", "log171.bin")  # ArduCopter 3.3-dev
@@ -56,7 +59,7 @@ def dfreader_field(path: Path, message: str, field: str) -> tuple[np.ndarray, np
 )
 def test_signal_equals_dfreader_field_sample_for_sample(real_data: Path, where, name, message, field, convert) -> None:
     path = real_data.joinpath(*where)
-    log = read_dataflash(path)
+    log = read_warned(read_dataflash, path)
     time_s, values = dfreader_field(path, message, field)
     np.testing.assert_array_equal(log[name].time_s, time_s)
     np.testing.assert_array_equal(log[name].values, convert(values) if convert else values)
@@ -65,7 +68,7 @@ def test_signal_equals_dfreader_field_sample_for_sample(real_data: Path, where, 
 @pytest.mark.parametrize("where", [SAMPLE, LOG171], ids=lambda w: w[1])
 def test_yaw_is_wrapped_to_minus_pi_pi(real_data: Path, where) -> None:
     path = real_data.joinpath(*where)
-    psi = read_dataflash(path)["psi"]
+    psi = read_warned(read_dataflash, path)["psi"]
     _, yaw_deg = dfreader_field(path, "ATT", "Yaw")
     assert np.all((psi.values > -np.pi) & (psi.values <= np.pi))
     # np.angle is an independent (-π, π] wrap; the two agree to float rounding (a few ulp of π)
@@ -74,7 +77,7 @@ def test_yaw_is_wrapped_to_minus_pi_pi(real_data: Path, where) -> None:
 
 
 def test_copter_36_log_metadata_and_sources(real_data: Path) -> None:
-    log = read_dataflash(real_data.joinpath(*SAMPLE))
+    log = read_warned(read_dataflash, real_data.joinpath(*SAMPLE))
     assert (log.log_format, log.autopilot) == ("dataflash", "ardupilot")
     assert log.vehicle.startswith("ArduCopter V3.6.4 (6c4da9e3); frame QUAD") and "4 motors" in log.vehicle
     assert log.parameters["FRAME_CLASS"] == 1.0
@@ -88,7 +91,7 @@ def test_copter_36_log_metadata_and_sources(real_data: Path) -> None:
 
 
 def test_copter_33_log_metadata_and_units(real_data: Path) -> None:
-    log = read_dataflash(real_data.joinpath(*LOG171))
+    log = read_warned(read_dataflash, real_data.joinpath(*LOG171))
     assert log.vehicle.startswith("APM:Copter V3.3-dev (ae3192b8); frame QUAD")
     assert log.missing == ()
     assert log["battery_v"].source == "CURR.Volt (cV→V)" and log["battery_v"].unit == "V"
@@ -101,7 +104,7 @@ def test_copter_33_log_metadata_and_units(real_data: Path) -> None:
 )
 def test_utc_offset_from_gps_week_and_ms(real_data: Path, where, leap: int, day: str) -> None:
     path = real_data.joinpath(*where)
-    log = read_dataflash(path)
+    log = read_warned(read_dataflash, path)
     reader = DFReader_binary(str(path))
     gps = []
     while (msg := reader.recv_match(type="GPS")) is not None:
@@ -125,7 +128,7 @@ def test_utc_offset_from_gps_week_and_ms(real_data: Path, where, leap: int, day:
 def test_gps_position_equals_dfreader_where_the_fix_is_3d(real_data: Path, where, dropped: int) -> None:
     """GPS Lat/Lng (deg as DFReader gives them) → rad, samples with Status ≥ 3 only."""
     path = real_data.joinpath(*where)
-    log = read_dataflash(path)
+    log = read_warned(read_dataflash, path)
     reader = DFReader_binary(str(path))
     rows = []
     while (msg := reader.recv_match(type="GPS")) is not None:
@@ -154,13 +157,15 @@ def test_gps_position_from_instance_0_and_none_without_a_fix(tmp_path: Path) -> 
     )
     path = tmp_path / "gps.bin"
     path.write_bytes(encode_dataflash([gps]))
-    log = read_dataflash(path)
+    with pytest.warns(DataQualityWarning, match=r"GPS\[0\].Lat, Lng: dropped 1 of 3 samples without a 3-D fix"):
+        log = read_dataflash(path)
     np.testing.assert_array_equal(log["latitude"].values, np.deg2rad([35.0, 35.0000001]))
     np.testing.assert_array_equal(log["longitude"].time_s, [1.2, 1.4])
     assert "GPS[0].Lat, Lng: dropped 1 of 3 samples without a 3-D fix (Status < 3)." in log.warnings
     nofix = standard_block("GPS", TimeUS=stamps, Status=[1, 2, 1], Lat=[35.0] * 3, Lng=[-106.9] * 3)
     path.write_bytes(encode_dataflash([nofix]))
-    log = read_dataflash(path)
+    with pytest.warns(DataQualityWarning, match="never had a 3-D fix"):
+        log = read_dataflash(path)
     assert "latitude" not in log.signals and any("never had a 3-D fix" in w for w in log.warnings)
 
 
@@ -201,7 +206,8 @@ def test_no_gps_fix_gives_no_utc(tmp_path: Path) -> None:
     gps = standard_block("GPS", TimeUS=[1_000_000, 1_200_000], GWk=[0, 0], GMS=[0, 0], Status=[1, 1])
     path = tmp_path / "nofix.bin"
     path.write_bytes(encode_dataflash([gps]))
-    assert read_dataflash(path).utc_offset_s is None
+    with pytest.warns(DataQualityWarning, match="never had a 3-D fix"):
+        assert read_dataflash(path).utc_offset_s is None
 
 
 def test_sidd_gives_the_excitation_and_sids_the_maneuver(tmp_path: Path) -> None:
@@ -291,15 +297,16 @@ def test_motor_count_from_moving_channels_without_frame_information(tmp_path: Pa
 def test_read_log_dispatches_and_reports_progress(real_data: Path) -> None:
     path = real_data.joinpath(*SAMPLE)
     calls: list[tuple[int, int]] = []
-    log = read_log(path, progress=lambda done, total: calls.append((done, total)))
+    log = read_warned(read_log, path, progress=lambda done, total: calls.append((done, total)))
     assert log.autopilot == "ardupilot" and calls[-1] == (path.stat().st_size,) * 2
 
 
 def test_appended_logs_with_other_layouts_map_the_first_only(real_data: Path, tmp_path: Path) -> None:
     path = tmp_path / "both.bin"
     path.write_bytes(real_data.joinpath(*SAMPLE).read_bytes() + real_data.joinpath(*LOG171).read_bytes())
-    log = read_dataflash(path)
-    first = read_dataflash(real_data.joinpath(*SAMPLE))
+    with pytest.warns(DataQualityWarning, match="only the first log|is redefined|clock goes back|EKF wind estimate"):
+        log = read_dataflash(path)
+    first = read_warned(read_dataflash, real_data.joinpath(*SAMPLE))
     np.testing.assert_array_equal(log["phi"].values, first["phi"].values)
     assert any("only the first log" in w for w in log.warnings)
-    assert decode_messages(path.read_bytes()).get("ATT@1") is not None
+    assert read_warned(decode_messages, path.read_bytes()).get("ATT@1") is not None

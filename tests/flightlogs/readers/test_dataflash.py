@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from pymavlink.DFReader import DFReader_binary
 
-from flightlogs.errors import LogFormatError
+from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError
 from flightlogs.readers.dataflash import DataFlashMessages, decode_messages, message_dtype, read_messages
 from flightlogs.writers.dataflash import MessageBlock, encode_dataflash, standard_block, text_block
 
@@ -128,7 +128,8 @@ def test_garbage_between_messages_is_skipped_and_reported(real_data: Path) -> No
     path = real_data.joinpath(*SAMPLE)
     raw, clean = path.read_bytes(), read_messages(path)
     cut = int(clean["IMU"].offsets[900])
-    damaged = decode_messages(raw[:cut] + _garbage(777) + raw[cut:], path="damaged.bin")
+    with pytest.warns(LogCorruptionWarning, match="damaged.bin: skipped 777 bytes"):
+        damaged = decode_messages(raw[:cut] + _garbage(777) + raw[cut:], path="damaged.bin")
     assert damaged.bytes_skipped == 777
     assert damaged.warnings == (f"damaged.bin: skipped 777 bytes at offset {cut}.",)
     assert_tables_equal(damaged, clean)  # everything before and after intact
@@ -140,7 +141,11 @@ def test_garbage_inside_a_message_loses_only_that_message_like_dfreader(real_dat
     cut = int(clean["ATT"].offsets[300]) + 10  # 10 bytes into an ATT message
     damaged_path = tmp_path / "damaged.bin"
     damaged_path.write_bytes(raw[:cut] + _garbage(500) + raw[cut:])
-    damaged = read_messages(damaged_path)
+    with (
+        pytest.warns(DataQualityWarning, match="ATT: the log clock goes back"),  # the garbled ATT's time
+        pytest.warns(LogCorruptionWarning, match="skipped 500 bytes"),
+    ):
+        damaged = read_messages(damaged_path)
     assert damaged.bytes_skipped == 500 and "skipped 500 bytes" in damaged.warnings[0]
     # the cut ATT is read from its own first bytes plus garbage (no check sum), as DFReader does
     assert len(damaged["ATT"]) == len(clean["ATT"])
@@ -155,7 +160,8 @@ def test_truncated_final_message_is_dropped_with_a_warning(real_data: Path) -> N
     path = real_data.joinpath(*SAMPLE)
     raw, clean = path.read_bytes(), read_messages(path)
     last = int(max(t.offsets[-1] for t in clean.tables.values()))
-    damaged = decode_messages(raw[:-5], path="cut.bin")
+    with pytest.warns(LogCorruptionWarning, match="cut.bin: truncated final message"):
+        damaged = decode_messages(raw[:-5], path="cut.bin")
     assert damaged.bytes_skipped == len(raw) - 5 - last
     assert damaged.warnings[0].startswith(
         f"cut.bin: truncated final message (type {raw[last + 2]}) at byte offset {last}"
@@ -166,7 +172,8 @@ def test_truncated_final_message_is_dropped_with_a_warning(real_data: Path) -> N
 def test_appended_logs_are_all_kept_and_the_clock_reset_reported(real_data: Path) -> None:
     raw = real_data.joinpath(*SAMPLE).read_bytes()
     clean = read_messages(real_data.joinpath(*SAMPLE))
-    twice = decode_messages(raw + raw, path="twice.bin")  # FMT block repeated, same layouts
+    with pytest.warns(DataQualityWarning, match="IMU: the log clock goes back 1 time"):
+        twice = decode_messages(raw + raw, path="twice.bin")  # FMT block repeated, same layouts
     assert dict(twice.counts) == {k: 2 * v for k, v in clean.counts.items()}
     np.testing.assert_array_equal(twice["ATT"]["Roll"], np.tile(clean["ATT"]["Roll"], 2))
     assert len(twice.warnings) == 1 and "clock goes back 1 time(s)" in twice.warnings[0]
@@ -175,7 +182,8 @@ def test_appended_logs_are_all_kept_and_the_clock_reset_reported(real_data: Path
 
 def test_appended_logs_with_other_layouts_are_kept_apart(real_data: Path) -> None:
     first, second = read_messages(real_data.joinpath(*SAMPLE)), read_messages(real_data.joinpath(*LOG171))
-    both = decode_messages(real_data.joinpath(*SAMPLE).read_bytes() + real_data.joinpath(*LOG171).read_bytes())
+    with pytest.warns(DataQualityWarning, match="is redefined with format|the log clock goes back"):
+        both = decode_messages(real_data.joinpath(*SAMPLE).read_bytes() + real_data.joinpath(*LOG171).read_bytes())
     for name, table in second.tables.items():
         key = name if name not in first.tables or first[name].format.format == table.format.format else f"{name}@1"
         tail = both[key].select(slice(len(both[key]) - len(table), None))
@@ -202,7 +210,8 @@ def test_fmt_length_disagreeing_with_format_skips_that_type() -> None:
     data = bytearray(encode_dataflash([att, rate]))
     fmt = decode_messages(bytes(data))["FMT"]
     data[int(fmt.offsets[list(fmt["Name"]).index("RATE")]) + 4] += 2  # the Length byte
-    ours = decode_messages(bytes(data), path="odd.bin")
+    with pytest.warns(LogCorruptionWarning, match="odd.bin: (40 messages of type.s. 130 have a FMT length|skipped)"):
+        ours = decode_messages(bytes(data), path="odd.bin")
     assert "RATE" not in ours.counts
     assert (
         ours.warnings[0]

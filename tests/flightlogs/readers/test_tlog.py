@@ -17,8 +17,10 @@ import numpy as np
 import pytest
 from pymavlink.dialects.v20 import all as mavlink2
 
-from flightlogs.errors import LogFormatError
+from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError
 from flightlogs.readers.tlog import read_tlog
+
+from builders import read_warned
 
 G0 = 9.80665
 PHOENIX = Path("phoenix") / "2018-09-17 16-44-06.tlog"
@@ -34,7 +36,7 @@ def phoenix(real_data) -> Path:
 
 @pytest.fixture(scope="module")
 def phoenix_log(phoenix):
-    return read_tlog(phoenix)
+    return read_warned(read_tlog, phoenix)
 
 
 @pytest.fixture(scope="module")
@@ -145,7 +147,8 @@ def test_gps_raw_int_gives_the_position_without_global_position(tmp_path):
                 ),
             ),
         ]
-    log = read_tlog(_tlog(tmp_path / "raw.tlog", items))
+    with pytest.warns(DataQualityWarning, match="GPS_RAW_INT.lat, lon: dropped 1 of 4 samples without a 3-D fix"):
+        log = read_tlog(_tlog(tmp_path / "raw.tlog", items))
     np.testing.assert_array_equal(log["latitude"].values, np.deg2rad((350_000_000 + np.arange(1, 4)) * 1e-7))
     np.testing.assert_allclose(log["longitude"].time_s, [6.0, 7.0, 8.0], atol=1e-6)  # via the receive clock
     assert log["longitude"].source == "GPS_RAW_INT.lon (1e-7 deg→rad; time from the receive clock)"
@@ -173,7 +176,7 @@ def test_real_tlog_utc_offset_and_parameters(phoenix_log, direct):
 def test_real_tlog_reads_fast_and_reports_progress(phoenix):
     calls: list[tuple[int, int]] = []
     start = time.perf_counter()
-    read_tlog(phoenix, progress=lambda done, total: calls.append((done, total)))
+    read_warned(read_tlog, phoenix, progress=lambda done, total: calls.append((done, total)))
     assert time.perf_counter() - start < 3.0
     size = phoenix.stat().st_size
     assert calls[-1] == (size, size) and len(calls) > 5
@@ -185,7 +188,11 @@ def test_real_tlog_with_garbage_inside_is_read_with_a_warning(phoenix, tmp_path)
     rng = np.random.default_rng(7)
     damaged = tmp_path / "damaged.tlog"
     damaged.write_bytes(data[:500_000] + rng.integers(0, 256, 2000, dtype=np.uint8).tobytes() + data[502_000:])
-    log = read_tlog(damaged)
+    with (
+        pytest.warns(DataQualityWarning),  # the flight's own: a reboot, no battery monitor ...
+        pytest.warns(LogCorruptionWarning, match="damaged.tlog: skipped"),
+    ):
+        log = read_tlog(damaged)
     skipped = [w for w in log.warnings if "skipped" in w]
     assert len(skipped) == 1 and "damaged.tlog" in skipped[0]
     n_skipped = int(skipped[0].split("skipped ")[1].split(" of")[0])
@@ -245,7 +252,8 @@ def test_px4_hexa_with_highres_imu_rangefinder_battery_and_system_time(tmp_path)
             (rx, VEHICLE, mavlink2.MAVLink_system_time_message(int((unix0 + boot_ms / 1000) * 1e6), boot_ms)),
             (rx, COMPANION, _attitude(boot_ms + 77, value=9.0)),  # not the vehicle's
         ]
-    log = read_tlog(_tlog(tmp_path / "px4.tlog", items))
+    with pytest.warns(DataQualityWarning, match="outside the sensor's range|reading 0 or 65535"):
+        log = read_tlog(_tlog(tmp_path / "px4.tlog", items))
     assert log.autopilot == "px4" and "hexarotor (MAV_TYPE 13)" in log.vehicle
     np.testing.assert_allclose(log["phi"].values, 0.1, rtol=1e-6)
     np.testing.assert_allclose(log["p"].time_s, 10 + np.arange(5))
@@ -320,7 +328,8 @@ def test_servo_clock_wrap_and_reboot_are_unwrapped(tmp_path):
         ]
     for k, boot in enumerate([3.0, 4.0]):  # reboot: the boot clock restarts
         items += [(110.0 + k, VEHICLE, _attitude(int(boot * 1000)))]
-    log = read_tlog(_tlog(tmp_path / "wrap.tlog", items))
+    with pytest.warns(DataQualityWarning, match="rebooted 1 time"):
+        log = read_tlog(_tlog(tmp_path / "wrap.tlog", items))
     np.testing.assert_allclose(log["motor_1"].time_s, boots, atol=1e-6)
     assert log["motor_1"].time_s[2] > period_s
     # after the reboot, times continue on the first session's clock via the receive time
@@ -340,7 +349,8 @@ def test_battery_without_monitor_and_unknown_frame_are_reported(tmp_path):
             ),
             (1.0 + k, VEHICLE, mavlink2.MAVLink_sys_status_message(0, 0, 0, 500, 65535, -1, -1, 0, 0, 0, 0, 0, 0)),
         ]
-    log = read_tlog(_tlog(tmp_path / "plane.tlog", items))
+    with pytest.warns(DataQualityWarning, match="no battery monitor|not a known multirotor"):
+        log = read_tlog(_tlog(tmp_path / "plane.tlog", items))
     assert "battery_v" not in log.signals and "motor_1..n" in log.missing
     assert any("no battery monitor" in w for w in log.warnings)
     assert any("not a known multirotor" in w for w in log.warnings)
@@ -376,7 +386,8 @@ def test_truncated_file_keeps_the_complete_messages(tmp_path):
     whole = _tlog(tmp_path / "whole.tlog", _attitude_items()).read_bytes()
     cut = tmp_path / "cut.tlog"
     cut.write_bytes(whole[:-15])
-    log = read_tlog(cut)
+    with pytest.warns(LogCorruptionWarning, match="cut.tlog: skipped 33 of"):
+        log = read_tlog(cut)
     assert log["p"].samples == 3
     kept = 48 - 15  # the last record (8-byte stamp + 40-byte ATTITUDE) lost 15 bytes
     assert any(f"skipped {kept} of {len(whole) - 15} bytes" in w and "cut.tlog" in w for w in log.warnings)

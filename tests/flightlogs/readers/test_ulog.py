@@ -11,6 +11,7 @@ import contextlib
 import io
 import re
 import struct
+import warnings
 from datetime import UTC, datetime
 from functools import cache
 from pathlib import Path
@@ -22,10 +23,13 @@ from hypothesis import strategies as st
 from pyulog import ULog
 from scipy.spatial.transform import Rotation
 
-from flightlogs.errors import LogFormatError, SysidError
+from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError, SysidError
 from flightlogs.flightlog import FlightLog
+from flightlogs.readers import read_log
 from flightlogs.readers.ulog import read_ulog
 from flightlogs.signals import LOGGED_SIGNALS
+
+from builders import read_warned
 
 QUAD = "px4-ulog-rs/quadrotor_local.ulg"
 OLD = "pyulog/sample.ulg"
@@ -35,15 +39,18 @@ DELTAS = {"delta_lat", "delta_lon", "delta_yaw", "delta_thr"}
 ATTITUDE = {"phi", "theta", "psi"}
 RATES_ACCEL = {"p", "q", "r", "ax", "ay", "az"}
 POSITION = {"latitude", "longitude"}
+# references (optional, never missing): vehicle_rates_setpoint, vehicle_attitude_setpoint, manual_control_setpoint
+REFERENCES = {"p_ref", "q_ref", "r_ref", "phi_ref", "theta_ref", "psi_ref"}
+STICKS = {"stick_lat", "stick_lon", "stick_yaw", "stick_thr"}
 
 # file -> (signals present, exactly; sources of some of them), from the data README
 REAL_ULOGS = {
     "kd0aij-impulse-response/log1.ulg": (
-        RATES_ACCEL,
+        RATES_ACCEL | REFERENCES,
         {"p": "sensor_gyro[0].x", "az": "sensor_accel[0].z"},
     ),
     QUAD: (
-        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | {"vd", "height_agl", "battery_v"},
+        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | REFERENCES | STICKS | {"vd", "height_agl", "battery_v"},
         {
             "p": "vehicle_angular_velocity[0].xyz[0]",
             "phi": "vehicle_attitude[0].q[0..3] (quaternion→Euler)",
@@ -55,7 +62,7 @@ REAL_ULOGS = {
         },
     ),
     GPS_LOG: (
-        set(LOGGED_SIGNALS) | MOTORS_4 | POSITION,
+        set(LOGGED_SIGNALS) | MOTORS_4 | POSITION | REFERENCES | STICKS,
         {
             "vn": "vehicle_local_position[0].vx",
             "delta_lat": "vehicle_torque_setpoint[0].xyz[0]",
@@ -69,7 +76,7 @@ REAL_ULOGS = {
         {"r": "vehicle_angular_velocity[0].xyz[2]", "battery_v": "battery_status[0].voltage_v"},
     ),
     OLD: (
-        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | {"vd", "height_agl"},
+        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | REFERENCES | {"vd", "height_agl"},
         {
             "p": "vehicle_attitude[0].rollspeed",
             "ax": "sensor_combined[0].accelerometer_m_s2[0]",
@@ -79,7 +86,7 @@ REAL_ULOGS = {
         },
     ),
     "pyulog/sample_appended_multiple.ulg": (
-        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | {"vd", "height_agl", "est_wind_n", "est_wind_e"},
+        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | REFERENCES | {"vd", "height_agl", "est_wind_n", "est_wind_e"},
         {
             "q": "vehicle_attitude[0].pitchspeed",
             "est_wind_n": "wind_estimate[0].windspeed_north",
@@ -92,7 +99,7 @@ REAL_ULOGS = {
 
 @cache
 def _read(path: Path) -> FlightLog:
-    return read_ulog(path)
+    return read_warned(read_ulog, path)
 
 
 @cache
@@ -256,11 +263,23 @@ def test_no_gps_time_gives_none(real_data: Path, relative: str) -> None:
 def test_corrupt_message_id_reads_with_warnings_and_prints_nothing(
     real_data: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    log = read_ulog(real_data / GPS_LOG)
+    with (
+        pytest.warns(DataQualityWarning, match=r"\((5|10) with (lat_lon|v_xy)_valid not set\)"),
+        pytest.warns(LogCorruptionWarning, match="message id 32812|unreadable bytes|pyulog: Warning") as raised,
+    ):
+        log = read_ulog(real_data / GPS_LOG)
     assert capsys.readouterr() == ("", "")
+    assert [str(w.message) for w in raised] == list(log.warnings)  # raised to the caller and kept, in order
     assert any("message id 32812" in w and "skipped 1" in w for w in log.warnings)
     assert any(re.search(r"skipped about \d+ unreadable bytes \(2 resynchronisation", w) for w in log.warnings)
     assert any(w.startswith("pyulog: Warning: no subscription found") for w in log.warnings)  # its print, captured
+
+
+def test_under_warnings_as_errors_a_corrupt_log_raises_its_first_warning(real_data: Path) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # as python -W error
+        with pytest.raises(LogCorruptionWarning, match="skipped 1 data message.* message id 32812"):
+            read_log(real_data / GPS_LOG)
 
 
 def test_wrong_size_message_and_zero_tail_are_reported(real_data: Path) -> None:
@@ -276,7 +295,12 @@ def test_truncated_copy_reads_the_intact_part(real_data: Path, tmp_path: Path) -
     data = (real_data / QUAD).read_bytes()
     cut = tmp_path / "cut.ulg"
     cut.write_bytes(data[: len(data) * 6 // 10])
-    log = read_ulog(cut)
+    with (
+        pytest.warns(DataQualityWarning, match="v_xy_valid not set"),
+        pytest.warns(LogCorruptionWarning, match="cut.ulg: the file is truncated") as raised,
+    ):
+        log = read_ulog(cut)
+    assert [str(w.message) for w in raised] == list(log.warnings)
     assert any(
         re.fullmatch(
             rf"cut\.ulg: the file is truncated: it ends inside a message at byte \d+ of "
@@ -361,7 +385,7 @@ def test_any_damage_reads_or_raises_log_format_error(
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         try:
-            log = read_ulog(path)
+            log = read_warned(read_ulog, path)  # whatever damage it reads past is warned about and kept
         except LogFormatError as err:
             assert str(err).startswith(f"{path}: ")
         else:
@@ -371,7 +395,7 @@ def test_any_damage_reads_or_raises_log_format_error(
 
 def test_progress_runs_from_zero_to_the_file_size(real_data: Path) -> None:
     calls: list[tuple[int, int]] = []
-    read_ulog(real_data / OLD, progress=lambda done, total: calls.append((done, total)))
+    read_warned(read_ulog, real_data / OLD, progress=lambda done, total: calls.append((done, total)))
     size = (real_data / OLD).stat().st_size
     assert calls[0] == (0, size) and calls[-1] == (size, size) and len(calls) > 3
     assert all(b[0] >= a[0] and b[1] == size for a, b in zip(calls, calls[1:]))
@@ -477,7 +501,9 @@ def test_synthetic_log_exercises_the_rest_of_the_table(tmp_path: Path) -> None:
         ("sensor_gps", 0): {"timestamp": STAMPS, "time_utc_usec": gps_utc},
         ("actuator_motors", 0): {"timestamp": STAMPS, **motors},
     }
-    log = read_ulog(_synthetic(tmp_path / "synthetic.ulg", topics, {"MAV_TYPE": 13}))
+    with pytest.warns(DataQualityWarning, match=r"dropped \d+ of \d+ samples|\[0\] is empty or invalid") as raised:
+        log = read_ulog(_synthetic(tmp_path / "synthetic.ulg", topics, {"MAV_TYPE": 13}))
+    assert [str(w.message) for w in raised] == list(log.warnings)
     assert log["p"].samples == N - 2
     assert "vehicle_angular_velocity[0].xyz[0]: dropped 1 of 200 samples (1 with timestamp 0)" in log.warnings
     assert any(w.startswith("vehicle_angular_velocity[0].xyz[0]: dropped 1 of 199 samples") for w in log.warnings)
@@ -507,7 +533,9 @@ def test_motor_count_from_actuator_outputs(
 ) -> None:
     outputs = {f"output[{i}]": _f(1500 + i) for i in range(16)}
     topics = {("actuator_outputs", 0): {"timestamp": STAMPS, "noutputs": np.full(N, noutputs, np.uint32), **outputs}}
-    log = read_ulog(_synthetic(tmp_path / "outputs.ulg", topics, parameters))
+    unknown = pytest.warns(DataQualityWarning, match="cannot tell which outputs drive motors")
+    with unknown if not motors else contextlib.nullcontext():
+        log = read_ulog(_synthetic(tmp_path / "outputs.ulg", topics, parameters))
     assert {n for n in log.signals if n.startswith("motor_")} == {f"motor_{i}" for i in range(1, motors + 1)}
     if motors:
         assert log[f"motor_{motors}"].source == f"actuator_outputs[0].output[{motors - 1}]"
@@ -548,7 +576,8 @@ def test_receiver_position_keeps_3d_fixes_in_either_layout(tmp_path: Path, topic
     }
     new = {"timestamp": STAMPS, "latitude_deg": lat_deg, "longitude_deg": lon_deg, "fix_type": fix}
     for layout, fields in (("old", old), ("new", new)):
-        log = read_ulog(_synthetic(tmp_path / f"{layout}.ulg", {(topic, 0): fields}, {}))
+        with pytest.warns(DataQualityWarning, match=r"dropped 30 of 200 samples \(30 with fix_type < 3\)"):
+            log = read_ulog(_synthetic(tmp_path / f"{layout}.ulg", {(topic, 0): fields}, {}))
         np.testing.assert_array_equal(log["latitude"].time_s, _seconds(STAMPS[30:]))
         if layout == "old":
             assert log["latitude"].source == f"{topic}[0].lat (1e-7 deg→rad)"

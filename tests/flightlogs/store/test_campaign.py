@@ -26,6 +26,7 @@ def test_no_conditioned_flight_names_each_logs_reason() -> None:
         campaign.require_flights()
 
 
+@pytest.mark.filterwarnings("ignore::flightlogs.errors.DataQualityWarning")  # the logs' own (no wind, invalid vn ve)
 def test_real_logs_are_kept_in_order(real_data: Path) -> None:
     logs = [real_data / "pyulog" / "sample_appended_multiple.ulg", real_data / "dronekit-la-testdata" / "log171.bin"]
     campaign = ingest_campaign(logs)

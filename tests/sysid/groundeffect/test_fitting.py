@@ -10,13 +10,14 @@ at the truth, computed here from the formulas, not from the code under test.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
-from flightlogs.errors import DataError, FitError, ModelError
+from flightlogs.errors import DataError, FitError, FitWarning, ModelError
 from simulator.world.environment import thrust_ratio
 from sysid.groundeffect import (
     FitConfig,
@@ -202,11 +203,33 @@ def test_too_few_points_and_an_unreachable_breakpoint_are_reported() -> None:
             ThrustRatioData(height_ratio=np.array([1.5, 3.0]), thrust_ratio=np.array([1.1, 1.0]), rotor_radius_m=R)
         )
     x = np.linspace(1.2, 3.0, 12)  # all inside ground effect: no plateau, the breakpoint is extrapolated
-    fit = fit_model("piecewise_linear", x, laws.piecewise_linear(x, -0.04, 1.18, 4.5))
+    with pytest.warns(FitWarning, match="breakpoint 4.5 lies past the largest Z/R 3: extrapolated"):
+        fit = fit_model("piecewise_linear", x, laws.piecewise_linear(x, -0.04, 1.18, 4.5))
     np.testing.assert_allclose(fit.values, [-0.04, 1.18, 4.5], rtol=1e-6)
     assert fit.notes and "extrapolated" in fit.notes[0]
-    fit = fit_model("piecewise_linear", x, laws.piecewise_linear(x, -0.04, 1.2, 1.25))  # one point below it
+    with pytest.warns(FitWarning, match="not identified by the data"):
+        fit = fit_model("piecewise_linear", x, laws.piecewise_linear(x, -0.04, 1.2, 1.25))  # one point below it
     assert fit.notes and "not identified" in fit.notes[0]
+
+
+def test_only_the_chosen_familys_notes_are_raised_and_named() -> None:
+    x = np.linspace(1.2, 3.0, 15)  # no plateau in the data: piecewise_linear extrapolates its breakpoint
+    wiggle = 0.002 * np.sin(7 * x)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nothing raised: the corrected law is chosen, without a note
+        fit = fit_ground_effect(
+            ThrustRatioData(height_ratio=x, thrust_ratio=laws.corrected(x, 3.3) + wiggle, rotor_radius_m=R)
+        )
+    assert fit.best == "corrected" and not fit.model("corrected").notes
+    assert "extrapolated" in fit.model("piecewise_linear").notes[0]  # kept in that family's fit
+    data = ThrustRatioData(
+        height_ratio=x, thrust_ratio=laws.piecewise_linear(x, -0.04, 1.18, 4.5) + wiggle, rotor_radius_m=R
+    )
+    with pytest.warns(
+        FitWarning, match=r"^piecewise_linear: breakpoint 4\.\d+ lies past the largest Z/R 3: extrapolated"
+    ):
+        fit = fit_ground_effect(data)
+    assert fit.best == "piecewise_linear" and "extrapolated" in fit.model("piecewise_linear").notes[0]
 
 
 # --------------------------------------------------------------------------- inputs and outputs
