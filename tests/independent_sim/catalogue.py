@@ -1,0 +1,352 @@
+"""The corpus: named cases, split into cases to tune a detector on and cases held out to test it.
+
+A maneuver detector (or any front end) may be tuned on :data:`TUNING_CASES`
+only; tests assert on :data:`HELDOUT_CASES`. The two lists share no case,
+and each covers PX4 and ArduPilot logs, calm and strong wind, sweeps of
+every design, doublets, 3-2-1-1s, multisines, piloted sweeps, a hover with
+no maneuver and a log with one axis never excited.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from independent_sim.maneuvers import (
+    Axis,
+    Chirp,
+    Design,
+    Doublet,
+    Injection,
+    Maneuver,
+    Multisine,
+    PilotedSweep,
+    ThreeTwoOneOne,
+)
+from independent_sim.scenario import Case, FlightPlan, LogFormat, Reposition
+from independent_sim.wind import WindModel
+
+__all__ = ["TUNING_CASES", "HELDOUT_CASES", "ALL_CASES", "case_named"]
+
+_Step = tuple[Axis, Design, float, Injection] | float  # a maneuver, or a pause (s)
+_FIRST_S = 10.0  # first maneuver, s after take-off (the climb takes 6 s)
+_TAIL_S = 12.0  # after the last maneuver: settle, descend (6 s), stand
+
+
+def _flight(
+    name: str,
+    fmt: LogFormat,
+    steps: Sequence[_Step],
+    *,
+    seed: int,
+    description: str,
+    heading_deg: float = 30.0,
+    wind: WindModel | None = None,
+    hover_s: float = 0.0,
+    repositions: tuple[Reposition, ...] = (),
+    **options: object,
+) -> Case:
+    """A case whose maneuvers follow each other; a bare number in `steps` is a pause (s)."""
+    maneuvers, at = [], _FIRST_S
+    for step in steps:
+        if isinstance(step, (int, float)):
+            at += float(step)
+            continue
+        axis, design, amplitude, injection = step
+        maneuvers.append(Maneuver(axis=axis, design=design, start_s=at, amplitude=amplitude, injection=injection))
+        at += design.duration_s
+    duration = max(at + _TAIL_S, hover_s)
+    return Case(
+        name=name,
+        fmt=fmt,
+        plan=FlightPlan(duration_s=duration, repositions=repositions, log_start_us=30_000_000 + 1_250_000 * seed),
+        maneuvers=tuple(maneuvers),
+        condition="strong" if wind is not None else "calm",
+        wind=wind,
+        heading_deg=heading_deg,
+        seed=seed,
+        description=description,
+        **options,  # type: ignore[arg-type]
+    )
+
+
+def _doublets(axes: Sequence[Axis], amplitude: float = 0.06, width_s: float = 1.0, pause_s: float = 6.0) -> list[_Step]:
+    """A doublet on each axis in turn (yaw at 8 %), each followed by a pause."""
+    out: list[_Step] = []
+    for axis in axes:
+        out += [(axis, Doublet(width_s=width_s), amplitude if axis != "yaw" else 0.08, "mixer"), pause_s]
+    return out
+
+
+_LOG = Chirp()  # 0.1-10 Hz, 34 s, fade-in 3 s: the dissertation's sweep
+_STRONG = WindModel(mean_speed_m_s=5.4, from_deg=250.0)
+
+TUNING_CASES: tuple[Case, ...] = (
+    _flight(
+        "tune-px4-lon-lat-sweeps",
+        "ulog",
+        [("lon", _LOG, 0.06, "mixer"), 8.0, ("lat", _LOG, 0.07, "mixer"), 8.0, *_doublets(["lon", "lat"])],
+        seed=101,
+        description="PX4: log sweeps lon then lat at the mixer, then doublets",
+    ),
+    _flight(
+        "tune-px4-yaw-thr-sweeps",
+        "ulog",
+        [
+            ("yaw", Chirp(duration_s=40.0, f_max_hz=5.0, law="linear"), 0.08, "mixer"),
+            8.0,
+            ("thr", Chirp(duration_s=30.0, f_max_hz=8.0), 0.05, "mixer"),
+            8.0,
+            *_doublets(["yaw", "thr"]),
+        ],
+        seed=102,
+        heading_deg=200.0,
+        description="PX4: linear yaw sweep and log thrust sweep, doublets",
+    ),
+    _flight(
+        "tune-ap-sweeps-down",
+        "dataflash",
+        [
+            ("lon", Chirp(duration_s=40.0, direction="down", fade_in_s=1.0, fade_out_s=3.0), 0.06, "mixer"),
+            6.0,
+            ("lat", Chirp(duration_s=30.0, f_min_hz=0.2, f_max_hz=8.0, law="linear"), 0.05, "mixer"),
+            6.0,
+            ("lat", ThreeTwoOneOne(unit_s=0.4), 0.06, "mixer"),
+            6.0,
+        ],
+        seed=103,
+        heading_deg=-75.0,
+        description="ArduPilot: falling log sweep lon, linear sweep lat, 3-2-1-1",
+    ),
+    _flight(
+        "tune-ap-piloted",
+        "dataflash",
+        [
+            ("lat", PilotedSweep(duration_s=45.0, f_min_hz=0.2, f_max_hz=3.0), 0.10, "attitude"),
+            8.0,
+            ("yaw", PilotedSweep(duration_s=40.0, f_min_hz=0.1, f_max_hz=2.0), 0.35, "rate"),
+            8.0,
+            ("thr", Multisine(duration_s=30.0, f_min_hz=0.2, f_max_hz=6.0), 0.05, "mixer"),
+        ],
+        seed=104,
+        description="ArduPilot: piloted sweeps lat (attitude) and yaw (rate), thrust multisine",
+    ),
+    _flight(
+        "tune-px4-hover",
+        "ulog",
+        [],
+        seed=105,
+        hover_s=90.0,
+        repositions=(Reposition(start_s=25.0, north_m=2.0, east_m=-1.0), Reposition(start_s=55.0, north_m=-2.0)),
+        description="PX4: take-off, hover with two repositions, landing; no maneuver",
+    ),
+    _flight(
+        "tune-ap-no-lon",
+        "dataflash",
+        [
+            ("lat", _LOG, 0.06, "mixer"),
+            6.0,
+            ("yaw", Chirp(duration_s=36.0, f_max_hz=6.0), 0.08, "mixer"),
+            6.0,
+            ("thr", Chirp(duration_s=30.0, f_max_hz=8.0, law="linear"), 0.05, "mixer"),
+        ],
+        seed=106,
+        heading_deg=120.0,
+        description="ArduPilot: lat, yaw and thr sweeps; lon never excited",
+    ),
+    _flight(
+        "tune-px4-wind",
+        "ulog",
+        [
+            ("lon", _LOG, 0.06, "mixer"),
+            8.0,
+            ("thr", Chirp(duration_s=30.0, f_max_hz=8.0), 0.05, "mixer"),
+            8.0,
+            *_doublets(["lon", "thr", "lon"]),
+        ],
+        seed=107,
+        wind=_STRONG,
+        description="PX4 in strong wind (5.4 m/s, Dryden): lon and thr sweeps, doublets; anemometer CSV",
+    ),
+)
+
+HELDOUT_CASES: tuple[Case, ...] = (
+    _flight(
+        "heldout-px4-sweeps",
+        "ulog",
+        [
+            ("lat", Chirp(duration_s=36.0), 0.06, "mixer"),
+            5.0,
+            ("lon", Chirp(duration_s=34.0, law="linear", f_min_hz=0.15, f_max_hz=8.0), 0.07, "mixer"),
+            5.0,
+            (
+                "yaw",
+                Chirp(duration_s=40.0, f_max_hz=5.0, direction="down", fade_in_s=1.0, fade_out_s=3.0),
+                0.08,
+                "mixer",
+            ),
+            5.0,
+            ("thr", Chirp(duration_s=30.0, f_max_hz=8.0), 0.05, "mixer"),
+            6.0,
+            *_doublets(["lat", "lon", "yaw", "thr"], width_s=0.8),
+        ],
+        seed=201,
+        heading_deg=75.0,
+        description="PX4: sweeps on all four axes back to back, then doublets",
+    ),
+    _flight(
+        "heldout-px4-piloted",
+        "ulog",
+        [
+            ("lon", PilotedSweep(duration_s=50.0, f_min_hz=0.15, f_max_hz=2.5, irregularity=0.3), 0.12, "attitude"),
+            8.0,
+            ("yaw", PilotedSweep(duration_s=40.0, f_min_hz=0.1, f_max_hz=2.0), 0.35, "rate"),
+            8.0,
+            ("lat", ThreeTwoOneOne(unit_s=0.35), 0.06, "mixer"),
+            6.0,
+            ("lon", ThreeTwoOneOne(unit_s=0.5), 0.06, "mixer"),
+            6.0,
+        ],
+        seed=202,
+        heading_deg=-140.0,
+        description="PX4: piloted sweeps lon (attitude stick) and yaw (rate stick), 3-2-1-1s",
+    ),
+    _flight(
+        "heldout-px4-multisine",
+        "ulog",
+        [
+            ("lat", Multisine(duration_s=30.0, f_min_hz=0.2, f_max_hz=8.0), 0.06, "mixer"),
+            6.0,
+            ("lon", Multisine(duration_s=40.0, f_min_hz=0.1, f_max_hz=6.0, period_s=20.0), 0.06, "mixer"),
+            6.0,
+            ("yaw", Chirp(duration_s=36.0, f_max_hz=6.0, direction="down"), 0.08, "mixer"),
+            6.0,
+            *_doublets(["lat", "lon"], width_s=1.2),
+        ],
+        seed=203,
+        heading_deg=10.0,
+        description="PX4: multisines lat and lon, falling yaw sweep, doublets",
+    ),
+    _flight(
+        "heldout-ap-sweeps",
+        "dataflash",
+        [
+            ("lon", _LOG, 0.06, "mixer"),
+            5.0,
+            ("lat", Chirp(duration_s=40.0, law="linear", f_max_hz=6.0), 0.08, "mixer"),
+            5.0,
+            ("yaw", Chirp(duration_s=34.0, f_max_hz=6.0), 0.08, "mixer"),
+            5.0,
+            (
+                "thr",
+                Chirp(duration_s=30.0, f_max_hz=8.0, direction="down", fade_in_s=1.0, fade_out_s=3.0),
+                0.05,
+                "mixer",
+            ),
+            6.0,
+            *_doublets(["lon", "lat", "yaw", "thr"]),
+        ],
+        seed=204,
+        heading_deg=300.0,
+        description="ArduPilot: sweeps on all four axes back to back, then doublets; no SIDD/SIDS",
+    ),
+    _flight(
+        "heldout-ap-doublets",
+        "dataflash",
+        [
+            *_doublets(["lat", "lon", "yaw", "thr"], width_s=1.0),
+            ("lat", ThreeTwoOneOne(), 0.06, "mixer"),
+            6.0,
+            ("lon", ThreeTwoOneOne(), 0.06, "mixer"),
+            6.0,
+            *_doublets(["lon", "lat"], amplitude=-0.07, width_s=0.7),
+            ("thr", Multisine(duration_s=30.0, f_min_hz=0.2, f_max_hz=5.0), 0.05, "mixer"),
+        ],
+        seed=205,
+        heading_deg=160.0,
+        description="ArduPilot: doublets (both signs) and 3-2-1-1s on every axis, thrust multisine",
+    ),
+    _flight(
+        "heldout-px4-no-lat",
+        "ulog",
+        [
+            ("lon", Chirp(duration_s=36.0), 0.06, "mixer"),
+            6.0,
+            ("yaw", Chirp(duration_s=36.0, f_max_hz=6.0), 0.08, "mixer"),
+            6.0,
+            ("thr", Chirp(duration_s=30.0, f_max_hz=8.0), 0.05, "mixer"),
+            6.0,
+            *_doublets(["lon", "yaw"]),
+        ],
+        seed=206,
+        heading_deg=-30.0,
+        px4_accel_topic="sensor_combined",
+        description="PX4 (accelerometer in sensor_combined only): lon, yaw, thr; lat never excited",
+    ),
+    _flight(
+        "heldout-ap-hover",
+        "dataflash",
+        [],
+        seed=207,
+        hover_s=75.0,
+        repositions=(Reposition(start_s=30.0, east_m=2.5, duration_s=6.0),),
+        description="ArduPilot: take-off, hover, one reposition, landing; no maneuver",
+    ),
+    _flight(
+        "heldout-ap-wind",
+        "dataflash",
+        [
+            ("lon", _LOG, 0.06, "mixer"),
+            8.0,
+            ("thr", Chirp(duration_s=30.0, f_max_hz=8.0), 0.05, "mixer"),
+            8.0,
+            *_doublets(["lon", "thr", "lon", "thr"]),
+        ],
+        seed=208,
+        wind=WindModel(mean_speed_m_s=5.4, from_deg=20.0),
+        description="ArduPilot in strong wind: lon and thr sweeps, doublets; anemometer CSV",
+    ),
+    _flight(
+        "heldout-px4-wind",
+        "ulog",
+        [
+            ("lon", Chirp(duration_s=36.0), 0.07, "mixer"),
+            8.0,
+            ("lat", _LOG, 0.06, "mixer"),
+            8.0,
+            *_doublets(["lon", "lat", "lon"]),
+        ],
+        seed=209,
+        wind=WindModel(mean_speed_m_s=5.4, from_deg=290.0, sigma_m_s=0.75),
+        description="PX4 in strong wind: lon and lat sweeps, doublets; anemometer CSV",
+    ),
+)
+
+ALL_CASES: tuple[Case, ...] = TUNING_CASES + HELDOUT_CASES
+
+
+def case_named(name: str) -> Case:
+    """The catalogue case called `name`.
+
+    Parameters
+    ----------
+    name : str
+        A name from :data:`TUNING_CASES` or :data:`HELDOUT_CASES`.
+
+    Returns
+    -------
+    Case
+
+    Raises
+    ------
+    KeyError
+        If no case has that name (the message lists them).
+
+    Examples
+    --------
+    >>> case_named("heldout-ap-hover").fmt
+    'dataflash'
+    """
+    for case in ALL_CASES:
+        if case.name == name:
+            return case
+    raise KeyError(f"no case {name!r}; cases are {', '.join(c.name for c in ALL_CASES)}")
