@@ -86,6 +86,7 @@ def simulate_flights(
 
     Examples
     --------
+    >>> from simulator.world.environment import Environment
     >>> flight = simulate_flights([Trial(duration_s=1.0, environment=Environment())])[0]
     >>> flight.signals["az"].size, round(float(np.mean(flight.truth["az"])), 2)
     (100, -9.81)
