@@ -18,6 +18,7 @@ The steps, in order (chapter 3 of the dissertation, section 3.3.3):
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -25,15 +26,18 @@ from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
+from scipy.ndimage import binary_erosion
 
 from flightlogs.conditioning.align import WindAlignment, estimate_residual_offset, wind_log_time
-from flightlogs.conditioning.lag import TransportDelay, bearing_and_distance, transport_delay
+from flightlogs.conditioning.lag import TransportDelay, transport_delay
 from flightlogs.conditioning.resample import contiguous_spans, resample_signals, uniform_time_base
-from flightlogs.errors import DataError
+from flightlogs.errors import DataError, DataQualityWarning, SysidWarning, collected_warnings
 from flightlogs.flightlog import FlightLog, Signal
 from flightlogs.frames import air_velocity_body, wind_to_body_axes
+from flightlogs.geo import bearing_and_distance, local_north_east
 from flightlogs.maneuvers.excitation_recovery import estimate_excitation
 from flightlogs.maneuvers.segments import Segment, detect_segments, segments_from_sid
+from flightlogs.masks import true_runs
 from flightlogs.record import Record
 
 __all__ = ["ConditioningOptions", "ConditionedFlight", "condition_flight", "CORE_SIGNALS"]
@@ -55,9 +59,15 @@ CORE_SIGNALS = (
     "delta_thr",
 )
 _MIXER = {"lat": "delta_lat", "lon": "delta_lon", "yaw": "delta_yaw", "thr": "delta_thr"}
+#: The traces that show each axis's maneuvers, for detection: the input, the references, the response.
+_SHOWN_BY = {
+    "lat": ("delta_lat", "stick_lat", "phi_ref", "p_ref", "p", "phi"),
+    "lon": ("delta_lon", "stick_lon", "theta_ref", "q_ref", "q", "theta"),
+    "yaw": ("delta_yaw", "stick_yaw", "r_ref", "r"),
+    "thr": ("delta_thr", "stick_thr", "az", "vd"),
+}
 #: Where the vehicle is: used for the anemometer geometry, not carried into the records.
 _POSITION = ("latitude", "longitude")
-_EARTH_RADIUS_M = 6_371_008.8
 _MAX_GPS_DISTANCE_M = 1000.0  # farther, the anemometer's position is more likely mistyped than meant
 _MIN_CORRELATION_S = 20.0  # shortest stretch a residual clock offset is estimated over
 
@@ -145,7 +155,8 @@ class ConditionedFlight:
     wind : WindAlignment or None
         How the anemometer was aligned, if one was given.
     warnings : tuple of str
-        Gaps, doubtful wind, dropped signals.
+        Gaps, doubtful wind, dropped signals (the messages of the warnings
+        raised while conditioning).
     """
 
     source: Path
@@ -181,22 +192,39 @@ def condition_flight(
     DataError
         If the log has none of the core signals, no stretch long enough, or
         the wind cannot be aligned.
+
+    Warns
+    -----
+    DataQualityWarning
+        For gaps that cut the records, signals left out of a record, wind
+        that cannot stand for the wind at the vehicle, a clock offset not
+        estimated, u v w without wind; every message is also in ``warnings``.
     """
     if options.estimate_transport_delay and wind is not None:
         return _with_estimated_delay(log, wind, options)
-    notes: list[str] = []
+    with collected_warnings() as caught:
+        first = _one_pass(log, wind, options)
+        if isinstance(first, ConditionedFlight):
+            return replace(first, warnings=caught.messages)
+        caught.discard()  # this pass only measured the clock offset: the passes with it corrected say what holds
+    return _with_estimated_offset(log, wind, options, first)
+
+
+def _one_pass(log: FlightLog, wind: Any | None, options: ConditioningOptions) -> ConditionedFlight | WindAlignment:
+    """One conditioning; or, when the clock offset is to be estimated, the alignment whose residual measures it."""
     core = {name: _unwrapped(log.signals[name]) for name in CORE_SIGNALS if name in log.signals}
     if not core:
         raise DataError(f"{log.path}: none of the core signals ({', '.join(CORE_SIGNALS)}) is in the log")
-    others = {n: s for n, s in log.signals.items() if n not in core and n not in _POSITION}
-    alignment, wind_signals = (None, {}) if wind is None else _wind_signals(log, wind, options, notes)
+    others = {n: _unwrapped(s) for n, s in log.signals.items() if n not in core and n not in _POSITION}
+    alignment, wind_signals = (None, {}) if wind is None else _wind_signals(log, wind, options)
     cut_by = core | wind_signals
     time_base = uniform_time_base(cut_by, rate_hz=options.rate_hz)
     rate_hz = 1.0 / float(np.median(np.diff(time_base)))
     spans = contiguous_spans(
         cut_by, time_base, max_gap_samples=options.max_gap_samples, min_duration_s=options.min_record_s
     )
-    notes.extend(spans.messages())
+    for message in spans.messages():
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     if not spans.spans:
         raise DataError(
             f"{log.path}: no stretch of at least {options.min_record_s:g} s where every core signal has data"
@@ -210,22 +238,21 @@ def condition_flight(
     if alignment is not None:
         alignment = _residual(alignment, time_base, values, rate_hz)
         if options.estimate_wind_offset and alignment.residual is not None:
-            return _with_estimated_offset(log, wind, options, alignment)
+            return alignment
         if options.estimate_wind_offset:
-            notes.append(
+            message = (
                 f"{log.path}: the clock offset was not estimated: that needs {_MIN_CORRELATION_S:g} s "
                 "where the wind and the autopilot's wind estimate or attitude are logged together; "
                 f"the offset used is {alignment.clock_offset_s:+.3f} s ({alignment.clock_offset_source})"
             )
-    _derived(values, units, wind_given=bool(wind_signals), notes=notes)
+            warnings.warn(DataQualityWarning(message), stacklevel=2)
+    _derived(values, units, wind_given=bool(wind_signals))
     segments = _segments(log, time_base, values, options)
     records = tuple(
-        _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}", notes)
+        _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}")
         for k, span in enumerate(spans.spans)
     )
-    return ConditionedFlight(
-        source=log.path, records=records, segments=segments, rate_hz=rate_hz, wind=alignment, warnings=tuple(notes)
-    )
+    return ConditionedFlight(source=log.path, records=records, segments=segments, rate_hz=rate_hz, wind=alignment)
 
 
 def _hold_edges(column: np.ndarray, time_base: np.ndarray, max_hold_s: float) -> np.ndarray:
@@ -247,15 +274,13 @@ def _hold_edges(column: np.ndarray, time_base: np.ndarray, max_hold_s: float) ->
 
 
 def _unwrapped(signal: Signal) -> Signal:
-    """Heading made continuous before it is interpolated (no jumps at ±π)."""
-    if signal.name != "psi":
+    """Heading and its setpoint made continuous before they are interpolated (no jumps at ±π)."""
+    if signal.name not in ("psi", "psi_ref"):
         return signal
     return replace(signal, values=np.unwrap(signal.values), source=f"{signal.source}, unwrapped")
 
 
-def _wind_signals(
-    log: FlightLog, wind: Any, options: ConditioningOptions, notes: list[str]
-) -> tuple[WindAlignment, dict[str, Signal]]:
+def _wind_signals(log: FlightLog, wind: Any, options: ConditioningOptions) -> tuple[WindAlignment, dict[str, Signal]]:
     if log.utc_offset_s is None and options.wind_offset_s is None:
         raise DataError(
             f"{log.path}: the log has no GPS time, so the anemometer cannot be aligned by UTC; "
@@ -270,12 +295,13 @@ def _wind_signals(
     if during.sum() < 2:
         raise DataError(f"{wind.path}: the anemometer record does not overlap {log.path.name} in time")
     wind_ne = np.column_stack([wind.wind_n, wind.wind_e])
-    delay = _transport_delay(log, wind_ne[during], raw_time[during], options, notes)
+    delay = _transport_delay(log, wind_ne[during], raw_time[during], options)
     if not delay.frozen_turbulence_holds:
-        notes.append(
+        message = (
             f"{wind.path}: sigma_M/M = {delay.turbulence_ratio:.2f} is not below 0.5, so Taylor's frozen "
             "turbulence does not hold: the anemometer wind is a poor stand-in for the wind at the vehicle"
         )
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     time_s = raw_time + delay.delay_s
     overlap = float(min(end, time_s[-1]) - max(start, time_s[0]))
     alignment = WindAlignment(
@@ -300,7 +326,7 @@ def _wind_signals(
 
 
 def _transport_delay(
-    log: FlightLog, wind_ne: np.ndarray, wind_time_s: np.ndarray, options: ConditioningOptions, notes: list[str]
+    log: FlightLog, wind_ne: np.ndarray, wind_time_s: np.ndarray, options: ConditioningOptions
 ) -> TransportDelay:
     """Distance / mean speed along the line, the line from the options or from GNSS positions."""
     if options.anemometer_position_rad is None or options.transport_delay_s is not None:
@@ -311,21 +337,21 @@ def _transport_delay(
             delay_s=options.transport_delay_s,
         )
     if options.wind_distance_m is not None:
-        notes.append(
+        message = (
             "the anemometer-to-vehicle distance was given (--wind-distance): the anemometer's position is not used"
         )
+        warnings.warn(SysidWarning(message), stacklevel=2)
         return transport_delay(wind_ne, distance_m=options.wind_distance_m, bearing_rad=options.wind_bearing_rad)
     if options.wind_bearing_rad is not None:
-        notes.append(
+        message = (
             "the bearing from the anemometer to the vehicle comes from their positions; --wind-bearing is not used"
         )
-    bearing, distance = _gps_geometry(log, options.anemometer_position_rad, wind_time_s, notes)
+        warnings.warn(SysidWarning(message), stacklevel=2)
+    bearing, distance = _gps_geometry(log, options.anemometer_position_rad, wind_time_s)
     return replace(transport_delay(wind_ne, distance_m=distance, bearing_rad=bearing), source="gps")
 
 
-def _gps_geometry(
-    log: FlightLog, anemometer_rad: tuple[float, float], wind_time_s: np.ndarray, notes: list[str]
-) -> tuple[float, float]:
+def _gps_geometry(log: FlightLog, anemometer_rad: tuple[float, float], wind_time_s: np.ndarray) -> tuple[float, float]:
     """Bearing (rad) and distance (m) from the anemometer to the vehicle's mean position while the wind overlaps."""
     if not set(_POSITION) <= log.signals.keys():
         raise DataError(
@@ -349,14 +375,14 @@ def _gps_geometry(
             f"{np.degrees(mean_lon):.6f}), too far for its wind to stand for the vehicle's; check the "
             "anemometer's position (latitude first, degrees) or give --wind-distance"
         )
-    north = (lat - mean_lat) * _EARTH_RADIUS_M
-    east = np.angle(np.exp(1j * (lon - mean_lon))) * _EARTH_RADIUS_M * np.cos(mean_lat)
+    north, east = local_north_east(lat, lon, mean_lat, mean_lon)
     spread = float(np.hypot(north, east).max())
     if spread > 0.5 * distance:
-        notes.append(
+        message = (
             f"{log.path.name}: the vehicle moved up to {spread:.1f} m from its mean position, which is "
             f"{distance:.1f} m from the anemometer: one transport delay is a rough stand-in for a varying one"
         )
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
     return bearing, distance
 
 
@@ -380,15 +406,9 @@ def _residual(
     return alignment
 
 
-def _true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
-    """Bounds [start, stop) of every run of True in `mask`, in order."""
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(np.int8), [0]])))
-    return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2])]
-
-
 def _longest_finite_run(mask: np.ndarray) -> tuple[int, int]:
     """Bounds [start, stop) of the longest run of True in `mask` ((0, 0) if none)."""
-    return max(_true_runs(mask), key=lambda run: run[1] - run[0], default=(0, 0))
+    return max(true_runs(mask), key=lambda run: run[1] - run[0], default=(0, 0))
 
 
 _MAX_OFFSET_ITERATIONS = 6
@@ -400,17 +420,20 @@ def _with_estimated_offset(
     """Condition again with the clock offset corrected by the residual found (vehicle lags by +lag).
 
     A large first residual is measured on a broad correlation peak, so the
-    correction is repeated until what is left is under a tenth of a sample.
+    correction is repeated until what is left is under a tenth of a sample;
+    only the last pass's warnings go on.
     """
     assert first.residual is not None
     corrected = first.clock_offset_s - first.residual.lag_s
-    for _ in range(_MAX_OFFSET_ITERATIONS):
-        again = condition_flight(log, wind, replace(options, wind_offset_s=corrected, estimate_wind_offset=False))
-        assert again.wind is not None
-        left = again.wind.residual
-        if left is None or abs(left.lag_s) < 0.1 / again.rate_hz:
-            break
-        corrected -= left.lag_s
+    with collected_warnings() as caught:
+        for _ in range(_MAX_OFFSET_ITERATIONS):
+            caught.discard()  # an earlier pass's: superseded by this one
+            again = condition_flight(log, wind, replace(options, wind_offset_s=corrected, estimate_wind_offset=False))
+            assert again.wind is not None
+            left = again.wind.residual
+            if left is None or abs(left.lag_s) < 0.1 / again.rate_hz:
+                break
+            corrected -= left.lag_s
     assert again.wind is not None
     alignment = replace(
         again.wind, clock_offset_source="estimated", residual=first.residual, residual_against=first.residual_against
@@ -420,7 +443,9 @@ def _with_estimated_offset(
 
 def _with_estimated_delay(log: FlightLog, wind: Any, options: ConditioningOptions) -> ConditionedFlight:
     """Condition without a delay, take the vehicle's lag behind the wind as the delay, condition again."""
-    first = condition_flight(log, wind, replace(options, transport_delay_s=0.0, estimate_transport_delay=False))
+    with collected_warnings() as caught:
+        first = condition_flight(log, wind, replace(options, transport_delay_s=0.0, estimate_transport_delay=False))
+        caught.discard()  # the pass without a delay only measures it: the pass with it says what holds
     assert first.wind is not None
     if first.wind.residual is None:
         raise DataError(
@@ -444,7 +469,7 @@ def _with_estimated_delay(log: FlightLog, wind: Any, options: ConditioningOption
     )
 
 
-def _derived(values: dict[str, np.ndarray], units: dict[str, str], *, wind_given: bool, notes: list[str]) -> None:
+def _derived(values: dict[str, np.ndarray], units: dict[str, str], *, wind_given: bool) -> None:
     """Add u v w (eq. 3.1) and, with wind, wind_lon wind_lat."""
     have = values.keys()
     wind_ne = np.column_stack([values["wind_n"], values["wind_e"]]) if wind_given else None
@@ -461,7 +486,8 @@ def _derived(values: dict[str, np.ndarray], units: dict[str, str], *, wind_given
             values[name] = uvw[:, k]
             units[name] = "m/s"
         if wind_ne is None:
-            notes.append("no wind given: u v w are ground-relative velocities in body axes")
+            message = "no wind given: u v w are ground-relative velocities in body axes"
+            warnings.warn(DataQualityWarning(message), stacklevel=2)
     if wind_ne is not None and "psi" in have:
         body = wind_to_body_axes(wind_ne, values["psi"])
         values["wind_lon"], values["wind_lat"] = body[:, 0], body[:, 1]
@@ -475,7 +501,8 @@ def _segments(
         return tuple(sorted(options.segments, key=lambda s: s.start_s))
     logged = segments_from_sid(log.system_id_runs) if log.system_id_runs else ()
     inputs = {axis: values[name] for axis, name in _MIXER.items() if name in values}
-    if not inputs:
+    shown = {axis: [name for name in names if name in values] for axis, names in _SHOWN_BY.items()}
+    if not inputs and not any(shown.values()):
         return tuple(logged)
     pieces = _between(time_base, logged)
     quiet = np.zeros(time_base.size, dtype=bool)
@@ -487,10 +514,72 @@ def _segments(
         detected = [
             segment
             for start, stop in pieces
-            for segment in detect_segments(time_base[start:stop], {a: x[start:stop] for a, x in excitation.items()})
+            for segment in detect_segments(
+                time_base[start:stop],
+                {a: x[start:stop] for a, x in excitation.items()},
+                responses=_finite_traces(values, shown, start, stop),
+            )
         ]
-    kept = [s for s in detected if not any(_overlaps(s, run) for run in logged)]
+    flying, vd = _flight_state(time_base, values)
+    kept = [
+        s
+        for s in detected
+        if not any(_overlaps(s, run) for run in logged) and (s.kind == "hover" or _flown(s, time_base, flying, vd))
+    ]
     return tuple(sorted([*logged, *kept], key=lambda s: s.start_s))
+
+
+_THRUST_ON = 0.3  # flying: thrust above this fraction of its 95th percentile
+_SETTLE_S = 2.0  # flying: this long after take-off and before landing are neither; the hover before a maneuver
+_LEVEL_M_S = 0.5  # level hover: |mean vertical speed| over the _SETTLE_S before a maneuver below this
+
+
+def _flight_state(time_base: np.ndarray, values: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Where the vehicle flies (thrust on, away from take-off and landing), and its vertical speed, m/s.
+
+    Thrust is the mixer's, else the motors' mean; without either, or
+    without a vertical speed, every sample passes that test. A log that
+    starts or ends in flight has no take-off or landing at its edges.
+    """
+    dt = float(np.median(np.diff(time_base))) if time_base.size > 1 else 1.0
+    width = max(1, int(round(_SETTLE_S / dt)))
+    flying = np.ones(time_base.size, dtype=bool)
+    thrust = values.get("delta_thr")
+    motors = [v for name, v in values.items() if name.startswith("motor_")]
+    if thrust is None and motors:
+        thrust = np.mean(motors, axis=0)
+    if thrust is not None and np.isfinite(thrust).any():
+        level_on = _THRUST_ON * float(np.nanpercentile(thrust, 95))
+        on = np.nan_to_num(thrust, nan=-np.inf) > level_on if level_on > 0 else np.zeros(time_base.size, dtype=bool)
+        flying = binary_erosion(on, iterations=width, border_value=1) if on.any() else on
+    vd = values.get("vd")
+    climb = vd if vd is not None and np.isfinite(vd).all() else np.zeros(time_base.size)
+    return flying, climb
+
+
+def _flown(segment: Segment, time_base: np.ndarray, flying: np.ndarray, vd: np.ndarray) -> bool:
+    """Whether `segment` is flown from a steady hover: flying throughout and just after, level just before.
+
+    A take-off, a landing flare or a mission's climb is not a maneuver,
+    however much its input looks like one. After a maneuver the loop may
+    still be recovering height, so only the hover it starts from must be level.
+    """
+    around = (time_base >= segment.start_s - _SETTLE_S) & (time_base <= segment.end_s + _SETTLE_S)
+    before = around & (time_base < segment.start_s)
+    level = not before.any() or abs(float(np.mean(vd[before]))) < _LEVEL_M_S
+    return bool(flying[around].all() and level)
+
+
+def _finite_traces(
+    values: dict[str, np.ndarray], shown: dict[str, list[str]], start: int, stop: int
+) -> dict[str, dict[str, np.ndarray]]:
+    """The traces of each axis on samples [start, stop) that are finite there."""
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for axis, names in shown.items():
+        finite = {name: values[name][start:stop] for name in names if np.isfinite(values[name][start:stop]).all()}
+        if finite:
+            out[axis] = finite
+    return out
 
 
 def _near(time_base: np.ndarray, segments: Sequence[Segment], margin_s: float) -> np.ndarray:
@@ -515,7 +604,7 @@ def _between(time_base: np.ndarray, logged: Sequence[Segment]) -> list[tuple[int
     for run in logged:
         free &= (time_base < run.start_s - 0.5) | (time_base > run.end_s + 0.5)
     rate = 1.0 / float(np.median(np.diff(time_base)))
-    return [(a, b) for a, b in _true_runs(free) if (b - a) / rate >= _MIN_DETECTION_S]
+    return [(a, b) for a, b in true_runs(free) if (b - a) / rate >= _MIN_DETECTION_S]
 
 
 def _overlaps(a: Segment, b: Segment) -> bool:
@@ -530,7 +619,6 @@ def _record(
     span: tuple[float, float],
     segments: Sequence[Segment],
     label: str,
-    notes: list[str],
 ) -> Record:
     inside = (time_base >= span[0] - 1e-9) & (time_base <= span[1] + 1e-9)
     columns = {}
@@ -539,7 +627,8 @@ def _record(
         if np.all(np.isfinite(piece)):
             columns[name] = piece
         else:
-            notes.append(f"{name}: not logged through {label} ({span[0]:.2f}-{span[1]:.2f} s); left out of it")
+            message = f"{name}: not logged through {label} ({span[0]:.2f}-{span[1]:.2f} s); left out of it"
+            warnings.warn(DataQualityWarning(message), stacklevel=2)
     table = pd.DataFrame(columns, index=pd.Index(time_base[inside], name="time_s"))
     quiet = np.zeros(table.shape[0], dtype=bool)
     t = table.index.to_numpy()

@@ -26,6 +26,7 @@ import numpy as np
 from flightlogs.errors import DataError
 from flightlogs.flightlog import SystemIdRun
 from flightlogs.maneuvers._detection import find_maneuvers, hover_spans
+from flightlogs.maneuvers._sweeps import find_sweeps
 
 __all__ = [
     "Axis",
@@ -147,6 +148,7 @@ def detect_segments(
     time_s: np.ndarray,
     inputs: Mapping[str, np.ndarray],
     *,
+    responses: Mapping[str, Mapping[str, np.ndarray]] | None = None,
     min_hover_s: float = 3.0,
     threshold: float = 4.0,
     trend_window_s: float = 10.0,
@@ -163,6 +165,14 @@ def detect_segments(
     inputs : Mapping[str, ndarray of shape (n_samples,)]
         Mixer input by axis (``"lat"``, ``"lon"``, ``"yaw"``, ``"thr"``; any
         subset), as logged, finite.
+    responses : Mapping of axis to Mapping of signal name to ndarray of shape (n_samples,), optional
+        For each axis, the traces that show its maneuvers: its mixer input
+        as logged, the references the autopilot logs (sticks, attitude and
+        rate setpoints) and the rates and angles that follow (canonical
+        names, finite). Given, sweeps and multisines are found by their
+        time-frequency signature in these traces together, and the
+        segment's `detail` names the traces that carried it; `inputs` then
+        serve the doublets and 3211s only.
     min_hover_s : float, optional
         Shortest stretch, quiet on every axis, reported as hover, s. Default 3.
     threshold : float, optional
@@ -214,9 +224,37 @@ def detect_segments(
     passes for a doublet).
     """
     t, dt = _uniform(time_s)
-    traces = _check_inputs(inputs, t.size)
-    maneuvers, busy = find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s)
-    segments = [
+    if not inputs and responses is None:
+        raise DataError("no mixer input given")
+    traces = _check_inputs(inputs, t.size) if inputs else {}
+    maneuvers, busy = (
+        find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s) if traces else ([], [])
+    )
+    segments: list[Segment] = []
+    if responses is not None:
+        sweeps = find_sweeps(t, dt, _check_responses(responses, t.size))
+        segments += [
+            Segment(
+                axis=cast(Axis, s.axis),
+                kind=s.kind,
+                start_s=t[s.first],
+                end_s=t[s.last],
+                source="detected",
+                f_min_hz=s.f_min_hz,
+                f_max_hz=s.f_max_hz,
+                detail=f"{s.direction} ridge in {', '.join(s.evidence)}",
+            )
+            for s in sweeps
+        ]
+        busy += [(s.first, s.last) for s in sweeps]
+        # sweeps come from their signature alone; steps (doublets, 3211s) and multisines of any phasing from
+        # the inputs, where no tone runs
+        maneuvers = [
+            m
+            for m in maneuvers
+            if m.kind != "sweep" and not any(m.first <= s.last and s.first <= m.last for s in sweeps)
+        ]
+    segments += [
         Segment(
             axis=cast(Axis, m.axis),  # the keys of `traces`, checked against AXES
             kind=m.kind,
@@ -396,9 +434,25 @@ def _uniform(time_s: np.ndarray) -> tuple[np.ndarray, float]:
     return t, dt
 
 
+def _check_responses(
+    responses: Mapping[str, Mapping[str, np.ndarray]], n: int
+) -> dict[str, dict[str, np.ndarray]]:
+    checked = {}
+    for axis, named in responses.items():
+        if axis not in AXES:
+            raise DataError(f"unknown axis {axis!r} (expected {', '.join(AXES)})")
+        traces = {}
+        for name, values in named.items():
+            x = np.asarray(values, dtype=np.float64)
+            if x.shape != (n,) or not np.isfinite(x).all():
+                raise DataError(f"{axis} trace {name!r} must be {n} finite samples, got shape {x.shape}")
+            traces[name] = x
+        if traces:
+            checked[axis] = traces
+    return checked
+
+
 def _check_inputs(inputs: Mapping[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
-    if not inputs:
-        raise DataError("no mixer input given")
     traces = {}
     for axis, values in inputs.items():
         x = np.asarray(values, dtype=np.float64)

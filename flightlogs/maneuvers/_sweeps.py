@@ -1,0 +1,310 @@
+"""Frequency sweeps found by their time-frequency signature, from an axis's input and responses together.
+
+In closed loop the feedback cancels most of a sweep's low-frequency part in
+the mixer input, while the rates and angles that follow it show it clearly;
+at high frequency it is the other way round. Each trace of an axis (its
+input, its reference, its rate and angle) is turned into constant-Q band
+envelopes normalised by their own noise floor (:mod:`._scalogram`), and the
+axis's score at each time and frequency is the best of its traces. A sweep
+is a stretch where that score stands far out of the noise along one ridge
+whose frequency rises or falls steadily (Spearman's ρ of log frequency
+against time) over at least a 3:1 range — neither the trim, nor a pilot's
+repositioning, nor a multisine (energy at many frequencies at once, no
+trend) has that. Edges are then found in the time domain, on each trace,
+where it leaves its local baseline (:func:`._detection._edges`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Literal
+
+import numpy as np
+from scipy.ndimage import median_filter
+from scipy.stats import spearmanr
+
+from flightlogs.maneuvers._detection import _activity, _bursts, _edges
+from flightlogs.maneuvers._scalogram import band_envelopes, band_frequencies
+from flightlogs.masks import true_runs
+
+__all__: list[str] = []
+
+_F_MIN_HZ, _F_MAX_HZ, _PER_OCTAVE, _CYCLES = 0.05, 15.0, 6, 4.0
+_FRAME_S = 0.1  # time step of the envelopes, s
+_FLOOR_QUANTILE = 0.2  # a band's noise floor: this quantile of its envelope over the quiet frames
+_SCORE = 6.0  # a frame is on the ridge when its best band (median over _SMOOTH_S) stands this many floors out
+_SMOOTH_S = 1.0  # running median of the ridge's score and log frequency, s
+_MAX_JUMP_OCTAVES = 0.5  # the ridge of one sweep moves less than this from one frame to the next
+_MERGE_S = 3.0  # pieces of ridge closer than this, continuing each other, are one
+_MIN_SWEEP_S = 15.0  # shortest sweep, s (a shorter sweeping piece counts only repeated: a multisine's period)
+_MIN_PERIOD_S = 4.0  # shortest sweeping piece, s
+_MIN_RHO = 0.8  # Spearman ρ of log ridge frequency against time, in magnitude
+_MIN_RATIO = 3.0  # ridge frequency range (90th over 10th percentile)
+_MIN_MEDIAN_SCORE = 10.0  # median score along a sweep's ridge
+_MAX_WIDTH_OCTAVES = 2.5  # a tone lights about 1.8 octaves of bands (cycles = 4); a multisine many more
+_YIELD = 3.0  # a frame where another axis scores this many times higher is that axis's
+_THRESHOLD, _TREND_S, _BURST_MERGE_S, _MIN_ACTIVE_S = 4.0, 10.0, 2.0, 0.3  # time-domain edges, as detect_segments
+_EDGE_WINDOW_S = 15.0  # edges are searched this far outside the ridge, s
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FoundSweep:
+    """A sweep found on one axis.
+
+    Parameters
+    ----------
+    axis : str
+        The axis that owns it.
+    kind : {"sweep", "multisine"}
+        One sweep, or a periodic (Schroeder-phased) multisine sweeping its band once a period.
+    first, last : int
+        Its first and last sample (inclusive).
+    f_min_hz, f_max_hz : float
+        Range of its ridge frequency, Hz.
+    direction : {"up", "down"}
+        Whether the frequency rises or falls.
+    evidence : tuple of str
+        The traces that carry it, strongest first.
+    score : float
+        Median ridge score over the sweep, in noise floors.
+    """
+
+    axis: str
+    kind: Literal["sweep", "multisine"]
+    first: int
+    last: int
+    f_min_hz: float
+    f_max_hz: float
+    direction: Literal["up", "down"]
+    evidence: tuple[str, ...]
+    score: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class _Ridge:
+    """One axis's ridge: best-band score and frequency per frame, and the best trace per frame."""
+
+    score: np.ndarray  # (n_frames,)
+    freq_hz: np.ndarray  # (n_frames,)
+    width_octaves: np.ndarray  # (n_frames,) span of the bands above a tenth of the ridge's score
+    trace: np.ndarray  # (n_frames,) index into the trace names
+    names: tuple[str, ...]
+
+
+def find_sweeps(t: np.ndarray, dt: float, traces: Mapping[str, Mapping[str, np.ndarray]]) -> list[FoundSweep]:
+    """Sweeps in the traces of each axis.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n_samples,)
+        Uniform sample times, s.
+    dt : float
+        Their interval, s.
+    traces : Mapping of axis to Mapping of name to ndarray, shape (n_samples,)
+        For each axis, its finite input, reference and response traces.
+
+    Returns
+    -------
+    list of FoundSweep
+        In time order; where sweeps on several axes overlap, only the one
+        that stands out most is kept (the others are the loop's reaction).
+    """
+    step = max(1, int(round(_FRAME_S / dt)))
+    freqs = band_frequencies(_F_MIN_HZ, min(_F_MAX_HZ, 0.4 / dt), _PER_OCTAVE)
+    ridges = _yield_to_stronger({axis: _ridge(named, dt, freqs, step) for axis, named in traces.items()})
+    found: list[FoundSweep] = []
+    for axis, named in traces.items():
+        ridge = ridges[axis]
+        for run in _runs(_pieces(ridge, step * dt), step * dt):
+            found += [
+                _found(axis, ridge, kind, chain, step, dt, named) for kind, chain in _tones(ridge, run, step * dt)
+            ]
+    return sorted(_owned(found), key=lambda s: s.first)
+
+
+def _ridge(named: Mapping[str, np.ndarray], dt: float, freqs: np.ndarray, step: int) -> _Ridge:
+    """The best band of the best trace per frame, its score and log frequency smoothed by a running median."""
+    scores = np.stack([_normalised(x, dt, freqs, step) for x in named.values()])  # (n_traces, n_frames, n_bands)
+    best_trace = np.argmax(scores, axis=0)
+    combined = np.take_along_axis(scores, best_trace[None], axis=0)[0]
+    band = np.argmax(combined, axis=1)
+    frames = np.arange(band.size)
+    width = max(1, int(round(_SMOOTH_S / (step * dt)))) | 1
+    loud = combined > np.maximum(_SCORE, 0.1 * combined[frames, band])[:, None]
+    return _Ridge(
+        score=median_filter(combined[frames, band], size=width, mode="nearest"),
+        width_octaves=median_filter(loud.sum(axis=1) / _PER_OCTAVE, size=width, mode="nearest"),
+        freq_hz=np.exp(median_filter(np.log(freqs[band]), size=width, mode="nearest")),
+        trace=best_trace[frames, band],
+        names=tuple(named),
+    )
+
+
+def _yield_to_stronger(ridges: dict[str, _Ridge]) -> dict[str, _Ridge]:
+    """Each axis's ridge without the frames where another axis stands out far more at a nearby frequency.
+
+    A sweep on one axis moves the others a little, at its own frequency,
+    through the loop and the airframe's coupling; those frames belong to the
+    sweep's axis. Activity at another frequency (a climb, a landing) does not
+    take a frame away.
+    """
+    out = {}
+    for axis, ridge in ridges.items():
+        weaker = np.zeros(ridge.score.size, dtype=bool)
+        for other, rival in ridges.items():
+            near = np.abs(np.log2(rival.freq_hz / ridge.freq_hz)) <= 1.0
+            weaker |= (other != axis) & near & (rival.score > _YIELD * ridge.score)
+        out[axis] = replace(ridge, score=np.where(weaker, 0.0, ridge.score))
+    return out
+
+
+def _pieces(ridge: _Ridge, frame_s: float) -> list[tuple[int, int]]:
+    """Half-open frame ranges where one continuous ridge stands out of the noise.
+
+    The ridge is cut where it jumps by more than half an octave between
+    frames (noise, or another motion taking over), and pieces that continue
+    each other across a short fade are joined.
+    """
+    octaves = np.log2(ridge.freq_hz)
+    pieces: list[tuple[int, int]] = []
+    for a, b in true_runs(ridge.score > _SCORE):
+        cuts = np.flatnonzero(np.abs(np.diff(octaves[a:b])) > _MAX_JUMP_OCTAVES) + a + 1
+        for lo, hi in zip([a, *cuts.tolist()], [*cuts.tolist(), b]):
+            if (
+                pieces
+                and lo - pieces[-1][1] < _MERGE_S / frame_s
+                and (abs(octaves[lo] - octaves[pieces[-1][1] - 1]) <= 2 * _MAX_JUMP_OCTAVES)
+            ):
+                pieces[-1] = (pieces[-1][0], hi)
+            else:
+                pieces.append((lo, hi))
+    return pieces
+
+
+def _normalised(x: np.ndarray, dt: float, freqs: np.ndarray, step: int) -> np.ndarray:
+    """Band envelopes over each band's noise floor, taken where no band stands out (two passes)."""
+    envelope = band_envelopes(x - np.median(x), dt, freqs, cycles=_CYCLES, step=step)
+    tiny = 1e-12 * max(1.0, float(envelope.max()))
+    floor = np.maximum(np.quantile(envelope, _FLOOR_QUANTILE, axis=0), tiny)
+    quiet = (envelope / floor).max(axis=1) < _SCORE
+    if quiet.sum() >= 0.1 * quiet.size:
+        floor = np.maximum(np.quantile(envelope[quiet], _FLOOR_QUANTILE, axis=0), tiny)
+    return np.asarray(envelope / floor)
+
+
+def _sweeping(ridge: _Ridge, a: int, b: int, frame_s: float) -> bool:
+    """Whether frames [a, b) hold one tone sweeping steadily through a 3:1 range or more."""
+    if (b - a) * frame_s < _MIN_PERIOD_S or np.median(ridge.score[a:b]) < _MIN_MEDIAN_SCORE:
+        return False
+    log_f = np.log(ridge.freq_hz[a:b])
+    lo_hz, hi_hz = np.exp(np.quantile(log_f, [0.1, 0.9]))
+    if hi_hz < _MIN_RATIO * lo_hz:
+        return False
+    return abs(float(spearmanr(np.arange(a, b), log_f).statistic)) >= _MIN_RHO
+
+
+def _runs(pieces: list[tuple[int, int]], frame_s: float) -> list[list[tuple[int, int]]]:
+    """Pieces of ridge grouped into runs of activity (gaps shorter than ``_MERGE_S``), jumps or not."""
+    runs: list[list[tuple[int, int]]] = []
+    for piece in pieces:
+        if runs and (piece[0] - runs[-1][-1][1]) * frame_s < _MERGE_S:
+            runs[-1].append(piece)
+        else:
+            runs.append([piece])
+    return runs
+
+
+def _tones(
+    ridge: _Ridge, run: list[tuple[int, int]], frame_s: float
+) -> list[tuple[Literal["sweep", "multisine"], list[tuple[int, int]]]]:
+    """The sweeps and multisines of one run of activity, each as the ridge pieces it spans.
+
+    The whole run sweeps (a piloted sweep's ridge jumps, but its trend
+    holds); or its pieces each sweep the same way, back to back, covering
+    most of it: a Schroeder-phased multisine sweeps its band once per period,
+    a saw-tooth; or some pieces sweep long enough on their own.
+    """
+    a, b = run[0][0], run[-1][1]
+    if (b - a) * frame_s >= _MIN_SWEEP_S and _sweeping(ridge, a, b, frame_s):
+        return [("sweep", run)]
+    swept = [p for p in run if _sweeping(ridge, *p, frame_s)]
+    if _periodic(ridge, swept, frame_s):
+        return [("multisine", swept)]
+    return [("sweep", [p]) for p in swept if (p[1] - p[0]) * frame_s >= _MIN_SWEEP_S]
+
+
+def _periodic(ridge: _Ridge, swept: list[tuple[int, int]], frame_s: float) -> bool:
+    """Whether sweeping pieces repeat one another: short, back to back, the same way over the same band."""
+    if len(swept) < 2 or any((hi - lo) * frame_s >= _MIN_SWEEP_S for lo, hi in swept):
+        return False
+    if len({_direction(ridge, *p) for p in swept}) > 1:
+        return False
+    bands = np.array([np.log(np.quantile(ridge.freq_hz[lo:hi], [0.1, 0.9])) for lo, hi in swept])
+    overlap = np.minimum(bands[:-1, 1], bands[1:, 1]) - np.maximum(bands[:-1, 0], bands[1:, 0])
+    narrower = np.minimum(np.diff(bands[:-1], axis=1), np.diff(bands[1:], axis=1))[:, 0]
+    gaps = np.array([b[0] - a[1] for a, b in zip(swept[:-1], swept[1:])]) * frame_s
+    return bool(np.all(overlap >= 0.5 * narrower) and np.all(gaps < _MERGE_S))
+
+
+def _direction(ridge: _Ridge, a: int, b: int) -> int:
+    """+1 where the ridge frequency rises over frames [a, b), -1 where it falls."""
+    return 1 if spearmanr(np.arange(a, b), np.log(ridge.freq_hz[a:b])).statistic > 0 else -1
+
+
+def _found(
+    axis: str,
+    ridge: _Ridge,
+    kind: Literal["sweep", "multisine"],
+    chain: list[tuple[int, int]],
+    step: int,
+    dt: float,
+    named: Mapping[str, np.ndarray],
+) -> FoundSweep:
+    a, b = chain[0][0], chain[-1][1]
+    frames = np.concatenate([np.arange(lo, hi) for lo, hi in chain])
+    rho = float(spearmanr(frames, np.log(ridge.freq_hz[frames])).statistic)
+    n = next(iter(named.values())).size
+    first, last = _time_edges(named, a * step, min((b - 1) * step, n - 1), dt)
+    counts = np.bincount(ridge.trace[frames], minlength=len(ridge.names))
+    return FoundSweep(
+        axis=axis,
+        kind=kind,
+        first=first,
+        last=last,
+        f_min_hz=float(ridge.freq_hz[frames].min()),
+        f_max_hz=float(ridge.freq_hz[frames].max()),
+        direction="up" if rho > 0 else "down",
+        evidence=tuple(ridge.names[k] for k in np.argsort(-counts) if counts[k] > 0),
+        score=float(np.median(ridge.score[frames])),
+    )
+
+
+def _time_edges(named: Mapping[str, np.ndarray], i0: int, i1: int, dt: float) -> tuple[int, int]:
+    """Earliest start and latest end, over the traces, of the activity overlapping samples [i0, i1]."""
+    n = next(iter(named.values())).size
+    window = (max(0, i0 - int(_EDGE_WINDOW_S / dt)), min(n - 1, i1 + int(_EDGE_WINDOW_S / dt)))
+    starts, ends = [], []
+    for name, x in named.items():
+        act = _activity(x, dt, _THRESHOLD, _TREND_S)
+        bursts = [
+            burst
+            for burst in _bursts(name, act, dt, _THRESHOLD, _BURST_MERGE_S, _MIN_ACTIVE_S)
+            if burst.last >= i0 and burst.first <= i1
+        ]
+        if bursts:
+            lo, hi = _edges(act, min(b.first for b in bursts), max(b.last for b in bursts), dt, window, _THRESHOLD)
+            starts.append(lo)
+            ends.append(hi)
+    if not starts:
+        return i0, i1
+    return min(starts), max(ends)
+
+
+def _owned(found: list[FoundSweep]) -> list[FoundSweep]:
+    """Of sweeps overlapping on several axes, the one with the highest score; the rest are reactions."""
+    kept: list[FoundSweep] = []
+    for sweep in sorted(found, key=lambda s: -s.score):
+        if not any(sweep.first <= k.last and k.first <= sweep.last for k in kept):
+            kept.append(sweep)
+    return kept
