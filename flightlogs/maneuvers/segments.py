@@ -25,8 +25,8 @@ import numpy as np
 
 from flightlogs.errors import DataError
 from flightlogs.flightlog import SystemIdRun
-from flightlogs.maneuvers._detection import find_maneuvers, hover_spans
-from flightlogs.maneuvers._sweeps import find_sweeps
+from flightlogs.maneuvers._detection import FoundManeuver, find_maneuvers, hover_spans
+from flightlogs.maneuvers._sweeps import FoundSweep, find_sweeps
 
 __all__ = [
     "Axis",
@@ -85,6 +85,8 @@ _SID_FIELDS = {
     "TFout": "fade_out_s",
 }
 _USER_KEYS = ("start_s", "end_s", "axis", "kind", "f_min_hz", "f_max_hz")
+_RING_S = 5.0  # the loop rings this long after a doublet or 3211
+_MIN_TONE_S = 15.0  # a sweep runs at least this long besides any step it overlaps
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -232,7 +234,8 @@ def detect_segments(
     )
     segments: list[Segment] = []
     if responses is not None:
-        sweeps = find_sweeps(t, dt, _check_responses(responses, t.size))
+        steps = [m for m in maneuvers if m.kind in ("doublet", "3211")]
+        sweeps = [s for s in find_sweeps(t, dt, _check_responses(responses, t.size)) if not _ringing(s, steps, dt)]
         segments += [
             Segment(
                 axis=cast(Axis, s.axis),
@@ -432,6 +435,20 @@ def _uniform(time_s: np.ndarray) -> tuple[np.ndarray, float]:
     if dt <= 0 or np.max(np.abs(steps - dt)) > 1e-3 * dt:
         raise DataError("time_s must be uniformly sampled; resample the inputs first")
     return t, dt
+
+
+def _ringing(sweep: FoundSweep, steps: Sequence[FoundManeuver], dt: float) -> bool:
+    """Whether a ridge "sweep" is only a doublet's or 3211's reaction: less than a sweep's length outside it.
+
+    A step excites every frequency at once and the closed loop rings down
+    after it, so its ridge may fall steadily for a while; the strict joint
+    fit that found the step is the better witness.
+    """
+    outside = sweep.last - sweep.first
+    for step in steps:
+        if step.axis == sweep.axis and step.first <= sweep.last and sweep.first <= step.last:
+            outside -= min(sweep.last, step.last + int(_RING_S / dt)) - max(sweep.first, step.first)
+    return outside * dt < _MIN_TONE_S
 
 
 def _check_responses(

@@ -1,0 +1,116 @@
+"""Maneuver detection on logs our simulator did not write (issue 14): the independent corpus and real logs.
+
+The detector's thresholds were set on the corpus's TUNING cases only; every
+assertion here is on its HELD-OUT cases (``tests/independent_sim``: closed
+loop, excitation 5-8 % of the mixer range injected after the rate loop and
+never logged, PX4 and ArduPilot), and on real logs recorded by others.
+
+Measured on the held-out calm cases (bounds minus truth, s):
+sweeps found 15/15 on the right axis, starts +0.1 to +1.3 s (the 3 s
+fade-in of a 0.1 Hz chirp stays under the noise for about a second), ends
+-0.6 to +1.0; doublets and 3211s 22/22 exact to a sample except the thrust
+doublets, whose starts come 2.2-2.5 s early; one Schroeder multisine
+(0.1-6 Hz, lon) read as a sweep starting 5.4 s late, and one extra thrust
+doublet (the loop's reaction to a lat 3211).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from independent_sim.fixtures import independent_corpus_fixture  # noqa: F401 (registers the fixture)
+
+from flightlogs.conditioning.condition import condition_flight
+from flightlogs.maneuvers import Segment
+from flightlogs.readers import read_log
+
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.filterwarnings("ignore:no wind given:flightlogs.errors.DataQualityWarning"),  # u v w unused here
+]
+
+CALM_HELDOUT = [
+    "heldout-px4-sweeps",
+    "heldout-px4-piloted",
+    "heldout-px4-multisine",
+    "heldout-px4-no-lat",
+    "heldout-ap-sweeps",
+    "heldout-ap-doublets",
+]
+BOUND_S = 0.5  # issue 14: "bounds within 0.5 s"
+
+
+def _found(segments: tuple[Segment, ...], axis: str, start_s: float, end_s: float) -> list[Segment]:
+    return [s for s in segments if s.axis == axis and s.start_s < end_s and start_s < s.end_s]
+
+
+@pytest.fixture(scope="module", name="detections")
+def detections_fixture(independent_corpus):  # type: ignore[no-untyped-def]
+    out = {}
+    for name in CALM_HELDOUT:
+        files = independent_corpus.files(name)
+        segments = tuple(s for s in condition_flight(read_log(files.log)).segments if s.kind != "hover")
+        out[name] = (files.truth, segments)
+    return out
+
+
+@pytest.mark.parametrize("name", CALM_HELDOUT)
+def test_every_held_out_maneuver_is_found_once_on_its_axis(name: str, detections) -> None:  # type: ignore[no-untyped-def]
+    truth, segments = detections[name]
+    for maneuver in truth.maneuvers:
+        assert len(_found(segments, maneuver.axis, maneuver.start_s, maneuver.end_s)) == 1, (maneuver, segments)
+
+
+@pytest.mark.parametrize("name", CALM_HELDOUT)
+def test_steps_have_exact_bounds_and_kinds(name: str, detections) -> None:  # type: ignore[no-untyped-def]
+    """Doublets and 3211s of the roll, pitch and yaw axes: the joint feedback fit gives both steps to a sample."""
+    truth, segments = detections[name]
+    steps = [m for m in truth.maneuvers if m.kind in ("doublet", "3211") and m.axis != "thr"]
+    for maneuver in steps:
+        (found,) = _found(segments, maneuver.axis, maneuver.start_s, maneuver.end_s)
+        assert found.kind == maneuver.kind, (maneuver, found)
+        assert abs(found.start_s - maneuver.start_s) <= BOUND_S and abs(found.end_s - maneuver.end_s) <= BOUND_S
+
+
+@pytest.mark.parametrize("name", CALM_HELDOUT)
+def test_sweeps_are_sweeps_and_name_the_traces_that_carried_them(name: str, detections) -> None:  # type: ignore[no-untyped-def]
+    truth, segments = detections[name]
+    for maneuver in (m for m in truth.maneuvers if m.kind == "sweep"):
+        (found,) = _found(segments, maneuver.axis, maneuver.start_s, maneuver.end_s)
+        assert found.kind == "sweep" and found.source == "detected"
+        assert "ridge in" in found.detail and found.f_max_hz is not None and found.f_max_hz > 3 * found.f_min_hz
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="open (issue 14): sweep starts are found +0.1 to +1.3 s late (the fade-in of a 0.1 Hz chirp is "
+    "under the noise for about a second), ends -0.6 to +1.0 s; thrust doublets start 2.2-2.5 s early",
+)
+@pytest.mark.parametrize("name", ["heldout-px4-sweeps", "heldout-ap-sweeps"])
+def test_every_bound_within_half_a_second(name: str, detections) -> None:  # type: ignore[no-untyped-def]
+    truth, segments = detections[name]
+    for maneuver in truth.maneuvers:
+        (found,) = _found(segments, maneuver.axis, maneuver.start_s, maneuver.end_s)
+        assert abs(found.start_s - maneuver.start_s) <= BOUND_S, (maneuver, found)
+        assert abs(found.end_s - maneuver.end_s) <= BOUND_S, (maneuver, found)
+
+
+def test_a_hover_with_repositions_has_no_maneuver(independent_corpus) -> None:  # type: ignore[no-untyped-def]
+    files = independent_corpus.files("heldout-ap-hover")
+    assert [s for s in condition_flight(read_log(files.log)).segments if s.kind != "hover"] == []
+
+
+@pytest.mark.parametrize(
+    "relative",
+    [
+        "dronekit-la-testdata/log171.bin",  # was a 242 s "yaw multisine"
+        "pyulog/sample.ulg",  # never armed; was a "multisine"
+        "px4-ulog-rs/quadrotor_local.ulg",  # its landing was a "thr doublet" that validate scored
+        "ardupilot-log-diagnosis/sample.bin",  # was lat and yaw "multisines"
+    ],
+)
+@pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning")  # dropouts and gaps of real logs, not tested here
+def test_real_logs_without_excitation_get_no_maneuver(relative: str, real_data: Path) -> None:
+    path = real_data / relative
+    assert [s for s in condition_flight(read_log(path)).segments if s.kind != "hover"] == []
