@@ -11,9 +11,9 @@ import pytest
 from scipy import signal as sps
 
 from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
-from flightlogs.conditioning.lag import destination_point
-from flightlogs.errors import DataError
+from flightlogs.errors import DataError, DataQualityWarning, SysidWarning
 from flightlogs.flightlog import Signal
+from flightlogs.geo import destination_point
 from flightlogs.readers.anemometer import read_anemometer_csv
 from flightlogs.readers.dispatch import read_log
 from simulator.campaign.demo_flight import write_demo_flight
@@ -107,6 +107,7 @@ def test_hover_is_found_between_maneuvers(demo: dict) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:no wind given:flightlogs.errors.DataQualityWarning")  # u v w are not used here
 def test_closed_loop_doublets_over_twelve_flights(tmp_path: Path) -> None:
     """Doublets the rate loop cancels in the mixer input, found from the excitation left once the
     fitted state feedback is removed, over 12 simulated flights (48 doublets).
@@ -170,7 +171,8 @@ def test_a_gap_splits_the_record_and_is_reported(demo: dict) -> None:
             "q": Signal(name="q", time_s=q.time_s[keep], values=q.values[keep], unit=q.unit, source=q.source),
         },
     )
-    flight = condition_flight(gapped)
+    with pytest.warns(DataQualityWarning, match=r"q: 1\.0\d s gap at 59\.99 s; record split|no wind given"):
+        flight = condition_flight(gapped)
     assert len(flight.records) == 2
     assert flight.records[0].end_s < 60.0 + ONE_SAMPLE_S and flight.records[1].start_s > 61.0 - ONE_SAMPLE_S
     assert any(w.startswith("q: 1.0") and "record split" in w for w in flight.warnings)
@@ -238,9 +240,10 @@ def test_a_vehicle_wandering_far_for_the_distance_is_noted(demo: dict) -> None:
     lat, lon = np.radians(demo["truth"]["vehicle_position_deg"])
     mean_n, mean_e = np.column_stack([demo["wind"].wind_n, demo["wind"].wind_e]).mean(axis=0)
     position = destination_point(lat, lon, np.arctan2(-mean_e, -mean_n), 1.0)
-    flight = condition_flight(
-        demo["log"], demo["wind"], ConditioningOptions(anemometer_position_rad=position, wind_offset_s=1.5)
-    )
+    with pytest.warns(DataQualityWarning, match="moved up to .* rough stand-in for a varying one"):
+        flight = condition_flight(
+            demo["log"], demo["wind"], ConditioningOptions(anemometer_position_rad=position, wind_offset_s=1.5)
+        )
     assert flight.wind is not None and flight.wind.transport.distance_m == pytest.approx(1.0, abs=0.05)
     assert any("moved up to" in w and "rough stand-in" in w for w in flight.warnings)
 
@@ -249,7 +252,8 @@ def test_a_given_distance_wins_over_the_anemometer_position(demo: dict) -> None:
     options = ConditioningOptions(
         anemometer_position_rad=_anemometer_rad(demo["truth"]), wind_distance_m=5.0, wind_offset_s=1.5
     )
-    flight = condition_flight(demo["log"], demo["wind"], options)
+    with pytest.warns(SysidWarning, match=r"distance was given \(--wind-distance\): the anemometer's position is not"):
+        flight = condition_flight(demo["log"], demo["wind"], options)
     assert flight.wind is not None and flight.wind.transport.source == "geometry"
     assert flight.wind.transport.distance_m == 5.0
     assert any("position is not used" in w for w in flight.warnings)
@@ -283,7 +287,10 @@ def test_a_clock_offset_that_cannot_be_estimated_is_reported(demo: dict) -> None
         return replace(signal, time_s=signal.time_s[keep], values=signal.values[keep])
 
     short = replace(log, signals={name: first_12_s(signal) for name, signal in log.signals.items()})
-    flight = condition_flight(short, demo["wind"], ConditioningOptions(wind_distance_m=4.6, estimate_wind_offset=True))
+    with pytest.warns(DataQualityWarning, match="the clock offset was not estimated: that needs 20 s"):
+        flight = condition_flight(
+            short, demo["wind"], ConditioningOptions(wind_distance_m=4.6, estimate_wind_offset=True)
+        )
     assert flight.wind is not None and flight.wind.clock_offset_source != "estimated"
     (note,) = [w for w in flight.warnings if "clock offset was not estimated" in w]
     assert "20 s" in note and f"{flight.wind.clock_offset_s:+.3f} s" in note

@@ -11,6 +11,7 @@ import pytest
 from click.testing import CliRunner
 
 from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
+from flightlogs.geo import local_north_east
 from flightlogs.readers.anemometer import read_anemometer_csv
 from flightlogs.readers.dispatch import read_log
 from simulator.campaign.fly import plan_trials, run_scenario
@@ -18,7 +19,6 @@ from simulator.campaign.scenario import load_builtin, read_scenario
 from sysid_cli.main import cli
 
 ONE_SAMPLE_S = 0.01 + 1e-9
-EARTH_RADIUS_M = 6_371_008.8  # mean radius, as the log writer's
 
 
 @pytest.fixture(scope="module")
@@ -100,6 +100,7 @@ def doublet_trials(tmp_path_factory: pytest.TempPathFactory) -> list:
 
 
 @pytest.mark.slow  # about 20 s, most of it simulating the 16 trials
+@pytest.mark.filterwarnings("ignore:no wind given:flightlogs.errors.DataQualityWarning")  # u v w are not used here
 def test_every_doublet_and_sweep_is_found_once_with_its_axis_and_bounds(doublet_trials: list) -> None:
     """Segmentation of the nonlinear campaign's logs against the plan's maneuver timing (truth JSON).
 
@@ -136,8 +137,7 @@ def test_the_logged_gps_is_the_path_flown(tmp_path: Path) -> None:
     utc_start = datetime(2024, 5, 1, tzinfo=UTC)
     log = read_log(write_ardupilot_log(flight, tmp_path / "gps.bin", utc_start=utc_start))
     lat0, lon0 = np.radians(VEHICLE_POSITION_DEG)
-    north = (log["latitude"].values - lat0) * EARTH_RADIUS_M
-    east = (log["longitude"].values - lon0) * EARTH_RADIUS_M * np.cos(lat0)
+    north, east = local_north_east(log["latitude"].values, log["longitude"].values, lat0, lon0)
     at = np.round((log["latitude"].time_s - log["latitude"].time_s[0]) * 100.0).astype(int)  # every 20th 100 Hz sample
     assert np.ptp(flight.truth["pn"]) > 0.05  # it does move in strong wind
     assert np.max(np.abs(north - flight.truth["pn"][at])) < 0.012
