@@ -10,7 +10,7 @@ import click
 
 from ._common import OutputPath, emit_json, json_option
 from ._flights import conditioned_flights
-from ._wind_options import wind_distance_option, wind_offset_option, wind_option
+from ._wind_options import segments_from, segments_option, wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["freqresp"]
 
@@ -21,6 +21,7 @@ Examples:
   sysid freqresp sweeps/*.bin --wind mast.csv --wind-distance 4.6 --pairs ax/delta_lon,ax/wind_lon -o fr.h5
   sysid freqresp flight.h5 --windows 2,4,8,12,17 --overlap 0.5 --min-coherence 0.6 --omega-min 1 --omega-max 60
   sysid freqresp px4_sweeps/*.ulg --reference none --no-whole-record -o fr.h5
+  sysid freqresp flight.ulg --segments maneuvers.csv --pairs q/delta_lon --json -
 """
 
 
@@ -63,6 +64,7 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
 @wind_option("Anemometer CSV or folder (with logs; aligned by UTC as in `sysid ingest`).")
 @wind_distance_option("Anemometer-to-vehicle distance, m (with --wind; see `sysid ingest` for the other choices).")
 @wind_offset_option("Anemometer clock minus UTC, s (with --wind).")
+@segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection (with logs).")
 @click.option(
     "--pairs",
     callback=_pairs,
@@ -153,6 +155,7 @@ def freqresp(
     wind_paths: tuple[Path, ...],
     wind_distance: float | None,
     wind_offset: float | None,
+    segments_file: Path | None,
     pairs: tuple[tuple[str, str], ...] | None,
     axis: str | None,
     kind: str,
@@ -198,8 +201,15 @@ def freqresp(
     flights = conditioned_flights(
         sources,
         wind_paths,
-        ConditioningOptions(wind_distance_m=wind_distance, wind_offset_s=wind_offset),
-        log_only={"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset},
+        ConditioningOptions(
+            wind_distance_m=wind_distance, wind_offset_s=wind_offset, segments=segments_from(segments_file)
+        ),
+        log_only={
+            "--wind": wind_paths,
+            "--wind-distance": wind_distance,
+            "--wind-offset": wind_offset,
+            "--segments": segments_file,
+        },
         quiet=quiet,
     )
     computed = flight_responses(

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from independent_sim.fixtures import independent_corpus_fixture  # noqa: F401 (registers the fixture)
 
 from simulator.autopilot.excitation import Maneuver
 from simulator.campaign.demo_flight import write_demo_flight
@@ -181,3 +182,24 @@ def test_usage_errors_are_exit_2(demo: dict[str, Path], args: list[str], fragmen
 def test_help_has_an_example() -> None:
     result = CliRunner().invoke(cli, ["freqresp", "--help"])
     assert result.exit_code == 0 and "sysid freqresp flight.h5 --pairs q/delta_lon" in result.output
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:no wind given:flightlogs.errors.DataQualityWarning")
+def test_segments_given_choose_the_maneuvers_of_a_log(independent_corpus, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """Issue 14: freqresp takes --segments as ingest does; only the sweep the file names is used, and the
+    same option with a dataset is a usage error (the dataset's segments were fixed at ingest)."""
+    files = independent_corpus.files("heldout-px4-no-lat")  # lon, yaw, thr sweeps; a log our simulator did not write
+    lon_only = tmp_path / "lon.csv"
+    lon_only.write_text("\n".join(files.segments_csv.read_text().splitlines()[:2]) + "\n")  # header + the lon sweep
+    runner = CliRunner()
+    result = runner.invoke(
+        cli, ["freqresp", str(files.log), "--segments", str(lon_only), "--json", "-", "-q"], catch_exceptions=False
+    )
+    assert result.exit_code == 0, result.output
+    pairs = {entry["pair"] for entry in json.loads(result.stdout)["responses"]}
+    assert "q/delta_lon" in pairs and not any(pair.endswith(("/delta_yaw", "/delta_thr")) for pair in pairs)
+    dataset = tmp_path / "x.h5"
+    assert runner.invoke(cli, ["ingest", str(files.log), "-o", str(dataset), "-q"]).exit_code == 0
+    refused = runner.invoke(cli, ["freqresp", str(dataset), "--segments", str(lon_only)])
+    assert refused.exit_code == 2 and "--segments" in refused.output
