@@ -5,15 +5,15 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import click
 
 from flightlogs.writers.jsonio import json_text, write_json
 
-__all__ = ["OutputPath", "json_option", "emit_json", "progress_bar"]
+__all__ = ["OutputPath", "json_option", "emit_json", "progress_bar", "staged_progress"]
 
 
 class OutputPath(click.Path):
@@ -84,18 +84,23 @@ def emit_json(summary: dict[str, Any], json_path: str | None) -> None:
 
 
 @contextmanager
-def progress_bar(label: str, *, quiet: bool = False) -> Iterator[Callable[[int, int], None]]:
+def progress_bar(
+    label: str, *, unit: Literal["bytes", "steps"] = "steps", quiet: bool = False
+) -> Iterator[Callable[[int, int], None]]:
     """Yield a ``progress(done, total)`` callback that drives a tqdm bar on stderr.
 
-    The bar appears only on a terminal and only once work has lasted about a second.
+    `unit` ``"bytes"`` counts bytes (scaled: kB, MB); ``"steps"`` counts
+    whole steps (trials, stages, files). The bar appears only on a terminal
+    and only once work has lasted about a second.
     """
     from tqdm import tqdm
 
+    bytes_ = unit == "bytes"
     bar = tqdm(
         desc=label,
         total=0,
-        unit="B",
-        unit_scale=True,
+        unit="B" if bytes_ else " steps",
+        unit_scale=bytes_,
         delay=1.0,
         leave=False,
         disable=True if quiet else None,
@@ -112,3 +117,23 @@ def progress_bar(label: str, *, quiet: bool = False) -> Iterator[Callable[[int, 
         yield update
     finally:
         bar.close()
+
+
+@contextmanager
+def staged_progress(label: str, *, quiet: bool = False) -> Iterator[Callable[[str, int, int], None]]:
+    """Yield ``progress(stage, done, total)``: ``reading …`` stages on a bar of bytes, the rest on a bar of steps.
+
+    Each bar runs once from 0 to its total; the steps bar names the stage.
+    """
+    with ExitStack() as stack:
+        bars: dict[str, Callable[[int, int], None]] = {}
+
+        def update(stage: str, done: int, total: int) -> None:
+            unit: Literal["bytes", "steps"] = "bytes" if stage.startswith("reading") else "steps"
+            if unit not in bars:
+                bars[unit] = stack.enter_context(
+                    progress_bar("reading" if unit == "bytes" else label, unit=unit, quiet=quiet)
+                )
+            bars[unit](done, total)
+
+        yield update

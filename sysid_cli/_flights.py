@@ -114,7 +114,7 @@ def conditioned_flights(
         return dataset_flights(sources)
     from flightlogs.store.campaign import ingest_campaign
 
-    with progress_bar("reading", quiet=quiet) as bar:
+    with progress_bar("reading", unit="bytes", quiet=quiet) as bar:
         campaign = ingest_campaign(
             list(sources), list(wind_paths), options=conditioning, progress=lambda _name, done, total: bar(done, total)
         )

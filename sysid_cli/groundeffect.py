@@ -202,7 +202,7 @@ def fit(data: Path, out: Path | None, report: Path | None, json_path: str | None
     from sysid.groundeffect import fit_ground_effect, fit_summary, load_thrust_ratio, write_ground_effect_model
 
     data_config, fit_config = _configs(kw)
-    with progress_bar("reading", quiet=quiet) as bar:
+    with progress_bar("reading", unit="bytes", quiet=quiet) as bar:
         points = load_thrust_ratio(data, data_config, progress=bar)
     result = fit_ground_effect(points, fit_config)
     if out is not None:

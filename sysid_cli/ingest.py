@@ -142,7 +142,7 @@ def ingest(
         transport_delay_s=transport_delay,
         segments=segments_from(segments_file),
     )
-    with progress_bar("reading", quiet=quiet) as bar:
+    with progress_bar("reading", unit="bytes", quiet=quiet) as bar:
         campaign = ingest_campaign(
             list(logs),
             list(wind_paths),

@@ -58,6 +58,14 @@ class Campaign:
         return self.flights
 
 
+def _size(path: str | Path) -> int:
+    """Bytes of a file, 0 if it cannot be read (the reader then says why)."""
+    try:
+        return Path(path).stat().st_size
+    except OSError:
+        return 0
+
+
 def expand_wind_paths(paths: Sequence[Path]) -> list[Path]:
     """Files given as they are, folders as the ``*.csv`` files inside them (sorted).
 
@@ -104,7 +112,8 @@ def ingest_campaign(
     options : ConditioningOptions, optional
         Conditioning choices.
     progress : callable, optional
-        ``progress(file_name, done, total)`` while reading, bytes.
+        ``progress(file_name, done, total)`` while reading: bytes read of all
+        the logs so far and in all, so one bar runs once from 0 to the end.
 
     Returns
     -------
@@ -121,12 +130,15 @@ def ingest_campaign(
         For a log (without wind) that cannot be conditioned; the reason is
         also in ``notes``. The readers' and the conditioning's own warnings go on.
     """
+    sizes = [_size(path) for path in log_paths]
     logs = []
-    for path in log_paths:
+    for k, path in enumerate(log_paths):
 
-        def report(done: int, total: int, name: str = Path(path).name) -> None:
+        def report(
+            done: int, _total: int, name: str = Path(path).name, before: int = sum(sizes[:k]), size: int = sizes[k]
+        ) -> None:
             if progress is not None:
-                progress(name, done, total)
+                progress(name, before + min(done, size), sum(sizes))
 
         logs.append(read_log(path, progress=report))
     winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]

@@ -32,3 +32,18 @@ def test_real_logs_are_kept_in_order(real_data: Path) -> None:
     campaign = ingest_campaign(logs)
     assert campaign.require_flights() == campaign.flights
     assert [f.source.name for f in campaign.flights] == [p.name for p in logs]
+
+
+@pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning")  # the logs' own, not tested here
+def test_progress_counts_the_bytes_of_all_logs_once(real_data: Path) -> None:
+    """Issue 14: the bar counted each file's bytes and reset between files. Now one count over all logs."""
+    logs = [real_data / "pyulog" / "sample_appended_multiple.ulg", real_data / "dronekit-la-testdata" / "log171.bin"]
+    calls: list[tuple[str, int, int]] = []
+    ingest_campaign(logs, progress=lambda name, done, total: calls.append((name, done, total)))
+    total = sum(p.stat().st_size for p in logs)
+    assert {c[2] for c in calls} == {total}
+    done = [c[1] for c in calls]
+    assert done == sorted(done) and done[0] == 0 and done[-1] == total
+    assert [c[0] for c in calls if c[1] == logs[0].stat().st_size][0] == logs[
+        0
+    ].name  # the first file ends where the second starts
