@@ -86,6 +86,10 @@ _SID_FIELDS = {
 }
 _USER_KEYS = ("start_s", "end_s", "axis", "kind", "f_min_hz", "f_max_hz")
 _RING_S = 5.0  # the loop rings this long after a doublet or 3211
+_STEP_JUMP = 5.0  # a logged step: a sample-to-sample change this many times the input's typical one
+_STEP_LOOK_BACK_S = 0.5  # the first step is searched from this long before the fitted start
+_STEP_RISE_S = 0.05  # a logged step's change is measured over this long
+_FIRST_STEP = 0.25  # the first step is at least this fraction of the largest (a doublet's first is half its second)
 _MIN_TONE_S = 15.0  # a sweep runs at least this long besides any step it overlaps
 
 
@@ -256,6 +260,12 @@ def detect_segments(
             m
             for m in maneuvers
             if m.kind != "sweep" and not any(m.first <= s.last and s.first <= m.last for s in sweeps)
+        ]
+        checked = _check_responses(responses, t.size)
+        maneuvers = [
+            stepped
+            for m in maneuvers
+            if (stepped := _stepped(m, checked.get(m.axis, {}).get(f"delta_{m.axis}"), dt)) is not None
         ]
     segments += [
         Segment(
@@ -435,6 +445,29 @@ def _uniform(time_s: np.ndarray) -> tuple[np.ndarray, float]:
     if dt <= 0 or np.max(np.abs(steps - dt)) > 1e-3 * dt:
         raise DataError("time_s must be uniformly sampled; resample the inputs first")
     return t, dt
+
+
+def _stepped(found: FoundManeuver, raw: np.ndarray | None, dt: float) -> FoundManeuver | None:
+    """A doublet or 3211 started at the first step of the mixer input as logged; None if that input never steps.
+
+    An injected step changes the logged input within a sample or two; the
+    loop's own reaction to a disturbance, or its recovery after a
+    maneuver, moves it smoothly. The joint fit can also reach back into the
+    hover before the first step where the feedback model leaves a drift.
+    """
+    if found.kind not in ("doublet", "3211") or raw is None:
+        return found
+    lag = max(1, int(round(_STEP_RISE_S / dt)))  # a step smoothed by the resampling filter still rises this fast
+    jumps = np.abs(raw[lag:] - raw[:-lag])
+    spread = float(np.median(jumps)) / 0.6745
+    if spread <= 0:
+        return found
+    lo = max(0, found.first - int(round(_STEP_LOOK_BACK_S / dt)))
+    window = jumps[lo : found.last]
+    if window.size == 0 or window.max() <= _STEP_JUMP * spread:
+        return None
+    sharp = np.flatnonzero(window > max(_STEP_JUMP / 2 * spread, _FIRST_STEP * window.max()))
+    return replace(found, first=max(found.first, lo + int(sharp[0])))  # the change from sharp[0] to + lag
 
 
 def _ringing(sweep: FoundSweep, steps: Sequence[FoundManeuver], dt: float) -> bool:
