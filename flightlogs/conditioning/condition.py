@@ -434,11 +434,8 @@ def _with_estimated_offset(
             if left is None or abs(left.lag_s) < 0.1 / again.rate_hz:
                 break
             corrected -= left.lag_s
-    assert again.wind is not None
-    alignment = replace(
-        again.wind, clock_offset_source="estimated", residual=first.residual, residual_against=first.residual_against
-    )
-    return replace(again, wind=alignment)
+    assert again.wind is not None  # its residual is what is left after the correction, not the offset corrected
+    return replace(again, wind=replace(again.wind, clock_offset_source="estimated"))
 
 
 def _with_estimated_delay(log: FlightLog, wind: Any, options: ConditioningOptions) -> ConditionedFlight:
@@ -461,12 +458,7 @@ def _with_estimated_delay(log: FlightLog, wind: Any, options: ConditioningOption
     again = condition_flight(log, wind, replace(options, transport_delay_s=delay, estimate_transport_delay=False))
     assert again.wind is not None
     transport = replace(again.wind.transport, source="correlation")
-    return replace(
-        again,
-        wind=replace(
-            again.wind, transport=transport, residual=first.wind.residual, residual_against=first.wind.residual_against
-        ),
-    )
+    return replace(again, wind=replace(again.wind, transport=transport))  # residual: what is left with the delay
 
 
 def _derived(values: dict[str, np.ndarray], units: dict[str, str], *, wind_given: bool) -> None:

@@ -46,6 +46,8 @@ def test_clock_offset_is_recovered_within_one_sample(demo: dict) -> None:
     assert flight.wind is not None and flight.wind.clock_offset_source == "estimated"
     assert flight.wind.residual_against == "autopilot wind estimate"
     assert abs(flight.wind.clock_offset_s - demo["truth"]["anemometer"]["clock_offset_s"]) < ONE_SAMPLE_S
+    # issue 14: the residual reported is what is left after the correction, not the offset before it
+    assert flight.wind.residual is not None and abs(flight.wind.residual.lag_s) < ONE_SAMPLE_S
 
 
 def test_aligned_wind_matches_the_wind_at_the_vehicle(demo: dict) -> None:
