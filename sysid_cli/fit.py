@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from ._common import OutputPath, emit_json, json_option, progress_bar
+from ._common import OutputPath, emit_json, json_option, staged_progress
 from ._flights import check_sources, dataset_flights
 from ._wind_options import (
     anemometer_at_option,
@@ -202,6 +202,7 @@ def fit(
     from sysid.model import load_structure
 
     structure = load_structure(model_name)
+    structure.values(initial)  # a --set that names no parameter is an error before any work
     options = IdentifyOptions(
         fit=FitOptions(
             starts=starts,
@@ -228,11 +229,7 @@ def fit(
             "--segments": segments_file,
         },
     )
-    with progress_bar("identifying", quiet=quiet) as bar:
-
-        def progress(_stage: str, done: int, total: int) -> None:
-            bar(done, total)
-
+    with staged_progress("identifying", quiet=quiet) as progress:
         if dataset:
             flights = dataset_flights(logs)
             model = identify_flights(flights, structure, options=options, files=list(logs), progress=progress)

@@ -62,21 +62,31 @@ def modes(
     if (model_file is None) == (structure_name is None):
         raise click.UsageError("give either MODEL_FILE or --model NAME with --set values")
     unset: tuple[str, ...] = ()
+    unidentified: list[str] = []
     if model_file is not None:
         if values or constants:
             raise click.UsageError("--set and --trim go with --model, not with a model file")
-        linear = read_model(model_file).linear_model()
+        identified = read_model(model_file)
+        linear = identified.linear_model()
+        unidentified = [a.axis for a in identified.unidentified_axes]
         source = str(model_file)
     else:
         assert structure_name is not None
         linear, unset = structure_model(load_structure(structure_name), values, constants=constants)
         source = structure_name
-    summary: dict[str, Any] = {"model": source, "eigenvalues": mode_summary(find_modes(linear)), "unset": list(unset)}
+    summary: dict[str, Any] = {
+        "model": source,
+        "eigenvalues": mode_summary(find_modes(linear)),
+        "unset": list(unset),
+        "unidentified_axes": unidentified,
+    }
     if not quiet:
 
         def say(text: str = "") -> None:
             click.echo(text, err=json_path == "-")
 
         say(f"modes of {source}" + (f" (not set, taken as dropped: {', '.join(unset)})" if unset else ""))
+        if unidentified:
+            say(f"  the {', '.join(unidentified)} axes are unidentified: their modes are not known and not listed")
         print_modes(summary["eigenvalues"], say)
     emit_json(summary, json_path)

@@ -187,8 +187,9 @@ def _verify(
         after_s=after_s,
         hint=hint,
         options=VerificationOptions(initial_state=initial_state),  # type: ignore[arg-type]
+        unidentified={a.input: a.reason for a in identified.unidentified_axes},
     )
-    return verification, notes
+    return verification, notes + list(verification.unverified)
 
 
 def _check_segments(path: Path, segments: Any, flights: list[Any]) -> None:

@@ -298,3 +298,26 @@ def read_warned(read: Callable[..., _T], *args: object, **kwargs: object) -> _T:
         result = read(*args, **kwargs)
     assert tuple(str(w.message) for w in raised) == tuple(result.warnings)  # type: ignore[attr-defined]
     return result
+
+
+# ------------------------------------------------------------------ models with unidentified axes
+
+
+def with_unidentified(
+    model: IdentifiedModel, names: set[str], reasons: Mapping[str, str] | None = None
+) -> IdentifiedModel:
+    """`model` with the parameters `names` unidentified (no value, no accuracy), as ``sysid fit --partial`` leaves them.
+
+    `reasons` gives the recorded reason of each unidentified axis (``{"lon": "no sweep found in 3 logs"}``);
+    without it the model records no axes, as an older file, and they are derived from the parameters.
+    """
+    nothing = {"status": "unidentified", "value": math.nan, "cr_percent": math.nan, "insensitivity_percent": math.nan}
+    parameters = tuple(dataclasses.replace(p, **nothing) if p.name in names else p for p in model.parameters)
+    changed = dataclasses.replace(model, parameters=parameters, axes=())
+    if reasons is None:
+        return changed
+    axes = tuple(
+        dataclasses.replace(a, status="unidentified", reason=reasons[a.axis]) if a.axis in reasons else a
+        for a in changed.axis_status
+    )
+    return dataclasses.replace(changed, axes=axes)

@@ -11,32 +11,41 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 from scipy import linalg
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
-from flightlogs.errors import FitError
+from flightlogs.errors import FitError, FitWarning, collected_warnings
 from flightlogs.record import Record
 from flightlogs.store.dataset import file_sha256
+from flightlogs.writers.jsonio import jsonable
+from sysid.fit.axes import merge_axes, partial_warning, structure_axes, unidentified_message
 from sysid.fit.engine import FitOptions, FrequencyFit, fit_frequency_responses
 from sysid.fit.reduce import ReductionStep
 from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance
-from sysid.fit.wind import WindStepResult, fit_wind
+from sysid.fit.wind import WindStepResult, fit_wind, unfitted_wind
+from sysid.fit.wind_alignment import wind_misalignment
 from sysid.freqresp import (
     FrequencyResponse,
     ResponseOptions,
+    coupled_inputs,
     frequency_responses,
     gate_responses,
+    maneuver_band,
     maneuver_records,
+    quiet_records,
     reference_options,
+    within_band,
 )
+from sysid.model.assemble import structure_model
 from sysid.model.structure import ModelStructure
 from sysid.model.toml_format import load_structure
 
@@ -98,6 +107,10 @@ class IdentifyOptions:
         Maneuvers whose records the wind step uses: those of the axes whose
         outputs carry the wind terms (yaw sweeps turn the nose through the
         wind and mix its components).
+    partial : bool
+        Identify the axes that can be, and leave the others ``unidentified``
+        (a warning says which); False (default) raises a FitError naming
+        every axis of the structure without a usable maneuver.
     """
 
     fit: FitOptions = field(default_factory=FitOptions)
@@ -113,6 +126,7 @@ class IdentifyOptions:
     use_excitation: bool = True
     wind_outputs: tuple[str, ...] = ("ax", "az")
     wind_axes: tuple[str, ...] = ("lon", "thr")
+    partial: bool = False
 
 
 def _report(progress: Progress | None, stage: str, done: int, total: int) -> None:
@@ -121,8 +135,21 @@ def _report(progress: Progress | None, stage: str, done: int, total: int) -> Non
 
 
 def _axis_responses(
-    structure: ModelStructure, records: list[Record], axis: str, options: IdentifyOptions, notes: list[str]
-) -> tuple[FrequencyResponse, ...]:
+    structure: ModelStructure,
+    records: list[Record],
+    axis: str,
+    options: IdentifyOptions,
+    band: tuple[float, float] | None = None,
+    quiet: Sequence[Record] = (),
+) -> tuple[tuple[FrequencyResponse, ...], str | None]:
+    """The responses of one axis's pairs, and the note saying what they were computed against (None if none).
+
+    With the maneuvers' `band` (rad/s) known and no reference, the grid keeps within it
+    (:func:`~sysid.freqresp.within_band`); `quiet` flight (:func:`~sysid.freqresp.quiet_records`) gives the
+    feedback floor removed from the responses, unless they are conditioned on the measured wind: that takes
+    the fed-back gusts out instead (on the strong-wind tuning log the floor, gusts of other stretches of
+    flight, gated out everything below 5 rad/s and with it X_u, M_u and the wind step).
+    """
     control = f"delta_{axis}"
     logged = set.intersection(*(set(r.signals) for r in records))
     if options.pairs is not None:
@@ -131,16 +158,44 @@ def _axis_responses(
         outputs = [o for o in FIT_PAIRS[axis] if o in structure.outputs]
     outputs = [o for o in outputs if o in logged]
     if not outputs or control not in logged:
-        return ()
+        return (), None
     winds = [s for s in dict.fromkeys(c.signal for c in structure.wind_inputs) if s in logged]
     inputs = [control] + (winds if options.condition_on_wind else [])
     longest = max(r.end_s - r.start_s for r in records)
     lowest = max(options.responses.omega_min, 2.0 * np.pi * options.min_record_periods / longest)
     grid = dataclasses.replace(options.responses, omega_min=min(lowest, options.responses.omega_max / 2.0))
     grid, note = reference_options(records, axis, inputs, options.kind, grid, options.use_excitation)
-    notes.append(note)
-    found = frequency_responses(records, inputs, outputs, grid)
-    return tuple(r for r in found if r.input == control)
+    grid = within_band(grid, band)
+    others = [f"delta_{a}" for a in _AXES if a != axis and f"delta_{a}" in logged]
+    found: list[FrequencyResponse] = []
+    for extra, group in _by_coupling(structure, outputs, coupled_inputs(records, control, others, grid)).items():
+        used = [*inputs, *extra]
+        usable = [r for r in quiet if {*used, *group} <= set(r.signals)] if len(inputs) == 1 else []
+        found += frequency_responses(records, used, group, grid, quiet=usable)
+    return tuple(r for o in outputs for r in found if r.input == control and r.output == o), note
+
+
+def _by_coupling(
+    structure: ModelStructure, outputs: Sequence[str], coupled: Sequence[str]
+) -> dict[tuple[str, ...], list[str]]:
+    """Outputs grouped by the `coupled` mixer inputs that drive them in `structure` (initial values, trim zero).
+
+    A response is conditioned on another mixer input only when that input moves with the maneuver's
+    (:func:`~sysid.freqresp.coupling.coupled_inputs`) and the structure lets it drive the output.
+    """
+    groups: dict[tuple[str, ...], list[str]] = {}
+    gain = None
+    if coupled:
+        model, _ = structure_model(structure, structure.values(), include_wind=False)
+        gain = np.abs(model.frequency_response(np.array([1.0, 3.0, 10.0])))
+        names = (model.outputs, model.inputs)
+    for output in outputs:
+        extra: tuple[str, ...] = ()
+        if gain is not None and output in names[0]:
+            row = gain[:, names[0].index(output)]
+            extra = tuple(i for i in coupled if np.max(row[:, names[1].index(i)]) > 1e-9 * np.max(row))
+        groups.setdefault(extra, []).append(output)
+    return groups
 
 
 def identify_flights(
@@ -174,10 +229,31 @@ def identify_flights(
     Raises
     ------
     FitError
-        If there is no flight, or no sweep gives a response that passes gating; naming the files.
+        If there is no flight, or no sweep gives a response that passes gating; naming the files. Unless
+        ``options.partial``, also if an axis of the structure has no usable response: one sentence per axis
+        says why and what to do (:func:`sysid.fit.axes.unidentified_message`).
     ModelError
         If ``options.constants`` names a constant the structure has no trim constant for.
+
+    Notes
+    -----
+    The model's ``notes`` say what each axis's responses were computed
+    against, which responses gating dropped and why, whether the wind
+    parameters were left out; then the message of each project warning
+    raised during the identification, which also goes on to the caller.
     """
+    with collected_warnings() as caught:
+        model = _identified(flights, structure, options, files, progress)
+    return dataclasses.replace(model, notes=model.notes + caught.messages)
+
+
+def _identified(
+    flights: Sequence[ConditionedFlight],
+    structure: ModelStructure | str,
+    options: IdentifyOptions,
+    files: Sequence[str | Path],
+    progress: Progress | None,
+) -> IdentifiedModel:
     if isinstance(structure, str):
         structure = load_structure(structure)
     structure.check_constants(options.constants or {})
@@ -189,7 +265,16 @@ def identify_flights(
         records = maneuver_records(flights, axis, kind=options.kind)
         if records:
             used[axis] = records
-            responses += _axis_responses(structure, records, axis, options, notes)
+            band = maneuver_band(flights, axis, kind=options.kind)
+            quiet = quiet_records(flights, axis)
+            found, note = _axis_responses(structure, records, axis, options, band, quiet)
+            responses += found
+            notes += [note] if note is not None else []
+    rule = {"min_coherence": options.min_coherence, "min_decades": options.min_decades}  # eq. 3.8
+    gated = gate_responses(responses, **rule)
+    axes = structure_axes(structure, flights, used, responses, gated, kind=options.kind, **rule)
+    if flights and any(not a.identified for a in axes) and not (options.partial and gated.kept):
+        raise FitError(unidentified_message(axes, model=structure.name))
     if not responses:
         given = ", ".join(Path(f).name for f in files) or "the data given"
         if not flights:
@@ -198,7 +283,6 @@ def identify_flights(
         raise FitError(
             f"{given}: no {options.kind} in flight {names} gives a response the model {structure.name} can be fitted to"
         )
-    gated = gate_responses(responses, min_coherence=options.min_coherence, min_decades=options.min_decades)
     notes += [d.reason for d in gated.dropped]
     if not gated.kept:
         raise FitError("no frequency response passed gating: " + " ".join(d.reason for d in gated.dropped))
@@ -208,12 +292,20 @@ def identify_flights(
     fit = fit_frequency_responses(
         structure, gated.kept, constants=constants, initial=options.initial, options=options.fit
     )
+    fit = dataclasses.replace(fit, axes=merge_axes(axes, fit.axes))
+    if fit.unidentified_axes:
+        if not options.partial:
+            raise FitError(unidentified_message(fit.axes, model=structure.name))
+        warnings.warn(FitWarning(partial_warning(fit.axes, model=structure.name)), stacklevel=2)
     wind = None
     if structure.wind_parameters:
         _report(progress, "wind step", len(_AXES) + 1, len(_AXES) + 2)
         signals = {c.signal for c in structure.wind_inputs}
         records = [r for axis in options.wind_axes for r in used.get(axis, [])]
-        if any(signals <= set(r.signals) for r in records):
+        misaligned = wind_misalignment(flights, structure)
+        if misaligned:
+            wind = unfitted_wind(structure, misaligned)
+        elif any(signals <= set(r.signals) for r in records):
             wind = fit_wind(
                 structure,
                 fit.values,
@@ -285,18 +377,6 @@ def _mean_trim(records: Sequence[Record]) -> dict[str, float]:
     return {name: float(np.mean([r.trim[name] for r in records if name in r.trim])) for name in names}
 
 
-def _jsonable(value: Any) -> Any:
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
-    if isinstance(value, Mapping):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value if isinstance(value, (str, int, float, bool)) or value is None else str(value)
-
-
 def _provenance(files: Sequence[str | Path], options: IdentifyOptions) -> Provenance:
     from importlib.metadata import PackageNotFoundError, version
 
@@ -310,7 +390,7 @@ def _provenance(files: Sequence[str | Path], options: IdentifyOptions) -> Proven
     return Provenance(
         files=tuple(paths),
         sha256={p: file_sha256(p) for p in paths},
-        options=_jsonable(options),
+        options=jsonable(options, default=str),
         versions=versions,
         created_utc=datetime.now(UTC).isoformat(timespec="seconds"),
     )
@@ -358,6 +438,7 @@ def model_from_fit(
         unit = p.unit
         for signal, text in units.items():
             unit = unit.replace("{" + signal + "}", text)
+        unit = unit.replace("{", "unit of ").replace("}", "")  # an input with no response: its unit is not known
         if p.name in fit.status:
             status, value, stage = fit.status[p.name], fit.values[p.name], "frequency"
         elif wind is not None:
@@ -409,4 +490,5 @@ def model_from_fit(
         wind=None if wind is None else wind.fit,
         input_units=units,
         notes=tuple(notes),
+        axes=fit.axes,
     )

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from sysid._json import finite_or_none as _num
-from sysid.fit._json import parameter_entry
+from sysid.fit._json import axis_entry, parameter_entry
 from sysid.fit.result import IdentifiedModel
 from sysid.model.modes import Mode, modes
 
@@ -58,8 +58,13 @@ def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
         ``cr_percent``, ``insensitivity_percent`` (None unless estimated),
         ``status``, ``unit``, ``stage``; ``cost`` with ``average`` and
         ``responses``; ``eigenvalues`` (see :func:`mode_summary`);
-        ``dropped`` (names of dropped parameters); ``reduction`` (the log);
-        ``wind`` (residual RMS before/after, or None); ``notes``.
+        ``dropped`` (names of dropped parameters); ``unidentified`` (names of
+        the parameters no response informed: value None); ``axes`` (each
+        control input's ``axis``, ``input``, ``status`` "identified" or
+        "unidentified", ``reason``, ``remedy``); ``reduction`` (the log, a
+        ``kept`` step with the costs that rose); ``wind`` (residual RMS
+        before/after, or None); ``notes``. Eigenvalues are those of the
+        identified axes.
     """
     return {
         "model": model.structure_name,
@@ -67,6 +72,8 @@ def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
         "cost": {"average": model.cost.average, "responses": dict(model.cost.responses)},
         "eigenvalues": mode_summary(modes(model.linear_model())),
         "dropped": [p.name for p in model.parameters if p.dropped],
+        "unidentified": [p.name for p in model.parameters if p.unidentified],
+        "axes": [axis_entry(a) for a in model.axis_status],
         "reduction": [
             {
                 "step": s.step,

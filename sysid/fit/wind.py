@@ -25,9 +25,9 @@ anemometer's clock is off by more than the wind delays can take up (the
 conditioning measures the residual offset against the autopilot's wind
 estimate, but applies it only when asked), the wind and the residual do not
 line up: every G_w term comes out insensitive and would be dropped as if the
-wind did nothing. :func:`wind_misalignment` detects it, and the wind
-parameters are then left ``unidentified`` (:func:`unfitted_wind`) with the
-offset to give. Outputs of an unidentified axis have no residual to fit; a
+wind did nothing. :func:`sysid.fit.wind_alignment.wind_misalignment` detects
+it, and the wind parameters are then left ``unidentified``
+(:func:`unfitted_wind`) with the offset to give. Outputs of an unidentified axis have no residual to fit; a
 wind parameter that only they would inform is unidentified too.
 """
 
@@ -44,7 +44,6 @@ import numpy as np
 from scipy import optimize
 from scipy import signal as sps
 
-from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import FitError, FitWarning
 from flightlogs.record import Record
 from sysid.fit.accuracy import Accuracy, accuracy
@@ -55,11 +54,9 @@ from sysid.model.assemble import Assembler, SystemMatrices
 from sysid.model.axes import axis_parts
 from sysid.model.structure import ModelStructure
 
-__all__ = ["WindStepResult", "fit_wind", "wind_misalignment", "unfitted_wind"]
+__all__ = ["WindStepResult", "fit_wind", "unfitted_wind"]
 
 WindStatus = Literal["estimated", "dropped", "unidentified"]
-#: Smallest cross-correlation peak (anemometer against the autopilot's wind estimate) trusted as a clock offset.
-_MIN_OFFSET_CORRELATION = 0.8
 
 _SCAN_STEP_S = 0.002
 
@@ -489,56 +486,4 @@ def unfitted_wind(structure: ModelStructure, reason: str) -> WindStepResult:
         status=MappingProxyType(dict.fromkeys(names, "unidentified")),
         accuracy=accuracy(np.zeros((1, 0)), np.zeros(0), ()),
         fit=None,
-    )
-
-
-def wind_misalignment(flights: Sequence[ConditionedFlight], structure: ModelStructure) -> str:
-    """Why the flights' wind cannot be regressed on: its clock is off by more than the wind delays take up; or "".
-
-    The conditioning measures the residual clock offset of each flight's
-    anemometer against the autopilot's wind estimate (or attitude) and
-    applies it only when asked (``--estimate-wind-offset``). An offset
-    found with a clear correlation peak and larger than the largest delay
-    the structure allows a wind input (``tau_w`` bounds, 0.5 s for
-    ``hover-wind``) leaves the wind and the residual of eq. 3.14 apart by
-    more than the wind step can align.
-
-    Parameters
-    ----------
-    flights : sequence of ConditionedFlight
-        The flights, with their wind alignment.
-    structure : ModelStructure
-        The structure, with wind inputs.
-
-    Returns
-    -------
-    str
-        The logs, the offset found and the option that corrects it; "" when the wind is aligned (or not measured).
-    """
-    bound = max(
-        (structure.parameter(n).upper for c in structure.wind_inputs for n in c.delay.names),
-        default=0.0,
-    )
-    bound = bound if math.isfinite(bound) else 0.5
-    off = [
-        f
-        for f in flights
-        if f.wind is not None
-        and f.wind.clock_offset_source != "estimated"
-        and f.wind.residual is not None
-        and abs(f.wind.residual.correlation) >= _MIN_OFFSET_CORRELATION
-        and abs(f.wind.residual.lag_s) > bound
-    ]
-    if not off:
-        return ""
-    lags = [f.wind.residual.lag_s for f in off if f.wind is not None and f.wind.residual is not None]
-    offsets = [f.wind.clock_offset_s - lag for f, lag in zip(off, lags) if f.wind is not None]
-    against = off[0].wind.residual_against if off[0].wind is not None else None
-    names = ", ".join(f.source.name for f in off[:3]) + (" ..." if len(off) > 3 else "")
-    return (
-        f"the anemometer's clock is off by {-float(np.median(lags)):+.2f} s in {len(off)} of {len(flights)} logs "
-        f"({names}): the wind correlates best with the {against or 'vehicle'} {float(np.median(lags)):+.2f} s from "
-        f"where it was placed, more than the {bound:g} s the wind delays can take up, so the wind does not line up "
-        f"with the residual of eq. 3.14 (nor u v w with the flight); give --estimate-wind-offset, or "
-        f"--wind-offset {float(np.median(offsets)):.2f}"
     )

@@ -4,14 +4,17 @@ The public names live in small modules and are re-exported here:
 :mod:`~sysid.freqresp.options` (:class:`ResponseOptions`),
 :mod:`~sysid.freqresp.estimate` (:func:`frequency_responses`),
 :mod:`~sysid.freqresp.gating` (:func:`gate_responses`),
-:mod:`~sysid.freqresp.records` (:func:`maneuver_records`, :data:`DEFAULT_PAIRS`,
-:func:`flight_responses`) and :mod:`~sysid.freqresp.io` (HDF5). Private
-modules hold the numerics: ``_spectra`` (windowed spectra), ``_whole`` (the
-records' whole-length transforms, the composite's bias-free member),
+:mod:`~sysid.freqresp.records` (:func:`maneuver_records`, :func:`maneuver_band`,
+:func:`quiet_records`, :func:`within_band`, :data:`DEFAULT_PAIRS`, :func:`flight_responses`),
+:mod:`~sysid.freqresp.coupling` (:func:`coupled_inputs`) and :mod:`~sysid.freqresp.io` (HDF5).
+Private modules hold the numerics: ``_spectra`` (windowed spectra), ``_whole``
+(the records' whole-length transforms, the composite's bias-free member),
+``_local`` (that member from one record: its neighbouring bins),
 ``_conditioning`` (conditioned and instrumental-variable estimates) and
 ``_composite``.
 """
 
+from sysid.freqresp.coupling import coupled_inputs
 from sysid.freqresp.estimate import automatic_window_lengths, frequency_responses
 from sysid.freqresp.gating import DroppedResponse, GatingResult, fit_range, gate_responses
 from sysid.freqresp.io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
@@ -22,9 +25,12 @@ from sysid.freqresp.records import (
     FlightResponses,
     default_pairs,
     flight_responses,
+    maneuver_band,
     maneuver_records,
     parse_pairs,
+    quiet_records,
     reference_options,
+    within_band,
 )
 from sysid.freqresp.response import FrequencyResponse
 
@@ -33,6 +39,7 @@ __all__ = [
     "ResponseOptions",
     "frequency_responses",
     "automatic_window_lengths",
+    "coupled_inputs",
     "DroppedResponse",
     "GatingResult",
     "gate_responses",
@@ -43,6 +50,9 @@ __all__ = [
     "DEFAULT_PAIRS",
     "EXCITATION",
     "maneuver_records",
+    "maneuver_band",
+    "quiet_records",
+    "within_band",
     "parse_pairs",
     "default_pairs",
     "reference_options",

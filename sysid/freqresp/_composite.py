@@ -30,10 +30,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
-from sysid.freqresp._conditioning import pair_estimate, random_error
+from sysid.freqresp._conditioning import Estimate, conditioned_spectra, pair_estimate, random_error
 from sysid.freqresp._spectra import WindowSpectra
 from sysid.freqresp._whole import significance_threshold
 
@@ -61,8 +62,14 @@ def composite_pair(
     j: int,
     y: int,
     instrument: int | None = None,
+    floors: Sequence[np.ndarray | None] | None = None,
+    min_ratio: float = 4.0,
 ) -> PairEstimate:
-    """Composite estimate of channel `y` against input channel ``inputs[j]`` (conditioned, or by `instrument`)."""
+    """Composite estimate of channel `y` against input channel ``inputs[j]`` (conditioned, or by `instrument`).
+
+    `floors`, one per member (None where the quiet records do not reach), are the feedback's spectra: the
+    composite floor (the members' weights) is removed from the conditioned spectra, see :func:`_floored`.
+    """
     n_conditioned = len(inputs) - 1
     n_d = np.array([max(w.n_effective - n_conditioned, 1.0) for w in windows])
     weights = np.zeros((len(windows), omega.size))
@@ -71,8 +78,9 @@ def composite_pair(
     for i, window in enumerate(windows):
         gamma2 = pair_estimate(window.spectra[reach[i]], inputs, j, y, instrument).coherence
         if window.noise_dof is not None:  # the whole-record member: only where its signal is significant
-            valid[i, reach[i]] = _significant(gamma2, window.n_effective, len(inputs), window.noise_dof[reach[i]])
-        unbiased = np.where(valid[i, reach[i]], _unbiased_coherence(gamma2, n_d[i]), 0.0)
+            valid[i, reach[i]] = _significant(gamma2, window.n_windows, len(inputs), window.noise_dof[reach[i]])
+        single = window.noise_dof is not None and window.n_windows <= len(inputs)  # its coherence is unbiased
+        unbiased = np.where(valid[i, reach[i]], gamma2 if single else _unbiased_coherence(gamma2, n_d[i]), 0.0)
         weights[i, reach[i]] = 2.0 * n_d[i] * unbiased / np.maximum(1.0 - unbiased, 1e-12)
     whole = any(w.noise_dof is not None and bool(np.any(weights[k] > 0)) for k, w in enumerate(windows))
     usable = valid.any(axis=0)
@@ -83,6 +91,10 @@ def composite_pair(
     spectra = np.einsum("if,ifab->fab", weights, stacked)
     estimate = pair_estimate(spectra, inputs, j, y, instrument)
     gamma2 = np.where(usable, estimate.coherence, 0.0)
+    response = estimate.response
+    if floors is not None and instrument is None:
+        response, excited = _floored(estimate, floors, weights, inputs, j, y, min_ratio)
+        gamma2 = np.where(excited, gamma2, 0.0)
     # averages credited: each member's, by its share of the estimate (weight x the spectrum H is divided by)
     divisor = instrument if instrument is not None and j == 0 else inputs[j]
     share = weights * np.abs(stacked[:, :, divisor, inputs[j]])
@@ -91,23 +103,54 @@ def composite_pair(
     )
     used = tuple(float(w.window_s) for k, w in enumerate(windows) if w.noise_dof is None and np.any(weights[k] > 0))
     return PairEstimate(
-        response=estimate.response,
+        response=response,
         coherence=gamma2,
         random_error=random_error(_unbiased_coherence(gamma2, n_d_mean), n_d_mean),
         input_autospectrum=estimate.g_jj,
         output_autospectrum=estimate.g_yy,
-        cross_spectrum=estimate.g_jy,
+        cross_spectrum=estimate.g_jy if response is estimate.response else response * estimate.g_jj,
         windows_s=used,
         whole_record=whole,
     )
+
+
+def _floored(
+    estimate: Estimate,
+    floors: Sequence[np.ndarray | None],
+    weights: np.ndarray,
+    inputs: Sequence[int],
+    j: int,
+    y: int,
+    min_ratio: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The response with the feedback floor removed, and where the excitation dominates the input.
+
+    The floor is averaged with the members' weights (those with a floor, renormalised) and conditioned as
+    the estimate was: ``H = (G_jy - F_jy) / (G_jj - F_jj)`` where ``G_jj >= min_ratio F_jj``. Where no
+    member has a floor the response is left as it is and counts as excited.
+    """
+    shape = next(f for f in floors if f is not None).shape
+    have = np.array([f is not None for f in floors], dtype=float)[:, None] * weights
+    norm = have.sum(axis=0)
+    stacked = np.stack([f if f is not None else np.zeros(shape, dtype=complex) for f in floors])
+    floor = np.einsum("if,ifab->fab", have / np.maximum(norm, np.finfo(float).tiny), stacked)
+    f_jj, _, f_jy = conditioned_spectra(floor, inputs[j], [k for n, k in enumerate(inputs) if n != j], y)
+    known = norm > 0
+    excited = ~known | (estimate.g_jj >= min_ratio * f_jj)
+    corrected = (estimate.g_jy - f_jy) / np.maximum(estimate.g_jj - f_jj, np.finfo(float).tiny)
+    return np.where(known & excited, corrected, estimate.response), excited
 
 
 def _significant(gamma2: np.ndarray, n_records: float, n_inputs: int, noise_dof: np.ndarray) -> np.ndarray:
     """Whether the whole-record member's output power stands out of its smoothed noise (F test, see ``_whole``).
 
     Its autospectra carry the noise as ``(K - q) / K`` of the smoothed estimate, so signal over noise is
-    ``(K - q) / K g^2 / (1 - g^2)``; the statistic is ``n_d`` times that, ``n_d = K - q + 1``.
+    ``(K - q) / K g^2 / (1 - g^2)``; the statistic is ``n_d`` times that, ``n_d = K - q + 1``. From one
+    record of one input the coherence is already ``1 - G_nn / G_yy``: the statistic is ``G_yy / G_nn =
+    1 / (1 - g^2)``.
     """
+    if n_records <= n_inputs:
+        return cast(np.ndarray, 1.0 / np.maximum(1.0 - gamma2, 1e-300) > significance_threshold(noise_dof))
     n_d = n_records - n_inputs + 1
     statistic = n_d * (n_records - n_inputs) / n_records * gamma2 / np.maximum(1.0 - gamma2, 1e-300)
     return statistic > significance_threshold(noise_dof)

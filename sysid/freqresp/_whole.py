@@ -27,7 +27,10 @@ Two details make the member usable:
   and the pointwise signal. The composite then uses the member only where its
   output power stands out of that noise at the 1e-4 level
   (:func:`significance_threshold`): with few records a noise-only frequency
-  would otherwise now and then look coherent.
+  would otherwise now and then look coherent. From as many records as
+  inputs or fewer (one sweep per axis, the usual log) there is no residual
+  between records: the noise, and with several inputs the responses too,
+  come from each record's neighbouring bins (:mod:`sysid.freqresp._local`).
 
 The signal is not smoothed across frequency: in closed loop the mixer
 input's notch is a bin or two wide, and weighting ``H`` by ``|X|^2`` over
@@ -46,6 +49,7 @@ from typing import cast
 import numpy as np
 
 from sysid.freqresp._conditioning import residual_noise
+from sysid.freqresp._local import local_member, local_noise
 from sysid.freqresp._spectra import WindowSpectra
 
 __all__: list[str] = []
@@ -67,13 +71,17 @@ def whole_record_spectra(
     instrument: int | None,
     min_cycles: float,
 ) -> WindowSpectra | None:
-    """Spectral matrix of the records' full-length transforms, noise smoothed; None with too few records.
+    """Spectral matrix of the records' full-length transforms, noise smoothed; None when it cannot be had.
 
-    `data` holds one array per record, shape (n_channels, n_samples). The
-    member needs more records than inputs (the noise is measured between them).
+    `data` holds one array per record, shape (n_channels, n_samples). With
+    more records than inputs the noise is measured between them; with as
+    many or fewer (one sweep per axis, as most logs have) between each
+    record's neighbouring frequency bins (:mod:`sysid.freqresp._local`),
+    which needs no reference unless there is one input
+    (:func:`member_possible`).
     """
     n_records, n_inputs = len(data), len(inputs)
-    if n_records <= n_inputs:
+    if not member_possible(n_records, n_inputs, instrument):
         return None
     n_channels = data[0].shape[0]
     longest = max(block.shape[1] for block in data)
@@ -86,6 +94,7 @@ def whole_record_spectra(
             block - block[:, :edge].mean(axis=1, keepdims=True)
         ) * taper
         energy += float(np.sum(taper**2))
+    scales = [dt / (np.pi * float(np.sum(_edge_taper(block.shape[1], dt) ** 2))) for block in data]
     x = np.zeros((omega.size, n_records * n_channels), dtype=complex)
     for start in range(0, longest, _CHUNK):  # a long record's kernel would not fit in memory at once
         stop = min(start + _CHUNK, longest)
@@ -96,7 +105,14 @@ def whole_record_spectra(
     omega_low = 2.0 * np.pi * min_cycles / max(lengths_s)
     valid = omega >= omega_low * (1.0 - 1e-12)
     bin_rad_s = 2.0 * np.pi / min(lengths_s)
-    dof = _smooth_noise(spectra, omega, valid, inputs, outputs, instrument, n_records, bin_rad_s)
+    scale = dt / (np.pi * energy)
+    blocks = [stacked[k * n_channels : (k + 1) * n_channels, : block.shape[1]] for k, block in enumerate(data)]
+    if n_records > n_inputs:
+        dof = _smooth_noise(spectra, omega, valid, inputs, outputs, instrument, n_records, bin_rad_s)
+    elif n_inputs == 1:
+        dof = local_noise(spectra, blocks[0], omega, valid, inputs[0], outputs, scale, dt)
+    else:
+        dof = local_member(spectra, blocks, omega, valid, inputs, outputs, scales, dt)
     spectra[~valid] = 0.0
     return WindowSpectra(
         window_s=max(lengths_s),
@@ -106,6 +122,45 @@ def whole_record_spectra(
         omega_low=omega_low,
         noise_dof=dof,
     )
+
+
+def member_possible(n_records: int, n_inputs: int, instrument: int | None) -> bool:
+    """Whether the whole-record member can be formed: more records than inputs, one input, or no reference."""
+    return n_records > n_inputs or n_inputs == 1 or instrument is None
+
+
+def whole_record_floor(data: Sequence[np.ndarray], dt: float, omega: np.ndarray, min_cycles: float) -> np.ndarray:
+    """The records' whole-length spectral matrix, averaged over them and smoothed across frequency.
+
+    The floor of the whole-record member (records flown without the
+    excitation; see :func:`sysid.freqresp.estimate.frequency_responses`):
+    each record tapered and levelled as the member's are, the squared
+    transforms averaged over the records and over ``±max(3 bins, 10 %)`` of
+    each frequency (a floor of feedback and noise is smooth in frequency).
+    Shape (n_freq, n_channels, n_channels); zero below ``min_cycles``
+    periods of the longest record.
+    """
+    n_channels = data[0].shape[0]
+    edge = max(1, int(round(EDGE_S / dt)))
+    spectra = np.zeros((omega.size, n_channels, n_channels), dtype=complex)
+    energy = 0.0
+    for block in data:
+        taper = _edge_taper(block.shape[1], dt)
+        levelled = (block - block[:, :edge].mean(axis=1, keepdims=True)) * taper
+        x = np.zeros((omega.size, n_channels), dtype=complex)
+        for start in range(0, block.shape[1], _CHUNK):
+            stop = min(start + _CHUNK, block.shape[1])
+            x += _kernel(omega * dt, start, stop) @ levelled[:, start:stop].T
+        spectra += np.conj(x)[:, :, None] * x[:, None, :]
+        energy += float(np.sum(taper**2))
+    spectra *= dt / (np.pi * energy)
+    lengths_s = [block.shape[1] * dt for block in data]
+    valid = omega >= 2.0 * np.pi * min_cycles / max(lengths_s) * (1.0 - 1e-12)
+    half = np.maximum(SMOOTH_BINS * 2.0 * np.pi / min(lengths_s), SMOOTH_FRACTION * omega)
+    near = ((np.abs(omega[:, None] - omega[None, :]) <= half[:, None]) & valid[None, :]).astype(float)
+    smoothed = np.einsum("fg,gab->fab", near, spectra) / np.maximum(near.sum(axis=1), 1.0)[:, None, None]
+    smoothed[~valid] = 0.0
+    return cast(np.ndarray, smoothed)
 
 
 def significance_threshold(noise_dof: np.ndarray, level: float = SIGNIFICANCE) -> np.ndarray:

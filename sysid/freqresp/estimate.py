@@ -10,7 +10,7 @@ from flightlogs.errors import DataError, MissingSignalError
 from flightlogs.record import Record
 from sysid.freqresp._composite import composite_pair
 from sysid.freqresp._spectra import WindowSpectra, window_spectra
-from sysid.freqresp._whole import whole_record_spectra
+from sysid.freqresp._whole import member_possible, whole_record_floor, whole_record_spectra
 from sysid.freqresp.options import ResponseOptions
 from sysid.freqresp.response import FrequencyResponse
 
@@ -26,6 +26,8 @@ def frequency_responses(
     inputs: Sequence[str],
     outputs: Sequence[str],
     options: ResponseOptions = ResponseOptions(),
+    *,
+    quiet: Sequence[Record] = (),
 ) -> tuple[FrequencyResponse, ...]:
     """Composite frequency responses of every output to every input.
 
@@ -43,6 +45,12 @@ def frequency_responses(
         Output signal names (``q``, ``ax`` ...).
     options : ResponseOptions, optional
         Grid, windows, overlap, taper, reference, whole-record member.
+    quiet : sequence of Record, optional
+        Flight with the same signals and rate but none of this excitation
+        (other axes' maneuvers, hover: :func:`~sysid.freqresp.quiet_records`).
+        In closed loop they measure the floor the autopilot's feedback of
+        disturbances and noise puts into the inputs and outputs; without a
+        reference, that floor is removed from the responses (see Notes).
 
     Returns
     -------
@@ -72,10 +80,24 @@ def frequency_responses(
     (Bendat & Piersol), ``n_d`` the overlap-corrected number of averages
     (less one per conditioning input), see :mod:`sysid.freqresp._composite`.
     Grid points below ``2 pi min_cycles / T`` of the longest window ``T`` are
-    left out; with the whole-record member (``options.whole_record`` and more
-    records than inputs, :mod:`sysid.freqresp._whole`) ``T`` is the longest
-    record. With ``options.reference`` the estimate of the first input is the
+    left out; with the whole-record member (``options.whole_record``; more
+    records than inputs, one input, or no reference:
+    :mod:`sysid.freqresp._whole`) ``T`` is the longest record. With ``options.reference`` the estimate of the first input is the
     instrumental-variable one (:mod:`sysid.freqresp._conditioning`).
+
+    Closed loop without a reference: where the excitation does not dominate
+    the input, the input also carries the feedback ``x_d = -C y_d`` of
+    disturbances and sensor noise, coherent with the output through the
+    controller's inverse, and ``G_xy / G_xx`` tends to ``P (1 - f)`` (``f``
+    the feedback's share of ``G_xx``, the loop gain high) with a coherence
+    that barely drops. With `quiet` records, the same spectra computed on
+    them (same windows; smoothed whole-record transforms for the member) are
+    that feedback's floor ``F``, stationary over a flight; the response is
+    ``(G_jy - F_jy) / (G_jj - F_jj)`` (spectra conditioned on the other
+    inputs), and where the excitation does not carry at least
+    ``options.min_excitation_ratio`` times the floor's input power the
+    coherence is set to zero (feedback-dominated: not fitted). The coherence
+    is otherwise the measured one.
 
     Examples
     --------
@@ -111,7 +133,7 @@ def frequency_responses(
     instrument = len(inputs) if reference is not None else None
     output_rows = [len(inputs) + len(extra) + o for o in range(len(outputs))]
     lengths = _window_samples(data, dt, options)
-    whole = options.whole_record and len(data) > len(inputs)
+    whole = options.whole_record and member_possible(len(data), len(inputs), instrument)
     longest = max(block.shape[1] for block in data) if whole else max(lengths)
     omega = _grid(options, dt, longest)
     windows = [_spectra(data, dt, n, omega, options) for n in lengths]
@@ -126,11 +148,14 @@ def frequency_responses(
             min_cycles=options.min_cycles,
         )
         windows += [member] if member is not None else []
+    floors = _floors(quiet, channels, dt, windows, omega, options) if reference is None else None
     units = _units(records, channels)
     found = []
     for o, output in enumerate(outputs):
         for j, name in enumerate(inputs):
-            estimate = composite_pair(windows, omega, input_rows, j, output_rows[o], instrument)
+            estimate = composite_pair(
+                windows, omega, input_rows, j, output_rows[o], instrument, floors, options.min_excitation_ratio
+            )
             found.append(
                 FrequencyResponse(
                     input=name,
@@ -256,6 +281,41 @@ def _spectra(
     )
     assert found is not None  # every length fits the longest record (checked in _window_samples)
     return found
+
+
+def _floors(
+    quiet: Sequence[Record],
+    channels: tuple[str, ...],
+    dt: float,
+    windows: Sequence[WindowSpectra],
+    omega: np.ndarray,
+    options: ResponseOptions,
+) -> list[np.ndarray | None] | None:
+    """Spectra of the `quiet` records matching each member (None where none is long enough); None without any."""
+    if not quiet:
+        return None
+    step = _common_step(quiet)
+    if abs(step - dt) > _RATE_TOLERANCE * dt:
+        raise DataError(f"the quiet records are at {1 / step:.3f} Hz, the maneuvers at {1 / dt:.3f} Hz: resample them")
+    data = [_channels(record, channels) for record in quiet]
+    floors: list[np.ndarray | None] = []
+    for window in windows:
+        if window.noise_dof is not None:
+            floors.append(whole_record_floor(data, dt, omega, options.min_cycles))
+            continue
+        n_window = int(round(window.window_s / dt))
+        found = window_spectra(
+            data,
+            dt,
+            n_window,
+            omega,
+            overlap=options.overlap,
+            taper=options.taper,
+            min_cycles=options.min_cycles,
+            spacing=options.spacing,
+        )
+        floors.append(None if found is None else found.spectra)
+    return floors if any(f is not None for f in floors) else None
 
 
 def _units(records: Sequence[Record], channels: tuple[str, ...]) -> dict[str, str]:

@@ -61,12 +61,22 @@ class ResponseOptions:
         :mod:`sysid.freqresp._conditioning`). None: the inputs themselves.
     whole_record : bool
         Add the records' whole-length transforms to the composite where they
-        are significant (:mod:`sysid.freqresp._whole`; needs more records
-        than inputs). A record holding a whole maneuver from trim to trim
+        are significant (:mod:`sysid.freqresp._whole`; from as many records
+        as inputs or fewer, without a reference unless there is one input,
+        its noise comes from neighbouring bins: :mod:`sysid.freqresp._local`).
+        A record holding a whole maneuver from trim to trim
         gives ``Y = H X`` exactly, free of the windows' resolution bias near
         a closed loop's notch, an unstable pair and the sweep's fade-in
         tone; the grid then reaches down to ``min_cycles`` periods of the
         longest record. False: windows only (CIFER's composite).
+    min_excitation_ratio : float
+        With quiet records given (flight without the excitation, see
+        :func:`~sysid.freqresp.frequency_responses`): the least ratio of the
+        input's autospectrum in the maneuvers to its feedback floor for a
+        frequency to count; below it the coherence is set to zero. The
+        floor is subtracted above it, so the ratio bounds the correction's
+        share of the estimate: 4 (6 dB) keeps it to a quarter, which an
+        error of a quarter of the floor's own estimate turns into under 0.5 dB.
 
     Examples
     --------
@@ -88,6 +98,7 @@ class ResponseOptions:
     spacing: Literal["log", "linear"] = "log"
     reference: str | None = None
     whole_record: bool = True
+    min_excitation_ratio: float = 4.0
 
     def __post_init__(self) -> None:
         if not 0.0 < self.omega_min < self.omega_max or not np.isfinite(self.omega_max):
@@ -113,6 +124,8 @@ class ResponseOptions:
             raise ValueError(f"{self.min_cycles=} must be > 0")
         if self.spacing not in ("log", "linear"):
             raise ValueError(f"spacing={self.spacing!r} must be 'log' or 'linear'")
+        if not (self.min_excitation_ratio > 1.0 and np.isfinite(self.min_excitation_ratio)):
+            raise ValueError(f"{self.min_excitation_ratio=} must be a finite ratio > 1")
         if self.reference is not None and (not isinstance(self.reference, str) or not self.reference):
             raise ValueError(f"reference={self.reference!r} must be a signal name or None")
 

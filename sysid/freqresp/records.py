@@ -20,6 +20,9 @@ __all__ = [
     "DEFAULT_PAIRS",
     "EXCITATION",
     "maneuver_records",
+    "maneuver_band",
+    "quiet_records",
+    "within_band",
     "parse_pairs",
     "default_pairs",
     "reference_options",
@@ -92,6 +95,143 @@ def maneuver_records(
                 label = f"{flight.source.name} {axis} {kind} {segment.start_s:.2f}-{segment.end_s:.2f} s"
                 pieces.append(record.between(start, end, label=label))
     return pieces
+
+
+def quiet_records(
+    flights: Sequence[ConditionedFlight],
+    axis: str,
+    *,
+    before_s: float = 2.0,
+    after_s: float = 5.0,
+    min_s: float = 4.0,
+) -> list[Record]:
+    """Flight with no maneuver on `axis`: the pieces of the other axes' maneuvers and of hover, in time order.
+
+    In closed loop the mixer input of `axis` carries the autopilot's
+    feedback of sensor noise and disturbances all the time; flown with no
+    excitation on `axis`, these pieces measure that feedback alone (its
+    "floor"), which :func:`~sysid.freqresp.frequency_responses` removes from
+    the maneuvers' spectra. Only the other maneuvers (with the 1 s margin
+    :func:`maneuver_records` keeps) and hover segments count, so take-off,
+    landing and time on the ground never do.
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        Conditioned flights.
+    axis : {"lat", "lon", "yaw", "thr"}
+        Mixer axis whose maneuvers are kept out.
+    before_s, after_s : float, optional
+        Flight kept out before and after each maneuver on `axis`, s (the
+        response outlasts the excitation; default 2 s and 5 s).
+    min_s : float, optional
+        Shortest piece kept, s.
+
+    Returns
+    -------
+    list of Record
+        Pieces of the flights' records.
+
+    Raises
+    ------
+    DataError
+        If `axis` is not a mixer axis.
+    """
+    if axis not in AXES:
+        raise DataError(f"axis {axis!r} is not a mixer axis ({', '.join(AXES)})")
+    pieces: list[Record] = []
+    for flight in flights:
+        spans = sorted(
+            (s.start_s - (0.0 if s.kind == "hover" else 1.0), s.end_s + (0.0 if s.kind == "hover" else 1.0))
+            for s in flight.segments
+            if s.axis != axis
+        )
+        excited = [(s.start_s - before_s, s.end_s + after_s) for s in flight.segments if s.axis == axis]
+        for start, end in _merged(spans):
+            for first, last in _without((start, end), excited):
+                for record in flight.records:
+                    a, b = max(first, record.start_s), min(last, record.end_s)
+                    if b - a >= min_s and record.table.loc[a:b].shape[0] >= _MIN_PIECE_SAMPLES:
+                        pieces.append(record.between(a, b, label=f"{flight.source.name} no {axis} {a:.2f}-{b:.2f} s"))
+    return pieces
+
+
+def _merged(spans: Sequence[tuple[float, float]]) -> list[tuple[float, float]]:
+    out: list[tuple[float, float]] = []
+    for start, end in spans:
+        if out and start <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], end))
+        else:
+            out.append((start, end))
+    return out
+
+
+def _without(span: tuple[float, float], holes: Sequence[tuple[float, float]]) -> list[tuple[float, float]]:
+    parts = [span]
+    for low, high in holes:
+        parts = [piece for a, b in parts for piece in ((a, min(b, low)), (max(a, high), b)) if piece[1] > piece[0]]
+    return parts
+
+
+def maneuver_band(
+    flights: Sequence[ConditionedFlight], axis: str, *, kind: str = "sweep"
+) -> tuple[float, float] | None:
+    """The band the maneuvers of `kind` on `axis` excite, rad/s, from their segments (None if one does not say).
+
+    Outside it the mixer input carries only the autopilot's feedback of
+    sensor noise and disturbances, which in closed loop is coherent with the
+    output (``y / x = -1 / C``, the controller's inverse) and not the
+    airframe's response: a sweep's responses are computed over its band only
+    (Tischler & Remple: the identification range lies within the frequency
+    range of the excitation).
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        Conditioned flights.
+    axis : {"lat", "lon", "yaw", "thr"}
+        Mixer axis.
+    kind : str, optional
+        Maneuver kind.
+
+    Returns
+    -------
+    tuple of float or None
+        ``(2 pi min f_min_hz, 2 pi max f_max_hz)`` over the segments, or None
+        when there is none or one lacks ``f_min_hz`` or ``f_max_hz``.
+    """
+    segments = [s for f in flights for s in f.segments if s.axis == axis and s.kind == kind]
+    lows = [s.f_min_hz for s in segments if s.f_min_hz is not None and s.f_max_hz is not None]
+    highs = [s.f_max_hz for s in segments if s.f_min_hz is not None and s.f_max_hz is not None]
+    if not segments or len(lows) < len(segments):
+        return None
+    return 2.0 * np.pi * min(lows), 2.0 * np.pi * max(highs)
+
+
+def within_band(options: ResponseOptions, band: tuple[float, float] | None) -> ResponseOptions:
+    """`options` with the grid kept within `band` (rad/s) when the responses are computed without a reference.
+
+    The band matters to the direct estimate ``G_xy / G_xx`` only: out of it the
+    input carries nothing but the feedback (:func:`maneuver_band`). With a
+    reference the instrumental-variable estimate has no such bias, and its
+    coherence says how far the excitation reaches. A band outside the grid
+    leaves it as it is.
+
+    Parameters
+    ----------
+    options : ResponseOptions
+        Options of one axis's responses.
+    band : tuple of float or None
+        ``(omega_low, omega_high)``, rad/s, or None.
+
+    Returns
+    -------
+    ResponseOptions
+    """
+    if band is None or options.reference is not None or band[0] >= options.omega_max or band[1] <= options.omega_min:
+        return options
+    low, high = max(options.omega_min, band[0]), min(options.omega_max, band[1])
+    return replace(options, omega_min=min(low, high / 2.0), omega_max=high)
 
 
 def parse_pairs(text: str) -> tuple[tuple[str, str], ...]:
@@ -190,6 +330,13 @@ def flight_responses(
     computed together, so an output paired with two inputs (``ax/delta_lon``
     and ``ax/wind_lon``) gets responses conditioned on the other input.
 
+    Each axis's grid keeps within its maneuvers' band when their segments
+    give one and there is no reference (:func:`within_band`), and the flight
+    without that axis's maneuvers (:func:`quiet_records`) gives the
+    autopilot's feedback floor removed from the responses computed without a
+    reference from mixer inputs alone (with a measured disturbance such as
+    the wind among the inputs, conditioning on it takes its feedback out).
+
     Where every piece of an axis carries a varying ``excitation`` (ArduPilot
     logs its System ID chirp as SIDD) and the axis's mixer input is among the
     inputs, that excitation is the reference of the mixer input's responses
@@ -245,7 +392,11 @@ def flight_responses(
         outputs = list(dict.fromkeys(output for output, _ in group))
         chosen_options, note = reference_options(records, group_axis, inputs, kind, options, use_excitation)
         notes.append(note)
-        for response in frequency_responses(records, inputs, outputs, chosen_options):
+        chosen_options = within_band(chosen_options, maneuver_band(flights, group_axis, kind=kind))
+        needed = {*inputs, *outputs}
+        mixers_only = all(i.startswith("delta_") for i in inputs)  # a measured disturbance is conditioned on
+        quiet = [r for r in quiet_records(flights, group_axis) if needed <= set(r.signals)] if mixers_only else []
+        for response in frequency_responses(records, inputs, outputs, chosen_options, quiet=quiet):
             found[(response.output, response.input)] = response
         pieces[group_axis] = len(records)
     return FlightResponses(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
@@ -10,7 +11,7 @@ from flightlogs.errors import DataError
 from flightlogs.store.campaign import ingest_campaign
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify.engine import VerificationOptions, verify
-from sysid.verify.records import doublet_records
+from sysid.verify.records import MIXER_INPUTS, DoubletRecords, doublet_records
 from sysid.verify.results import Verification
 
 __all__ = ["verify_logs", "verify_flights"]
@@ -28,6 +29,7 @@ def verify_logs(
     before_s: float = 0.5,
     after_s: float = 1.0,
     progress: Callable[[str, int, int], None] | None = None,
+    unidentified: Mapping[str, str] | None = None,
 ) -> Verification:
     """Verify `model` (and `wind_model`) on every doublet of the logs.
 
@@ -52,6 +54,8 @@ def verify_logs(
         Quiet stretch kept before and response after each doublet, s.
     progress : callable, optional
         ``progress(file_name, done, total)`` while reading, bytes.
+    unidentified : Mapping[str, str], optional
+        Mixer inputs of the model's unidentified axes, with the reason (see :func:`verify_flights`).
 
     Returns
     -------
@@ -77,6 +81,7 @@ def verify_logs(
         options=options,
         before_s=before_s,
         after_s=after_s,
+        unidentified=unidentified,
     )
 
 
@@ -90,6 +95,7 @@ def verify_flights(
     before_s: float = 0.5,
     after_s: float = 1.0,
     hint: str = "give their times with --segments if they were not detected",
+    unidentified: Mapping[str, str] | None = None,
 ) -> Verification:
     """Verify `model` (and `wind_model`) on every doublet of conditioned flights (see :func:`verify_logs`).
 
@@ -109,25 +115,33 @@ def verify_flights(
         Quiet stretch kept before and response after each doublet, s.
     hint : str, optional
         What the message says to do when no doublet is found ("" for nothing).
+    unidentified : Mapping[str, str], optional
+        Mixer inputs of axes the identification left unidentified (``model``
+        lacks them), with the reason: their doublets are not verified, and
+        ``Verification.unverified`` says so.
 
     Returns
     -------
     Verification
+        ``unverified`` names every axis of the model without a doublet, and every unidentified axis.
 
     Raises
     ------
     DataError
-        If no flight holds a doublet on an axis of the model.
+        If no flight holds a doublet on an axis of the model (naming the unidentified axes too).
     """
     cut = doublet_records(flights, before_s=before_s, after_s=after_s)
     kept = [k for k, name in enumerate(cut.excited) if name in model.inputs]  # axes the model does not have
+    unverified = _unverified(model, flights, cut, unidentified or {})
     if not kept:
         names = ", ".join(dict.fromkeys(flight.source.name for flight in flights))
         raise DataError(
             f"no doublet found in {names} on an axis of the model ({', '.join(model.inputs)}): "
-            "validation needs doublets not used in the fit" + (f" ({hint})" if hint else "")
+            "validation needs doublets not used in the fit"
+            + (f" ({hint})" if hint else "")
+            + "".join(f"; {text}" for text in unverified if text.split(":")[0] not in _axis_names(model))
         )
-    return verify(
+    verification = verify(
         model,
         [cut.records[k] for k in kept],
         wind_model=wind_model,
@@ -135,3 +149,32 @@ def verify_flights(
         axes=axes,
         options=options,
     )
+    return replace(verification, unverified=tuple(unverified))
+
+
+def _axis_names(model: DelayedStateSpace) -> set[str]:
+    return {axis for axis, signal in MIXER_INPUTS.items() if signal in model.inputs}
+
+
+def _unverified(
+    model: DelayedStateSpace,
+    flights: Sequence[ConditionedFlight],
+    cut: DoubletRecords,
+    unidentified: Mapping[str, str],
+) -> list[str]:
+    """One sentence per mixer axis of the model without a doublet, and per unidentified axis."""
+    logs = len({f.source for f in flights})
+    in_logs = f"in {logs} log{'' if logs == 1 else 's'}"
+    out = []
+    for axis, signal in MIXER_INPUTS.items():
+        doublets = sum(name == signal for name in cut.excited)
+        if signal in unidentified:
+            seen = (
+                f"its {doublets} doublet{' is' if doublets == 1 else 's are'} not verified"
+                if doublets
+                else "not verified (no doublet either)"
+            )
+            out.append(f"{axis}: the model's {axis} axis is unidentified ({unidentified[signal]}); {seen}")
+        elif signal in model.inputs and not doublets:
+            out.append(f"{axis}: no doublet {in_logs}; not verified")
+    return out

@@ -8,36 +8,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from flightlogs.errors import ModelError
+from sysid.model.axes import reachable, restrict_model
 from sysid.model.statespace import DelayedStateSpace
 
 if TYPE_CHECKING:
     from sysid.fit import IdentifiedModel
 
 __all__ = ["driven_part", "axis_outputs"]
-
-
-def reachable(a: np.ndarray, start: np.ndarray) -> np.ndarray:
-    """States `start` reaches through A (``a[i, j] != 0``: state j drives state i), `start` included.
-
-    Pass ``a.T`` for the states that reach `start` instead.
-
-    Parameters
-    ----------
-    a : ndarray, shape (n_states, n_states)
-        State matrix.
-    start : ndarray of bool, shape (n_states,)
-        The states to start from.
-
-    Returns
-    -------
-    ndarray of bool, shape (n_states,)
-    """
-    reached = np.asarray(start, dtype=bool)
-    while True:
-        grown = reached | np.any(a[:, reached] != 0, axis=1)
-        if np.array_equal(grown, reached):
-            return reached
-        reached = grown
 
 
 def driven_part(model: DelayedStateSpace, excited: str) -> DelayedStateSpace:
@@ -71,17 +48,11 @@ def driven_part(model: DelayedStateSpace, excited: str) -> DelayedStateSpace:
     reached = reachable(a, np.any(b[:, columns] != 0, axis=1))
     rows = np.any(c[:, reached] != 0, axis=1) | np.any(d[:, columns] != 0, axis=1)
     keep_inputs = np.any(b[reached] != 0, axis=0) | np.any(d[rows] != 0, axis=0)
-    x, u, y = np.flatnonzero(reached), np.flatnonzero(keep_inputs), np.flatnonzero(rows)
-    return DelayedStateSpace(
-        a=a[np.ix_(x, x)],
-        b=b[np.ix_(x, u)],
-        c=c[np.ix_(y, x)],
-        d=d[np.ix_(y, u)],
-        states=tuple(model.states[i] for i in x),
-        inputs=tuple(model.inputs[j] for j in u),
-        outputs=tuple(model.outputs[i] for i in y),
-        input_delays_s=np.asarray(model.input_delays_s, dtype=float)[u],
-        trim=model.trim,
+    return restrict_model(
+        model,
+        states={model.states[i] for i in np.flatnonzero(reached)},
+        outputs={model.outputs[i] for i in np.flatnonzero(rows)},
+        inputs=np.flatnonzero(keep_inputs).tolist(),
     )
 
 

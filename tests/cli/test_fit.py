@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -64,7 +65,8 @@ def test_report_option_judges_by_the_limits_given(runner: CliRunner, flights: Pa
     """The --max-cr and --max-insensitivity of the fit travel with the model, into its report and its file."""
     report, out = tmp_path / "fit.html", tmp_path / "model.json"
     logs = [str(p) for p in sorted(flights.glob("*lon*.bin"))]
-    command = ["fit", *logs, "--max-cr", "35", "--max-insensitivity", "12", "-o", str(out), "--report", str(report)]
+    command = ["fit", *logs, "--partial", "--max-cr", "35", "--max-insensitivity", "12", "-o", str(out)]
+    command += ["--report", str(report)]
     result = runner.invoke(cli, [*command, "-q"])
     assert result.exit_code == 0, result.output
     page = report.read_text(encoding="utf-8")
@@ -81,12 +83,13 @@ def test_fit_reads_an_ingested_dataset(runner: CliRunner, flights: Path, tmp_pat
         cli, ["ingest", *logs, "--wind", str(flights), "--wind-distance", "4.6", "-o", str(dataset), "-q"]
     )
     assert ingested.exit_code == 0, ingested.output
-    result = runner.invoke(cli, ["fit", str(dataset), "--json", "-", "-q"])
+    result = runner.invoke(cli, ["fit", str(dataset), "--partial", "--json", "-", "-q"])
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
     assert set(summary["cost"]["responses"]) >= {"q/delta_lon", "ax/delta_lon"}
     assert summary["parameters"]["M_lon"]["status"] == "estimated"
-    assert summary["parameters"]["L_lat"]["status"] == "fixed"  # no lateral sweep in the dataset
+    lateral = summary["parameters"]["L_lat"]  # no lateral sweep in the dataset: no value, never the starting one
+    assert lateral["status"] == "unidentified" and lateral["value"] is None
 
 
 @pytest.mark.parametrize(
@@ -106,8 +109,59 @@ def test_fit_errors(runner: CliRunner, flights: Path, extra: list[str], code: in
     assert message in result.output
 
 
+def test_an_axis_without_a_sweep_is_an_error_naming_it(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
+    """Issue 14: the structure's starting values were printed as results with exit 0. Now: exit 1, one sentence
+    per missing axis saying why and what to do, and no file written."""
+    logs = [str(p) for p in sorted(flights.glob("*l[ao][nt]-*.bin"))]  # the lateral and pitch sweeps only
+    out = tmp_path / "model.json"
+    result = runner.invoke(cli, ["fit", *logs, "-o", str(out), "-q"])
+    assert result.exit_code == 1, result.output
+    assert "model hover: 2 of its 4 axes cannot be identified." in result.output
+    assert (
+        "yaw: no sweep found in 2 logs; the delta_yaw input never passed the sweep test; give the maneuvers with "
+        "--segments, or --partial to write a model of the other axes." in result.output
+    )
+    assert "thr: no sweep found in 2 logs" in result.output and "Traceback" not in result.output
+    assert not out.exists()
+
+
+def test_partial_writes_a_model_of_the_identified_axes(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
+    logs = [str(p) for p in sorted(flights.glob("*l[ao][nt]-*.bin"))]
+    out = tmp_path / "model.json"
+    result = runner.invoke(cli, ["fit", *logs, "--partial", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "warning: model hover is partial: it covers lat, lon only" in result.stderr
+    assert re.search(r"N_yaw +— +- +- +unidentified", result.stdout)  # no value, never the starting one
+    doc = json.loads(out.read_text())
+    axes = {a["axis"]: a for a in doc["axes"]}
+    assert axes["yaw"]["status"] == "unidentified" and axes["lon"]["status"] == "identified"
+    assert axes["yaw"]["reason"] == "no sweep found in 2 logs; the delta_yaw input never passed the sweep test"
+    assert doc["parameters"]["N_yaw"] == doc["parameters"]["N_yaw"] | {"value": None, "status": "unidentified"}
+    model = read_model(out)
+    assert [a.axis for a in model.unidentified_axes] == ["yaw", "thr"]
+    assert model.linear_model().inputs == ("delta_lat", "delta_lon")
+
+
 def test_help_has_an_example(runner: CliRunner) -> None:
     result = runner.invoke(cli, ["fit", "--help"])
     assert result.exit_code == 0 and "sysid fit sweeps/*.bin" in result.output
     help_text = " ".join(result.output.split())
     assert "[default: 20.0; x>0]" in help_text and "[default: 10.0; x>0]" in help_text  # Tischler's CR% and I%
+
+
+def test_the_maneuvers_can_be_given_with_segments(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
+    """--segments replaces detection: the pitch sweep given by its times is fitted; an axis the file does not
+    name is reported as such."""
+    log = sorted(flights.glob("*lon-sweep*.bin"))[0]
+    truth = json.loads(log.with_name(log.stem + "-truth.json").read_text())
+    (sweep,) = truth["maneuvers"]
+    given = tmp_path / "segments.csv"
+    given.write_text(f"start_s,end_s,axis,kind\n{sweep['start_s']},{sweep['end_s']},lon,sweep\n")
+    result = runner.invoke(cli, ["fit", str(log), "--segments", str(given), "--partial", "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert {"q/delta_lon", "ax/delta_lon"} <= set(summary["cost"]["responses"])
+    assert [a["axis"] for a in summary["axes"] if a["status"] == "identified"] == ["lon"]
+    strict = runner.invoke(cli, ["fit", str(log), "--segments", str(given), "-q"])
+    assert strict.exit_code == 1
+    assert "lat: no sweep found in 1 log; the maneuvers given name no lat sweep; give the maneuvers" in strict.output

@@ -68,3 +68,17 @@ def test_modes_errors(runner: CliRunner, args: list[str], code: int, message: st
     result = runner.invoke(cli, args)
     assert result.exit_code == code, result.output
     assert message in result.output
+
+
+def test_modes_of_a_partial_model_are_those_of_its_identified_axes(runner: CliRunner, tmp_path: Path) -> None:
+    """A model of pitch only: its pitch modes, and a line saying the other axes' modes are not known."""
+    structure = load_structure("hover")
+    truth, _ = structure_model(structure, dict(CALM_HOVER))
+    responses = synthetic_responses(truth, ["q/delta_lon", "ax/delta_lon", "u/delta_lon"], fit_range=(0.8, 50.0))
+    path = write_model(tmp_path / "pitch.json", model_from_fit(fit_frequency_responses(structure, responses)))
+    result = runner.invoke(cli, ["modes", str(path), "--json", "-"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert summary["unidentified_axes"] == ["lat", "yaw", "thr"]
+    assert {m["mode"] for m in summary["eigenvalues"]} <= {"pitch", "actuator"}
+    assert "the lat, yaw, thr axes are unidentified: their modes are not known and not listed" in result.stderr

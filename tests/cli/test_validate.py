@@ -19,7 +19,10 @@ from click.testing import CliRunner
 from simulator.campaign.fly import run_scenario
 from simulator.campaign.scenario import read_scenario
 from simulator.vehicle.identified import CALM_HOVER, STRONG_WIND_TERMS
+from sysid.fit import read_model, write_model
 from sysid_cli.main import cli
+
+from builders import with_unidentified
 
 SCENARIO = """
 [scenario]
@@ -136,3 +139,30 @@ def test_validate_without_doublets_fails_with_one_sentence(
     result = CliRunner().invoke(cli, ["validate", str(model), str(logs[0]), "--segments", str(segments)])
     assert result.exit_code == 1
     assert "no doublet found" in result.output and "Traceback" not in result.output
+
+
+def test_axes_without_doublets_are_said_not_verified(flights: tuple[Path, list[Path], list[Path]]) -> None:
+    """Lon doublets only: the lat, yaw and thr axes are named as not verified, with no TIC of nothing."""
+    model, logs, _ = flights
+    result = CliRunner().invoke(cli, ["validate", str(model), str(logs[0]), "--json", "-", "-q"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    for axis in ("lat", "yaw", "thr"):
+        assert f"{axis}: no doublet in 1 log; not verified" in summary["notes"]
+    assert not any(note.startswith("lon:") for note in summary["notes"])
+    assert set(summary["summary"]) == {"u", "q", "theta", "ax"}
+
+
+def test_an_unidentified_axis_is_not_verified(flights: tuple[Path, list[Path], list[Path]], tmp_path: Path) -> None:
+    """A model written with --partial whose lon axis is unidentified: its lon doublets are not simulated, and said."""
+    model, logs, _ = flights
+    pitch = {"X_u", "M_u", "X_lon", "M_lon", "tau_lon"}
+    partial = with_unidentified(read_model(model), pitch, {"lon": "no sweep found in 5 logs"})
+    path = write_model(tmp_path / "partial.json", partial)
+    result = CliRunner().invoke(cli, ["validate", str(path), str(logs[0])])
+    assert result.exit_code == 1, result.output
+    assert "no doublet found" in result.output
+    assert (
+        "lon: the model's lon axis is unidentified (no sweep found in 5 logs); its 1 doublet is not verified"
+        in result.output
+    )

@@ -18,7 +18,7 @@ from reports.model_report import model_report_html
 from sysid.fit import IdentifiedModel, model_verdict
 from sysid.verify import Verification
 
-from builders import STAMP, sample_verification, small_model
+from builders import STAMP, sample_verification, small_model, with_unidentified
 
 HOSTILE = '<script>alert("x")</script><img src=x onerror=alert(1)>'
 
@@ -181,3 +181,32 @@ def test_the_wind_of_the_trim_is_shown_as_speed_and_direction_from() -> None:
     model = dataclasses.replace(model, trim={"wind_n": -2.7 / math.sqrt(2), "wind_e": 2.7 / math.sqrt(2)})
     page = model_report_html(model, generated_utc=STAMP)
     assert "mean 2.7 m/s from 315°" in page
+
+
+def test_unidentified_parameters_show_no_value_flagged_and_the_missing_axis() -> None:
+    """Issue 14: a parameter no response informed is "—" and flagged, its axis named in the card and the verdict."""
+    pitch = {"X_u", "M_u", "X_lon", "M_lon", "tau_lon"}
+    model = with_unidentified(small_model(responses=False), pitch, {"lon": "no sweep found in 3 logs"})
+    page = model_report_html(model, generated_utc=STAMP)
+    row = _row(page, "M_lon")
+    assert '<td class="flag">—</td>' in row and '<td class="left flag">unidentified</td>' in row
+    assert "unidentified, so not simulated: lon (no sweep found in 3 logs)" in page
+    assert "5 unidentified (no value)" in page
+    assert (
+        '<p class="verdict warn">Acceptable model: lon unidentified (no sweep found in 3 logs): a model of lat, yaw, thr only'
+        in page
+    )
+
+
+def test_a_reduction_step_refused_for_its_cost_is_shown_kept_with_the_reason() -> None:
+    model = small_model(responses=False)
+    kept = dataclasses.replace(
+        model.reduction[0],
+        parameter="tau_yaw",
+        action="kept",
+        reason="I% = 11.2 > 10; removing it, the cost of r/delta_yaw rose from 2.8 to 83 (allowed: up to 4.8), so it stays",
+    )
+    page = model_report_html(dataclasses.replace(model, reduction=(kept,)), generated_utc=STAMP)
+    assert '<td class="left warn">kept</td>' in page
+    assert "the cost of r/delta_yaw rose from 2.8 to 83 (allowed: up to 4.8), so it stays" in page
+    assert "by more than 2 %, or the cost of any one response by more than 20 %" in page

@@ -17,10 +17,9 @@ from typing import Any
 import pytest
 
 from sysid.fit import DEFAULT_GUIDELINES, CostSummary, FitOptions, Guidelines, IdentifiedModel, model_verdict
-from sysid.fit.axes import AxisStatus
 from sysid.verify import OutputSummary, Verification
 
-from builders import small_model
+from builders import small_model, with_unidentified
 
 
 def _model(
@@ -195,23 +194,11 @@ def test_an_unverified_model_says_so() -> None:
     assert verdict.sentence.endswith("; not yet verified on doublets.")
 
 
-def _unidentified(model: IdentifiedModel, names: set[str], axes: tuple[AxisStatus, ...] = ()) -> IdentifiedModel:
-    parameters = tuple(
-        dataclasses.replace(
-            p, status="unidentified", value=math.nan, cr_percent=math.nan, insensitivity_percent=math.nan
-        )
-        if p.name in names
-        else p
-        for p in model.parameters
-    )
-    return dataclasses.replace(model, parameters=parameters, axes=axes)
-
-
 LON = {"X_u", "M_u", "X_lon", "M_lon", "tau_lon"}
 
 
 def test_a_model_with_an_unidentified_axis_is_never_good_and_says_which() -> None:
-    model = _unidentified(_model(), LON)
+    model = with_unidentified(_model(), LON)
     assert [a.axis for a in model.unidentified_axes] == ["lon"]  # no axes recorded: derived from the parameters
     verdict = model_verdict(model, _verification({"p": 0.05}))
     assert verdict.grade == "acceptable"
@@ -221,15 +208,14 @@ def test_a_model_with_an_unidentified_axis_is_never_good_and_says_which() -> Non
     )
     check = next(c for c in verdict.checks if c.guideline == "every axis identified")
     assert (check.value, check.grade) == ("3 of 4", "acceptable")
-    recorded = AxisStatus(axis="lon", input="delta_lon", status="unidentified", reason="no sweep found in 3 logs")
-    said = _unidentified(_model(), LON, axes=(recorded,))
+    said = with_unidentified(_model(), LON, {"lon": "no sweep found in 3 logs"})
     assert "lon unidentified (no sweep found in 3 logs)" in model_verdict(said).sentence
 
 
 def test_a_fit_of_two_parameters_is_not_good() -> None:
     """Issue 14: the verdict was green for a fit of 2 parameters."""
     keep = {"N_yaw", "tau_yaw"}
-    model = _unidentified(_model(), {p.name for p in _model().parameters if p.status == "estimated"} - keep)
+    model = with_unidentified(_model(), {p.name for p in _model().parameters if p.status == "estimated"} - keep)
     verdict = model_verdict(model)
     check = next(c for c in verdict.checks if c.guideline == "free parameters estimated")
     assert (check.value, check.grade) == ("2 of 17", "acceptable")

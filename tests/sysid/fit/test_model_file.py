@@ -31,6 +31,8 @@ from sysid.fit import (
 from sysid.model import load_structure, structure_model
 from sysid.model.statespace import DelayedStateSpace
 
+from builders import with_unidentified
+
 PAIRS = ["p/delta_lat", "ay/delta_lat", "q/delta_lon", "ax/delta_lon", "r/delta_yaw", "az/delta_thr"]
 
 
@@ -256,16 +258,7 @@ def test_a_partial_model_is_simulated_on_its_identified_axes_only(partial: Ident
 def test_nothing_builds_matrices_from_an_unidentified_parameter(partial: IdentifiedModel) -> None:
     with pytest.raises(ModelError, match="N_yaw has no value"):
         structure_model(load_structure("hover"), {"N_yaw": math.nan})
-    nothing = dataclasses.replace(
-        partial,
-        parameters=tuple(
-            dataclasses.replace(
-                p, status="unidentified", value=math.nan, cr_percent=math.nan, insensitivity_percent=math.nan
-            )
-            for p in partial.parameters
-        ),
-        axes=(),
-    )
+    nothing = with_unidentified(partial, {p.name for p in partial.parameters})
     with pytest.raises(ModelError, match="no identified axis"):
         nothing.linear_model()
 

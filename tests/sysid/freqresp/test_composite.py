@@ -6,8 +6,9 @@ filters, so the truth is exact (``freqz`` at ``omega dt``). The conditioned
 input's correlated part, ``H1 + H2 G_12 / G_11``, and are visibly biased.
 
 The windows' composite (CIFER's) is compared with its single windows with
-the whole-record member switched off; the member's own rules (more records
-than inputs, significance against its noise) are tested at the end.
+the whole-record member switched off; the member's own rules (its noise
+between records or, from one record, between bins; significance against
+that noise) are tested at the end.
 """
 
 from __future__ import annotations
@@ -171,23 +172,29 @@ def test_composite_random_error_lies_between_its_windows() -> None:
     assert np.median(composite.random_error[high] / singles[-1].random_error[high]) < 0.5
 
 
-def test_the_whole_record_member_needs_more_records_than_inputs() -> None:
-    """Its noise is measured between records: one record (or as many as inputs) leaves the windows alone."""
-    records, _ = _lag_sweeps(0.1, seed=6)
+def test_the_whole_record_member_from_one_record_measures_its_noise_between_bins() -> None:
+    """More records than inputs: the noise between records. One record: between its neighbouring bins
+    (``sysid.freqresp._local``); either way the grid reaches down to 3 periods of the 38 s records,
+    below the longest window's 3 periods."""
+    records, model = _lag_sweeps(0.1, seed=6)
     (one,) = frequency_responses(records[:1], ["x"], ["y"])
     (two,) = frequency_responses(records[:2], ["x"], ["y"])
-    assert not one.whole_record and two.whole_record
-    longest_window = max(one.windows_s)
-    assert one.omega[0] >= 2 * np.pi * 3 / longest_window * (1 - 1e-9)
-    assert two.omega[0] < 2 * np.pi * 3 / longest_window  # down to 3 periods of the 38 s records
-    assert two.omega[0] >= 2 * np.pi * 3 / 38.0 * (1 - 1e-9)
+    assert one.whole_record and two.whole_record
+    longest_window = max(two.windows_s)
+    for response in (one, two):
+        assert response.omega[0] < 2 * np.pi * 3 / longest_window
+        assert response.omega[0] >= 2 * np.pi * 3 / 38.0 * (1 - 1e-9)
+    truth = model.frequency_response(one.omega)[:, 0, 0]
+    low = one.omega < 2 * np.pi * 3 / longest_window  # only the member reaches here
+    assert np.all(one.coherence[low] > 0.5)
+    assert np.sqrt(np.mean(np.abs(np.log(one.response[low] / truth[low])) ** 2)) < 0.1
 
 
-@pytest.mark.parametrize("n_records", [2, 3])
+@pytest.mark.parametrize("n_records", [1, 2, 3])
 def test_noise_only_records_never_look_coherent(n_records: int) -> None:
-    """An output unrelated to the sweep: from 2 or 3 records the member's own coherence is 0.5 or more at a
-    few per cent of the frequencies by chance; its significance test (1e-4) keeps it out, so the response is
-    the windows' composite where the windows reach and has no coherence below."""
+    """An output unrelated to the sweep: from 1, 2 or 3 records the member's own coherence is 0.5 or more at
+    a few per cent of the frequencies by chance; its significance test (1e-4) keeps it out, so the response
+    is the windows' composite where the windows reach and has no coherence below."""
     records, _ = _lag_sweeps(0.1, seed=7)
     rng = np.random.default_rng(8)
     unrelated = [_record({"x": r["x"], "y": rng.normal(size=r["x"].size)}) for r in records[:n_records]]

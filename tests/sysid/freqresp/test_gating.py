@@ -184,12 +184,15 @@ RATE_HZ = 100.0
 def _flight(*, gap: tuple[float, float] | None = None, seed: int = 0, excitation: str = "none") -> ConditionedFlight:
     """100 s at 100 Hz: a lon sweep 10-50 s (q = 2 delta_lon + noise), a lat sweep 60-90 s, a lon doublet 52-54 s.
 
+    Outside the lon sweep (and its 1 s margins) delta_lon is a twentieth as large, a closed loop's feedback:
+    flight without a lon maneuver is the floor :func:`flight_responses` removes (``quiet_records``).
+
     `excitation`: "none" (as PX4), "sweeps" (logged during the sweeps only, as ArduPilot's SIDD: the lon one
     is delta_lon there, the mixer input being the excitation itself), "lat" (during the lat sweep only).
     """
     rng = np.random.default_rng(seed)
     t = np.arange(int(100 * RATE_HZ)) / RATE_HZ
-    delta = rng.normal(size=t.size)
+    delta = rng.normal(size=t.size) * np.where((t >= 9.0) & (t <= 51.0), 1.0, 0.05)
     columns = {
         "delta_lon": delta,
         "q": 2.0 * delta + 0.1 * rng.normal(size=t.size),

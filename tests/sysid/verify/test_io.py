@@ -99,3 +99,10 @@ def test_a_file_that_is_not_json_is_refused(tmp_path: Path) -> None:
         read_verification(path)
     with pytest.raises(DataError, match="cannot read"):
         read_verification(tmp_path / "missing.json")
+
+
+def test_the_axes_not_verified_are_saved(sample: Verification, tmp_path: Path) -> None:
+    said = dataclasses.replace(sample, unverified=("lat: no doublet in 2 logs; not verified",))
+    loaded = read_verification(write_verification(tmp_path / "v.json", said)).verification
+    assert loaded.unverified == ("lat: no doublet in 2 logs; not verified",)
+    assert read_verification(write_verification(tmp_path / "w.json", sample)).verification.unverified == ()
