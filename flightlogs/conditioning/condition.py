@@ -540,12 +540,24 @@ def _segments(
     kept = [
         s
         for s in detected
-        if not any(_overlaps(s, run) for run in logged) and (s.kind == "hover" or _flown(s, time_base, flying, vd))
+        if not any(_overlaps(s, run) for run in logged) and s.kind != "hover" and _flown(s, time_base, flying, vd)
     ]
-    return tuple(sorted([*logged, *kept], key=lambda s: s.start_s))
+    hovers = [piece for s in detected if s.kind == "hover" for piece in _airborne(s, time_base, flying)]
+    return tuple(sorted([*logged, *kept, *hovers], key=lambda s: s.start_s))
+
+
+def _airborne(hover: Segment, time_base: np.ndarray, flying: np.ndarray) -> list[Segment]:
+    """The parts of a quiet stretch where the vehicle flies (ground time is quiet too, but no trim)."""
+    inside = flying & (time_base >= hover.start_s) & (time_base <= hover.end_s)
+    return [
+        replace(hover, start_s=float(time_base[a]), end_s=float(time_base[b - 1]))
+        for a, b in true_runs(inside)
+        if time_base[b - 1] - time_base[a] >= _MIN_HOVER_S
+    ]
 
 
 _THRUST_ON = 0.3  # flying: thrust above this fraction of its 95th percentile
+_MIN_HOVER_S = 3.0  # shortest hover kept once ground time is taken out, s (as detect_segments')
 _SETTLE_S = 2.0  # flying: this long after take-off and before landing are neither; the hover before a maneuver
 _LEVEL_M_S = 0.5  # level hover: |mean vertical speed| over the _SETTLE_S before a maneuver below this
 
