@@ -11,7 +11,10 @@ accelerometer outputs is explained by ``H1 G_w u_w(t - tau_w)``: the G_w
 entries are found by linear least squares at given delays, each wind delay
 by a 1-D scan (coarse then fine, coordinate-wise, twice over), then all of
 them are polished together by nonlinear least squares. Each output's
-residual is weighted by its own level. Wind parameters that miss the CR% /
+residual is weighted by its own level, and each record's mean is taken out of
+the residual and of the wind (a per-record bias, as VERIFY's: accelerometer
+bias and the trim leave a constant the wind does not explain). Wind
+parameters that miss the CR% /
 I% guidelines are dropped one at a time, as in step 1 (a wind delay the
 data cannot resolve becomes 0).
 
@@ -121,7 +124,8 @@ def _prediction_data(
     for record in records:
         x, u = _states(record, structure, plain, m)
         y = np.column_stack([record[o] for o in outputs])
-        residual.append(y - x @ m.c[rows].T - u @ m.d[rows].T)
+        r = y - x @ m.c[rows].T - u @ m.d[rows].T
+        residual.append(r - r.mean(axis=0))  # a bias per record (sensor bias, trim): not the wind's
         winds.append(np.column_stack([record[s] for s in signals]))
         times.append(record.time_s)
     scale = 1.0 / np.maximum(np.vstack(residual).std(axis=0), 1e-12)
@@ -192,7 +196,8 @@ class _Problem:
         if key not in self._cache:
             if len(self._cache) > 64:  # the scan revisits few delays; the polish visits many once
                 self._cache.clear()
-            self._cache[key] = [np.interp(t - tau, t, w[:, k]) for t, w in zip(self.data.times, self.data.winds)]
+            shifted = [np.interp(t - tau, t, w[:, k]) for t, w in zip(self.data.times, self.data.winds)]
+            self._cache[key] = [x - x.mean() for x in shifted]  # as the residual: each record's bias taken out
         return self._cache[key]
 
     def parts(self, theta: np.ndarray) -> tuple[SystemMatrices, list[np.ndarray]]:

@@ -43,3 +43,25 @@ def test_partial_marks_that_axis_unidentified(independent_corpus, tmp_path: Path
     for name in ("Y_v", "L_v", "Y_lat", "L_lat", "tau_lat"):
         assert doc["parameters"][name]["value"] is None and doc["parameters"][name]["status"] == "unidentified"
     assert read_model(out).linear_model().inputs == ("delta_lon", "delta_yaw", "delta_thr")
+
+
+def test_the_wind_term_cuts_the_doublets_error_in_strong_wind(independent_corpus, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """Issue 14 done-when: strong-wind logs + anemometer CSV of the independent generator; G_w must cut the
+    doublets' ax and az RMS error by at least 15 %. Measured on heldout-ap-wind: ax -25 %, az -52 %; before the
+    per-record bias of the wind step and the trim over flight only, every G_w term was dropped (0 %)."""
+    files = independent_corpus.files("heldout-ap-wind")
+    wind = ["--segments", str(files.segments_csv), "--wind", str(files.anemometer_csv), "--wind-distance", "4.6"]
+    model = tmp_path / "model.json"
+    runner = CliRunner()
+    fitted = runner.invoke(cli, ["fit", str(files.log), *wind, "--model", "hover-wind", "--partial", "-o", str(model)])
+    assert fitted.exit_code == 0, fitted.output
+    summary = tmp_path / "validation.json"
+    checked = runner.invoke(cli, ["validate", str(model), str(files.log), *wind, "--json", str(summary), "-q"])
+    assert checked.exit_code == 0, checked.output
+    correction = json.loads(summary.read_text())["wind_correction"]
+    assert correction["ax"]["reduction_percent"] >= 15.0 and correction["az"]["reduction_percent"] >= 15.0
+    parameters = json.loads(model.read_text())["parameters"]
+    truth = files.truth.parameters
+    for name in ("X_w_lon", "Z_w_lon"):  # Table 3.5 strong wind; same sign, within 30 % (measured -19 %, -10 %)
+        assert parameters[name]["status"] == "estimated"
+        assert abs(parameters[name]["value"] / truth[name] - 1.0) < 0.3, (name, parameters[name], truth[name])
