@@ -484,9 +484,7 @@ def _ringing(sweep: FoundSweep, steps: Sequence[FoundManeuver], dt: float) -> bo
     return outside * dt < _MIN_TONE_S
 
 
-def _check_responses(
-    responses: Mapping[str, Mapping[str, np.ndarray]], n: int
-) -> dict[str, dict[str, np.ndarray]]:
+def _check_responses(responses: Mapping[str, Mapping[str, np.ndarray]], n: int) -> dict[str, dict[str, np.ndarray]]:
     checked = {}
     for axis, named in responses.items():
         if axis not in AXES:
