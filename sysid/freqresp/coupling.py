@@ -20,8 +20,7 @@ import numpy as np
 
 from flightlogs.record import Record
 from sysid.freqresp._conditioning import coherence
-from sysid.freqresp._spectra import window_spectra
-from sysid.freqresp.estimate import _channels, _common_step, _grid, _window_samples
+from sysid.freqresp.estimate import _channels, _common_step, _grid, _window_samples, _windowed
 from sysid.freqresp.options import ResponseOptions
 
 __all__ = ["coupled_inputs"]
@@ -90,16 +89,7 @@ def coupled_inputs(
         if name == control or all(np.ptp(block[1]) == 0 for block in pair):
             continue
         for n_window in lengths:
-            spectra = window_spectra(
-                pair,
-                dt,
-                n_window,
-                omega,
-                overlap=options.overlap,
-                taper=options.taper,
-                min_cycles=options.min_cycles,
-                spacing=options.spacing,
-            )
+            spectra = _windowed(pair, dt, n_window, omega, options)
             if spectra is None or spectra.n_effective <= 1.0:
                 continue
             reached = omega >= spectra.omega_low * (1.0 - 1e-12)

@@ -266,10 +266,11 @@ def _grid(options: ResponseOptions, dt: float, longest: int) -> np.ndarray:
     return kept
 
 
-def _spectra(
+def _windowed(
     data: Sequence[np.ndarray], dt: float, n_window: int, omega: np.ndarray, options: ResponseOptions
-) -> WindowSpectra:
-    found = window_spectra(
+) -> WindowSpectra | None:
+    """:func:`~sysid.freqresp._spectra.window_spectra` with the overlap, taper, cycles and spacing of `options`."""
+    return window_spectra(
         data,
         dt,
         n_window,
@@ -279,6 +280,12 @@ def _spectra(
         min_cycles=options.min_cycles,
         spacing=options.spacing,
     )
+
+
+def _spectra(
+    data: Sequence[np.ndarray], dt: float, n_window: int, omega: np.ndarray, options: ResponseOptions
+) -> WindowSpectra:
+    found = _windowed(data, dt, n_window, omega, options)
     assert found is not None  # every length fits the longest record (checked in _window_samples)
     return found
 
@@ -303,17 +310,7 @@ def _floors(
         if window.noise_dof is not None:
             floors.append(whole_record_floor(data, dt, omega, options.min_cycles))
             continue
-        n_window = int(round(window.window_s / dt))
-        found = window_spectra(
-            data,
-            dt,
-            n_window,
-            omega,
-            overlap=options.overlap,
-            taper=options.taper,
-            min_cycles=options.min_cycles,
-            spacing=options.spacing,
-        )
+        found = _windowed(data, dt, int(round(window.window_s / dt)), omega, options)
         floors.append(None if found is None else found.spectra)
     return floors if any(f is not None for f in floors) else None
 
