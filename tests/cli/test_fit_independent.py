@@ -7,6 +7,7 @@ PX4 log with lon, yaw and thrust sweeps and doublets, nothing logged about the e
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -65,3 +66,18 @@ def test_the_wind_term_cuts_the_doublets_error_in_strong_wind(independent_corpus
     for name in ("X_w_lon", "Z_w_lon"):  # Table 3.5 strong wind; same sign, within 30 % (measured -19 %, -10 %)
         assert parameters[name]["status"] == "estimated"
         assert abs(parameters[name]["value"] / truth[name] - 1.0) < 0.3, (name, parameters[name], truth[name])
+
+
+def test_the_report_of_a_four_axis_fit_has_the_bode_of_every_axis(independent_corpus, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """Issue 14 done-when: the report of such a fit has the Bode figures of all four axes, each with the model."""
+    files = independent_corpus.files("heldout-px4-sweeps")  # a sweep on every axis, PX4, nothing about it logged
+    report = tmp_path / "fit.html"
+    command = ["fit", str(files.log), "-o", str(tmp_path / "model.json"), "--report", str(report), "-q"]
+    result = CliRunner().invoke(cli, command)
+    assert result.exit_code == 0, result.output
+    page = report.read_text()
+    for signal in ("delta_lat", "delta_lon", "delta_yaw", "delta_thr"):
+        assert re.search(
+            rf"Responses to {signal} \([^)]*\)? ?mixer input\): flight data \(solid\) and identified model", page
+        )
+    assert page.count("<svg") >= 4
