@@ -60,8 +60,9 @@ def test_default_pairs_from_a_dataset_with_outputs_reopened(demo: dict[str, Path
     assert "q/delta_lon" in plot.read_text() and "kept" in result.stderr
     # the simulator's ArduPilot log carries SIDD: the excitation is every axis's reference, said so
     assert all(entry["reference"] == "excitation" for entry in summary["responses"])
+    assert all(r.reference == "excitation" for r in responses)
     # one piece per axis: the whole-record member now comes from that one record (its noise from neighbouring bins)
-    assert all(r.reference == "excitation" and r.whole_record for r in responses)
+    assert all(by_pair[pair].whole_record for pair in ("q/delta_lon", "p/delta_lat", "r/delta_yaw", "az/delta_thr"))
     assert (
         summary["notes"][1] == "lon: the logged excitation (SIDD) is the reference of the delta_lon responses, "
         "H = G_ry / G_rx."
