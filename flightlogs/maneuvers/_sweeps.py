@@ -42,7 +42,6 @@ _MIN_PERIOD_S = 4.0  # shortest sweeping piece, s
 _MIN_RHO = 0.8  # Spearman ρ of log ridge frequency against time, in magnitude
 _MIN_RATIO = 3.0  # ridge frequency range (90th over 10th percentile)
 _MIN_MEDIAN_SCORE = 10.0  # median score along a sweep's ridge
-_MAX_WIDTH_OCTAVES = 2.5  # a tone lights about 1.8 octaves of bands (cycles = 4); a multisine many more
 _YIELD = 3.0  # a frame where another axis scores this many times higher is that axis's
 _THRESHOLD, _TREND_S, _BURST_MERGE_S, _MIN_ACTIVE_S = 4.0, 10.0, 2.0, 0.3  # time-domain edges, as detect_segments
 _EDGE_WINDOW_S = 15.0  # edges are searched this far outside the ridge, s
@@ -87,7 +86,6 @@ class _Ridge:
 
     score: np.ndarray  # (n_frames,)
     freq_hz: np.ndarray  # (n_frames,)
-    width_octaves: np.ndarray  # (n_frames,) span of the bands above a tenth of the ridge's score
     trace: np.ndarray  # (n_frames,) index into the trace names
     names: tuple[str, ...]
 
@@ -131,10 +129,8 @@ def _ridge(named: Mapping[str, np.ndarray], dt: float, freqs: np.ndarray, step: 
     band = np.argmax(combined, axis=1)
     frames = np.arange(band.size)
     width = max(1, int(round(_SMOOTH_S / (step * dt)))) | 1
-    loud = combined > np.maximum(_SCORE, 0.1 * combined[frames, band])[:, None]
     return _Ridge(
         score=median_filter(combined[frames, band], size=width, mode="nearest"),
-        width_octaves=median_filter(loud.sum(axis=1) / _PER_OCTAVE, size=width, mode="nearest"),
         freq_hz=np.exp(median_filter(np.log(freqs[band]), size=width, mode="nearest")),
         trace=best_trace[frames, band],
         names=tuple(named),
@@ -236,7 +232,8 @@ def _tones(
 
 def _periodic(ridge: _Ridge, swept: list[tuple[int, int]], frame_s: float) -> bool:
     """Whether sweeping pieces repeat one another: short, back to back, the same way over the same band."""
-    if len(swept) < 2 or any((hi - lo) * frame_s >= _MIN_SWEEP_S for lo, hi in swept):
+    lengths = [(hi - lo) * frame_s for lo, hi in swept]
+    if len(swept) < 2 or np.median(lengths) >= _MIN_SWEEP_S:  # the outer pieces may be stretched by a slow band
         return False
     if len({_direction(ridge, *p) for p in swept}) > 1:
         return False

@@ -1,0 +1,65 @@
+"""Sweeps and multisines by their time-frequency ridge (``detect_segments(..., responses=...)``), on signals
+with known truth built here: a chirp whose low-frequency part the feedback has cancelled from the input, a
+Schroeder multisine, and noise alone."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from flightlogs.maneuvers import detect_segments
+
+DT = 0.01
+T = np.arange(0.0, 120.0, DT)
+
+
+def _chirp(start_s: float, duration_s: float, f0: float, f1: float) -> np.ndarray:
+    """Logarithmic chirp from f0 to f1 Hz with 1 s raised-cosine fades, zero outside."""
+    tau = T - start_s
+    inside = (tau >= 0) & (tau <= duration_s)
+    k = np.log(f1 / f0) / duration_s
+    phase = 2 * np.pi * f0 * np.expm1(k * np.clip(tau, 0, duration_s)) / k
+    fade = np.clip(np.minimum(tau, duration_s - tau), 0, 1.0)
+    return np.where(inside, np.sin(phase) * 0.5 * (1 - np.cos(np.pi * fade)), 0.0)
+
+
+def _high_passed(x: np.ndarray, corner_hz: float) -> np.ndarray:
+    """What a loop with crossover `corner_hz` leaves of an input excitation: its low frequencies cancelled."""
+    spectrum = np.fft.rfft(x)
+    f = np.fft.rfftfreq(x.size, DT)
+    return np.fft.irfft(spectrum * (1j * f / corner_hz) / (1 + 1j * f / corner_hz), x.size)
+
+
+@pytest.mark.parametrize(("f0", "f1", "direction"), [(0.1, 8.0, "up"), (8.0, 0.1, "down")])
+def test_a_chirp_is_found_from_input_and_response_together(f0: float, f1: float, direction: str) -> None:
+    """The input alone keeps only the chirp's fast part and the response its slow part; together, one sweep."""
+    rng = np.random.default_rng(3)
+    chirp = _chirp(30.0, 40.0, f0, f1)
+    delta = 0.06 * _high_passed(chirp, 1.0) + rng.normal(0, 0.003, T.size)
+    theta = 0.05 * (chirp - _high_passed(chirp, 1.0)) + rng.normal(0, 0.002, T.size)
+    (found,) = detect_segments(T, {}, responses={"lon": {"delta_lon": delta, "theta": theta}}, min_hover_s=1e9)
+    assert (found.axis, found.kind) == ("lon", "sweep")
+    assert found.detail.startswith(f"{direction} ridge in")
+    assert 28.0 <= found.start_s <= 31.5 and 68.5 <= found.end_s <= 72.0  # truth 30-70 s with 1 s fades
+    assert found.f_min_hz is not None and found.f_max_hz is not None
+    assert found.f_min_hz <= 0.5 and found.f_max_hz >= 6.0  # the ridge's range where it stands out of the noise
+
+
+def test_a_schroeder_multisine_is_a_multisine() -> None:
+    """Schroeder phases sweep the band once a period: a saw-tooth ridge, not one sweep."""
+    rng = np.random.default_rng(4)
+    harmonics = np.arange(2, 61)  # 0.2-6 Hz over a 10 s period
+    k = np.arange(1, harmonics.size + 1)
+    phases = -np.pi * k * (k - 1) / harmonics.size  # Schroeder (1970)
+    signal = np.cos(2 * np.pi * np.outer(T, harmonics) / 10.0 + phases).sum(axis=1)
+    signal *= (T >= 40.0) & (T < 70.0)
+    x = 0.06 * signal / np.abs(signal).max() + rng.normal(0, 0.002, T.size)
+    (found,) = detect_segments(T, {}, responses={"thr": {"delta_thr": x}}, min_hover_s=1e9)
+    assert (found.axis, found.kind) == ("thr", "multisine")
+    assert 39.0 <= found.start_s <= 41.0 and 69.0 <= found.end_s <= 71.0
+
+
+def test_noise_alone_is_no_maneuver() -> None:
+    rng = np.random.default_rng(5)
+    traces = {"lat": {"delta_lat": rng.normal(0, 0.003, T.size), "p": rng.normal(0, 0.01, T.size)}}
+    assert detect_segments(T, {}, responses=traces, min_hover_s=1e9) == ()
