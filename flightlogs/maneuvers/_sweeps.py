@@ -8,10 +8,13 @@ envelopes normalised by their own noise floor (:mod:`._scalogram`), and the
 axis's score at each time and frequency is the best of its traces. A sweep
 is a stretch where that score stands far out of the noise along one ridge
 whose frequency rises or falls steadily (Spearman's ρ of log frequency
-against time) over at least a 3:1 range — neither the trim, nor a pilot's
-repositioning, nor a multisine (energy at many frequencies at once, no
-trend) has that. Edges are then found in the time domain, on each trace,
-where it leaves its local baseline (:func:`._detection._edges`).
+against time) over at least a 3:1 range and 15 s — neither the trim nor a
+pilot's repositioning has that. A Schroeder-phased multisine sweeps its band
+once a period: its ridge is a saw-tooth of short, like pieces, and it is
+reported as a multisine. A doublet's ring-down can fall steadily for a
+while; the caller lets the strict doublet fit win there. Edges are found in
+the time domain, on each trace, where it leaves its local baseline
+(:func:`._detection._edges`): the earliest start and the latest end.
 """
 
 from __future__ import annotations
