@@ -18,7 +18,9 @@ v1.14 on).
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 
 __all__ = [
     "SignalSpec",
@@ -26,6 +28,7 @@ __all__ = [
     "LOGGED_SIGNALS",
     "ESTIMATOR_SIGNALS",
     "REFERENCE_SIGNALS",
+    "COMMAND_AXES",
     "is_canonical",
     "describe",
 ]
@@ -138,6 +141,17 @@ REFERENCE_SIGNALS: tuple[str, ...] = (
     "stick_lon",
     "stick_yaw",
     "stick_thr",
+)
+
+#: The control axis each command moves: the mixer inputs and the references.
+COMMAND_AXES: Mapping[str, str] = MappingProxyType(
+    {
+        **{f"delta_{axis}": axis for axis in ("lat", "lon", "yaw", "thr")},
+        **{f"stick_{axis}": axis for axis in ("lat", "lon", "yaw", "thr")},
+        **dict.fromkeys(("p_ref", "phi_ref"), "lat"),
+        **dict.fromkeys(("q_ref", "theta_ref"), "lon"),
+        **dict.fromkeys(("r_ref", "psi_ref"), "yaw"),
+    }
 )
 
 _MOTOR = re.compile(r"motor_([1-9][0-9]?)")

@@ -601,13 +601,29 @@ def _flown(segment: Segment, time_base: np.ndarray, flying: np.ndarray, vd: np.n
 def _finite_traces(
     values: dict[str, np.ndarray], shown: dict[str, list[str]], start: int, stop: int
 ) -> dict[str, dict[str, np.ndarray]]:
-    """The traces of each axis on samples [start, stop) that are finite there."""
+    """The traces of each axis on samples [start, stop) that are finite on most of them, gaps bridged.
+
+    A trace with a gap (a lost message, a dropout the record was cut at)
+    still shows the maneuvers around it: its gaps are filled by straight
+    lines. One finite on less than `_MIN_FINITE` of the stretch is left out.
+    """
     out: dict[str, dict[str, np.ndarray]] = {}
     for axis, names in shown.items():
-        finite = {name: values[name][start:stop] for name in names if np.isfinite(values[name][start:stop]).all()}
+        finite = {}
+        for name in names:
+            x = values[name][start:stop]
+            ok = np.isfinite(x)
+            if ok.all():
+                finite[name] = x
+            elif ok.mean() >= _MIN_FINITE:
+                index = np.arange(x.size)
+                finite[name] = np.interp(index, index[ok], x[ok])
         if finite:
             out[axis] = finite
     return out
+
+
+_MIN_FINITE = 0.9  # a trace finite on less of a stretch is not used to find its maneuvers
 
 
 def _near(time_base: np.ndarray, segments: Sequence[Segment], margin_s: float) -> np.ndarray:

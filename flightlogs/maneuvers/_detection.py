@@ -310,8 +310,8 @@ def _robust_poly(t: np.ndarray, x: np.ndarray, degree: int, at: np.ndarray) -> n
     for _ in range(3):
         coef = np.polyfit(t, x, degree, w=np.sqrt(w))
         resid = x - np.polyval(coef, t)
-        r = resid / (4.685 * max(_robust_std(resid), 1e-300))
-        w = np.where(np.abs(r) < 1, (1 - r * r) ** 2, 0.0)
+        r = resid / (4.685 * max(_robust_std(resid), 1e-12 * (1.0 + float(np.max(np.abs(x))))))
+        w = np.where(np.abs(r) < 1, (1 - np.minimum(r * r, 1.0)) ** 2, 0.0)
         if np.count_nonzero(w) <= degree + 1:
             break
     return np.polyval(coef, at)

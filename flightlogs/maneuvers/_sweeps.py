@@ -45,8 +45,10 @@ _MIN_PERIOD_S = 4.0  # shortest sweeping piece, s
 _MIN_RHO = 0.8  # Spearman ρ of log ridge frequency against time, in magnitude
 _MIN_RATIO = 3.0  # ridge frequency range (90th over 10th percentile)
 _MIN_MEDIAN_SCORE = 10.0  # median score along a sweep's ridge
+_DYNAMIC_RANGE = 0.01  # a band's floor is at least this fraction of its median envelope (a held setpoint has none)
 _YIELD = 3.0  # a frame where another axis scores this many times higher is that axis's
 _THRESHOLD, _TREND_S, _BURST_MERGE_S, _MIN_ACTIVE_S = 4.0, 10.0, 2.0, 0.3  # time-domain edges, as detect_segments
+_HELD = 1e-9  # a trace whose quiet noise is below this fraction of its peak is held (a setpoint), not measured
 _EDGE_WINDOW_S = 15.0  # edges are searched this far outside the ridge, s
 
 
@@ -64,8 +66,8 @@ class FoundSweep:
         Its first and last sample (inclusive).
     f_min_hz, f_max_hz : float
         Range of its ridge frequency, Hz.
-    direction : {"up", "down"}
-        Whether the frequency rises or falls.
+    direction : {"up", "down", "none"}
+        Whether the frequency rises or falls; "none" for a pilot's broadband input without a trend.
     evidence : tuple of str
         The traces that carry it, strongest first.
     score : float
@@ -78,7 +80,7 @@ class FoundSweep:
     last: int
     f_min_hz: float
     f_max_hz: float
-    direction: Literal["up", "down"]
+    direction: Literal["up", "down", "none"]
     evidence: tuple[str, ...]
     score: float
 
@@ -185,10 +187,11 @@ def _normalised(x: np.ndarray, dt: float, freqs: np.ndarray, step: int) -> np.nd
     """Band envelopes over each band's noise floor, taken where no band stands out (two passes)."""
     envelope = band_envelopes(x - np.median(x), dt, freqs, cycles=_CYCLES, step=step)
     tiny = 1e-12 * max(1.0, float(envelope.max()))
-    floor = np.maximum(np.quantile(envelope, _FLOOR_QUANTILE, axis=0), tiny)
+    lowest = np.maximum(_DYNAMIC_RANGE * np.median(envelope, axis=0), tiny)
+    floor = np.maximum(np.quantile(envelope, _FLOOR_QUANTILE, axis=0), lowest)
     quiet = (envelope / floor).max(axis=1) < _SCORE
     if quiet.sum() >= 0.1 * quiet.size:
-        floor = np.maximum(np.quantile(envelope[quiet], _FLOOR_QUANTILE, axis=0), tiny)
+        floor = np.maximum(np.quantile(envelope[quiet], _FLOOR_QUANTILE, axis=0), lowest)
     return np.asarray(envelope / floor)
 
 
@@ -216,13 +219,15 @@ def _runs(pieces: list[tuple[int, int]], frame_s: float) -> list[list[tuple[int,
 
 def _tones(
     ridge: _Ridge, run: list[tuple[int, int]], frame_s: float
-) -> list[tuple[Literal["sweep", "multisine"], list[tuple[int, int]]]]:
+) -> list[tuple[Literal["sweep", "multisine", "piloted"], list[tuple[int, int]]]]:
     """The sweeps and multisines of one run of activity, each as the ridge pieces it spans.
 
     The whole run sweeps (a piloted sweep's ridge jumps, but its trend
     holds); or its pieces each sweep the same way, back to back, covering
     most of it: a Schroeder-phased multisine sweeps its band once per period,
-    a saw-tooth; or some pieces sweep long enough on their own.
+    a saw-tooth; or some pieces sweep long enough on their own, unless they
+    cover under half of a run that a pilot's command carries broadband
+    (:func:`_piloted`), which is then one piloted input.
     """
     a, b = run[0][0], run[-1][1]
     if (b - a) * frame_s >= _MIN_SWEEP_S and _sweeping(ridge, a, b, frame_s):
@@ -230,7 +235,28 @@ def _tones(
     swept = [p for p in run if _sweeping(ridge, *p, frame_s)]
     if _periodic(ridge, swept, frame_s):
         return [("multisine", swept)]
-    return [("sweep", [p]) for p in swept if (p[1] - p[0]) * frame_s >= _MIN_SWEEP_S]
+    long = [p for p in swept if (p[1] - p[0]) * frame_s >= _MIN_SWEEP_S]
+    if sum(hi - lo for lo, hi in long) < 0.5 * (b - a) and (b - a) * frame_s >= _MIN_SWEEP_S and _piloted(ridge, a, b):
+        return [("piloted", run)]  # a trend in a short part of a broadband input is chance
+    return [("sweep", [p]) for p in long]
+
+
+def _piloted(ridge: _Ridge, a: int, b: int) -> bool:
+    """Whether frames [a, b) are a pilot's frequency-rich stick input: broadband, carried by a command trace.
+
+    A pilot's frequency sweep need not trend (the pilot moves between
+    frequencies at will); it is still one when a command the pilot gives
+    carries tones over a 3:1 range or more, standing far out of that
+    trace's noise, most of the time. The command is the stick where one is
+    logged (in position or altitude modes the setpoints are the outer
+    loops' reaction, not the pilot's); else the attitude and rate setpoints.
+    """
+    if np.median(ridge.score[a:b]) < _MIN_MEDIAN_SCORE:
+        return False
+    lo_hz, hi_hz = np.quantile(ridge.freq_hz[a:b], [0.1, 0.9])
+    sticks = np.array([name.startswith("stick_") for name in ridge.names])
+    commands = sticks if sticks.any() else np.array([name.endswith("_ref") for name in ridge.names])
+    return bool(hi_hz >= _MIN_RATIO * lo_hz and np.mean(commands[ridge.trace[a:b]]) >= 0.5)
 
 
 def _periodic(ridge: _Ridge, swept: list[tuple[int, int]], frame_s: float) -> bool:
@@ -255,7 +281,7 @@ def _direction(ridge: _Ridge, a: int, b: int) -> int:
 def _found(
     axis: str,
     ridge: _Ridge,
-    kind: Literal["sweep", "multisine"],
+    kind: Literal["sweep", "multisine", "piloted"],
     chain: list[tuple[int, int]],
     step: int,
     dt: float,
@@ -269,24 +295,30 @@ def _found(
     counts = np.bincount(ridge.trace[frames], minlength=len(ridge.names))
     return FoundSweep(
         axis=axis,
-        kind=kind,
+        kind="sweep" if kind == "piloted" else kind,
         first=first,
         last=last,
         f_min_hz=float(ridge.freq_hz[frames].min()),
         f_max_hz=float(ridge.freq_hz[frames].max()),
-        direction="up" if rho > 0 else "down",
+        direction="none" if kind == "piloted" else "up" if rho > 0 else "down",
         evidence=tuple(ridge.names[k] for k in np.argsort(-counts) if counts[k] > 0),
         score=float(np.median(ridge.score[frames])),
     )
 
 
 def _time_edges(named: Mapping[str, np.ndarray], i0: int, i1: int, dt: float) -> tuple[int, int]:
-    """Earliest start and latest end, over the traces, of the activity overlapping samples [i0, i1]."""
+    """Earliest start and latest end, over the traces, of the activity overlapping samples [i0, i1].
+
+    A trace held exactly constant outside the maneuver (a setpoint before
+    take-off) has no noise to measure its edges against: the trend's tails
+    pass for activity there. It is used only if every trace is held.
+    """
     n = next(iter(named.values())).size
     window = (max(0, i0 - int(_EDGE_WINDOW_S / dt)), min(n - 1, i1 + int(_EDGE_WINDOW_S / dt)))
     starts, ends = [], []
-    for name, x in named.items():
-        act = _activity(x, dt, _THRESHOLD, _TREND_S)
+    activities = {name: _activity(x, dt, _THRESHOLD, _TREND_S) for name, x in named.items()}
+    noisy = {name: act for name, act in activities.items() if act.sigma > _HELD * np.max(np.abs(act.detrended))}
+    for name, act in (noisy or activities).items():
         bursts = [
             burst
             for burst in _bursts(name, act, dt, _THRESHOLD, _BURST_MERGE_S, _MIN_ACTIVE_S)
@@ -302,9 +334,16 @@ def _time_edges(named: Mapping[str, np.ndarray], i0: int, i1: int, dt: float) ->
 
 
 def _owned(found: list[FoundSweep]) -> list[FoundSweep]:
-    """Of sweeps overlapping on several axes, the one with the highest score; the rest are reactions."""
+    """Of overlapping sweeps, the strongest, and any of comparable strength on another axis.
+
+    Another axis reacts to a sweep far more weakly than the sweep's own
+    traces stand out (scores are in each trace's noise floors); one that
+    stands out within a factor ``_YIELD`` of it is flown on its own (a pilot
+    moving two sticks at once).
+    """
     kept: list[FoundSweep] = []
     for sweep in sorted(found, key=lambda s: -s.score):
-        if not any(sweep.first <= k.last and k.first <= sweep.last for k in kept):
+        rivals = [k for k in kept if sweep.first <= k.last and k.first <= sweep.last]
+        if all(k.axis != sweep.axis and _YIELD * sweep.score >= k.score for k in rivals):
             kept.append(sweep)
     return kept

@@ -91,6 +91,9 @@ _STEP_LOOK_BACK_S = 0.5  # the first step is searched from this long before the 
 _STEP_RISE_S = 0.05  # a logged step's change is measured over this long
 _FIRST_STEP = 0.25  # the first step is at least this fraction of the largest (a doublet's first is half its second)
 _MIN_TONE_S = 15.0  # a sweep runs at least this long besides any step it overlaps
+#: The rate (or, for thrust, the acceleration) a step on each axis moves.
+_RATE_OF = {"lat": "p", "lon": "q", "yaw": "r", "thr": "az"}
+_FOLLOWED = 2.0  # a step's rate: its RMS over the step and one second after, this many times the hover's before
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -249,7 +252,11 @@ def detect_segments(
                 source="detected",
                 f_min_hz=s.f_min_hz,
                 f_max_hz=s.f_max_hz,
-                detail=f"{s.direction} ridge in {', '.join(s.evidence)}",
+                detail=(
+                    f"{s.direction} ridge in {', '.join(s.evidence)}"
+                    if s.direction != "none"
+                    else f"piloted, broadband without a trend, in {', '.join(s.evidence)}"
+                ),
             )
             for s in sweeps
         ]
@@ -266,6 +273,7 @@ def detect_segments(
             stepped
             for m in maneuvers
             if (stepped := _stepped(m, checked.get(m.axis, {}).get(f"delta_{m.axis}"), dt)) is not None
+            and _followed(stepped, checked.get(m.axis, {}).get(_RATE_OF[m.axis]), dt)
         ]
     segments += [
         Segment(
@@ -468,6 +476,24 @@ def _stepped(found: FoundManeuver, raw: np.ndarray | None, dt: float) -> FoundMa
         return None
     sharp = np.flatnonzero(window > max(_STEP_JUMP / 2 * spread, _FIRST_STEP * window.max()))
     return replace(found, first=max(found.first, lo + int(sharp[0])))  # the change from sharp[0] to + lag
+
+
+def _followed(found: FoundManeuver, rate: np.ndarray | None, dt: float) -> bool:
+    """Whether the axis's rate answers a doublet or 3211: it moves more during it than in the hover before.
+
+    A step injected anywhere in the loop turns the vehicle; the controller's
+    own chatter (a mission's descent, a gust) moves the mixer input as much
+    while the rate stays at its noise (True where no rate is logged).
+    """
+    if found.kind not in ("doublet", "3211") or rate is None:
+        return True
+    span = found.last - found.first + 1
+    after = min(rate.size, found.last + 1 + int(round(1.0 / dt)))
+    before = rate[max(0, found.first - span) : found.first]
+    if before.size < max(10, span // 2):
+        return True
+    during = rate[found.first : after]
+    return bool(np.std(during) >= _FOLLOWED * np.std(before))
 
 
 def _ringing(sweep: FoundSweep, steps: Sequence[FoundManeuver], dt: float) -> bool:

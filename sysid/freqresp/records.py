@@ -12,6 +12,7 @@ from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import DataError
 from flightlogs.maneuvers.segments import AXES
 from flightlogs.record import Record
+from flightlogs.signals import COMMAND_AXES
 from sysid.freqresp.estimate import frequency_responses
 from sysid.freqresp.options import ResponseOptions
 from sysid.freqresp.response import FrequencyResponse
@@ -462,9 +463,10 @@ def reference_options(
 
 
 def _axis_of(input_: str, pairs: Sequence[tuple[str, str]]) -> str:
-    if input_.startswith("delta_") and input_[6:] in AXES:
-        return input_[6:]
-    axes = {i[6:] for _, i in pairs if i.startswith("delta_") and i[6:] in AXES}
+    """The axis whose maneuvers an input's responses come from: its own (a mixer input, a reference), else the pairs'."""
+    if input_ in COMMAND_AXES:
+        return COMMAND_AXES[input_]
+    axes = {COMMAND_AXES[i] for _, i in pairs if i in COMMAND_AXES}
     if len(axes) == 1:
         return axes.pop()
     raise DataError(f"cannot tell which maneuvers to use for input {input_}: give the axis (lat, lon, yaw or thr)")

@@ -9,6 +9,8 @@ import numpy as np
 
 __all__ = ["FrequencyResponse"]
 
+_ANCHOR_COHERENCE = 0.6  # the phase's branch is fixed at the first frequency this coherent
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class FrequencyResponse:
@@ -100,5 +102,15 @@ class FrequencyResponse:
 
     @property
     def phase_deg(self) -> np.ndarray:
-        """Phase, deg, unwrapped along frequency, shape (n_freq,)."""
-        return cast(np.ndarray, np.degrees(np.unwrap(np.angle(self.response))))
+        """Phase, deg, unwrapped along frequency, shape (n_freq,).
+
+        The branch is that of the lowest frequency with coherence gamma^2 of
+        0.6 or more (the most coherent one if none reaches it), taken in
+        (-180, 180] deg: noise at the incoherent low end of the grid would
+        otherwise shift the whole curve by whole turns.
+        """
+        unwrapped = np.unwrap(np.angle(self.response))
+        coherent = np.flatnonzero(self.coherence >= _ANCHOR_COHERENCE)
+        anchor = int(coherent[0]) if coherent.size else int(np.argmax(np.nan_to_num(self.coherence)))
+        turns = np.round((unwrapped[anchor] - np.angle(self.response[anchor])) / (2 * np.pi))
+        return cast(np.ndarray, np.degrees(unwrapped - 2 * np.pi * turns))

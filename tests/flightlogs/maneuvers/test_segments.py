@@ -334,3 +334,19 @@ def test_runs_from_the_dataflash_reader_are_accepted() -> None:
         fade_out_s=1.0,
     )
     assert segments_from_sid([no_sidd])[0].end_s == 91.0
+
+
+@pytest.mark.parametrize(("follows", "expected"), [(True, ["doublet"]), (False, [])])
+def test_a_doublet_counts_only_when_the_rate_answers_it(follows: bool, expected: list[str]) -> None:
+    """The same mixer doublet, with a pitch rate that integrates it (the airframe) or stays at its noise.
+
+    The second is what a mission log showed: the yaw controller's chatter in a climb passed the doublet test
+    in delta_yaw while r did not move.
+    """
+    rng = np.random.default_rng(12)
+    t = np.arange(2000) / RATE_HZ
+    delta = 0.1 * _doublet(t - 8.0) + 1e-3 * rng.standard_normal(t.size)
+    answer = np.cumsum(delta) / RATE_HZ * 30.0 if follows else 0.0  # q = M_lon ∫ delta, M_lon = 30 rad/s² per unit
+    q = answer + 0.01 * rng.standard_normal(t.size)
+    found = detect_segments(t, {"lon": delta}, responses={"lon": {"delta_lon": delta, "q": q}})
+    assert [s.kind for s in found if s.kind != "hover"] == expected

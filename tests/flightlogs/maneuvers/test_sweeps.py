@@ -63,3 +63,40 @@ def test_noise_alone_is_no_maneuver() -> None:
     rng = np.random.default_rng(5)
     traces = {"lat": {"delta_lat": rng.normal(0, 0.003, T.size), "p": rng.normal(0, 0.01, T.size)}}
     assert detect_segments(T, {}, responses=traces, min_hover_s=1e9) == ()
+
+
+def _band_noise(rng: np.random.Generator, lo_hz: float, hi_hz: float) -> np.ndarray:
+    """White noise band-passed to [lo_hz, hi_hz] (a pilot shaking the stick at will), unit RMS."""
+    spectrum = np.fft.rfft(rng.standard_normal(T.size))
+    f = np.fft.rfftfreq(T.size, DT)
+    x = np.fft.irfft(spectrum * ((f >= lo_hz) & (f <= hi_hz)), T.size)
+    return x / x.std()
+
+
+def test_a_pilot_shaking_two_sticks_at_once_is_found_on_both_axes() -> None:
+    """Roll and pitch setpoints driven together by a pilot at 0.7-5 Hz, no trend, held exactly at zero before.
+
+    A held setpoint has no noise floor (kd0aij's before take-off): the floor is then bounded by the trace's
+    own level, not by the rounding. Neither axis is the other's reaction: both are found, as piloted.
+    """
+    rng = np.random.default_rng(5)
+    flown = (T >= 30.0) & (T < 80.0)
+    responses = {}
+    for axis, rate in (("lat", "p"), ("lon", "q")):
+        command = np.where(flown, 0.3 * _band_noise(rng, 0.7, 5.0), 0.0)
+        responses[axis] = {f"{rate}_ref": command, rate: command + rng.normal(0, 0.01, T.size)}
+    found = detect_segments(T, {}, responses=responses, min_hover_s=1e9)
+    assert sorted(s.axis for s in found) == ["lat", "lon"]
+    for segment in found:
+        assert segment.kind == "sweep" and segment.detail.startswith("piloted, broadband without a trend")
+        assert 28.5 <= segment.start_s <= 31.0 and 79.0 <= segment.end_s <= 81.5
+
+
+def test_broadband_motion_that_no_command_carries_is_no_maneuver() -> None:
+    """The same shaking in the rate alone, with the pilot's stick logged and centred: turbulence, not a pilot."""
+    rng = np.random.default_rng(6)
+    flown = (T >= 30.0) & (T < 80.0)
+    p = np.where(flown, 0.3 * _band_noise(rng, 0.7, 5.0), 0.0) + rng.normal(0, 0.01, T.size)
+    stick = rng.normal(0, 1e-3, T.size)
+    found = detect_segments(T, {}, responses={"lat": {"stick_lat": stick, "p": p}}, min_hover_s=1e9)
+    assert found == ()

@@ -411,3 +411,19 @@ def test_a_grid_above_the_nyquist_frequency_is_refused() -> None:
     record = _simple({"x": np.random.default_rng(0).normal(size=2000), "y": np.ones(2000)}, rate_hz=20.0)
     with pytest.raises(DataError, match="above the Nyquist frequency 62.8 rad/s of the 20 Hz records"):
         frequency_responses([record], ["x"], ["y"])
+
+
+def test_the_phase_branch_is_fixed_where_the_response_is_coherent() -> None:
+    """A 20 ms delay, with noise at the incoherent low end that turns the phase a whole turn there.
+
+    Unwrapped from the first grid point the whole curve sat 360 deg low (kd0aij's q/q_ref read -371 deg at
+    4 rad/s where the loop tracks with -11 deg); anchored at the first point of coherence 0.6, the delay's
+    -omega tau is exact on the coherent part.
+    """
+    delay = np.exp(-1j * OMEGA * 0.02)
+    noisy = OMEGA < 1.5
+    steps = np.cumsum(noisy) * -2 * np.pi / noisy.sum()  # noise: steps of under half a turn, a turn in all
+    response = _response(np.where(noisy, 0.2, 0.95), response=delay * np.exp(1j * np.where(noisy, steps, 0.0)))
+    coherent = ~noisy
+    assert np.degrees(np.unwrap(np.angle(response.response)))[coherent][0] < -300.0  # the naive unwrap: a turn low
+    assert response.phase_deg[coherent] == pytest.approx(-np.degrees(OMEGA[coherent] * 0.02), abs=1e-9)
