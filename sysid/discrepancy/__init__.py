@@ -1,0 +1,22 @@
+"""Discrepancy discovery: where a real flight departs from its simulation, the physics left out, and the proof.
+
+:func:`discover` compares flights as :class:`FlightSeries` (:func:`flight_series`
+from a conditioned flight's records) and returns a :class:`DiscrepancyResult`.
+"""
+
+from sysid.discrepancy.discover import DiscrepancyOptions, discover
+from sysid.discrepancy.result import DiscrepancyResult, Finding, FittedParameter, Regime
+from sysid.discrepancy.series import FlightSeries, flight_series
+from sysid.discrepancy.terms import EFFECTS
+
+__all__ = [
+    "EFFECTS",
+    "DiscrepancyOptions",
+    "DiscrepancyResult",
+    "Finding",
+    "FittedParameter",
+    "FlightSeries",
+    "Regime",
+    "discover",
+    "flight_series",
+]

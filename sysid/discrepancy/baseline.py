@@ -1,0 +1,104 @@
+"""The simulation's model, identified from SIM by equation error and evaluated on REAL.
+
+Each output (a specific force or an angular acceleration) is regressed on
+the four mixer inputs at lags 0 to 0.3 s (an impulse response that holds
+the simulated delays and lags, whatever they are), their squares at four of
+those lags (differential rotor speeds change the total thrust: a yaw sweep
+pulls az down), the body velocities and rates, and a constant. Nothing about the vehicle is assumed. What REAL
+does that this model of SIM does not is the discrepancy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries
+
+__all__ = ["BaselineModel", "fit_baseline", "Commands"]
+
+_LAG_S = 0.3  # longest input lag of the impulse responses, s
+_STATES = ("u", "v", "w", "p", "q", "r")
+_N_SQUARE_LAGS = 4  # the inputs' squares (a rotor's thrust grows with its speed squared) at this many lags
+
+#: Mixer inputs to drive a prediction with (each shape (n,)); None: as logged.
+Commands = Mapping[str, np.ndarray] | None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class BaselineModel:
+    """Linear equation-error model of the simulation.
+
+    Parameters
+    ----------
+    coefficients : Mapping[str, ndarray]
+        Per output, the regression coefficients, shape (n_regressors,).
+    lags : ndarray of int, shape (n_lags,)
+        Input lags, samples.
+    states : tuple of str
+        State regressors used.
+    rate_hz : float
+        Sample rate it was fitted at, Hz.
+    """
+
+    coefficients: Mapping[str, np.ndarray]
+    lags: np.ndarray
+    states: tuple[str, ...]
+    rate_hz: float
+
+    def predict(self, series: FlightSeries, commands: Commands = None) -> dict[str, np.ndarray]:
+        """Each output as the simulation would have it on `series`, shape (n,) each.
+
+        Parameters
+        ----------
+        series : FlightSeries
+            A flight with the same signals.
+        commands : Mapping[str, ndarray], optional
+            Mixer inputs to use instead of the logged ones (delayed, lagged).
+        """
+        design = _design(series, self.lags, self.states, commands)
+        return {o: design @ c for o, c in self.coefficients.items()}
+
+
+def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> BaselineModel:
+    """Least-squares fit of every output on samples `rows` (default all).
+
+    Parameters
+    ----------
+    series : FlightSeries
+        The simulation's flight.
+    rows : ndarray of int, optional
+        Samples to fit on (the others are held out).
+
+    Returns
+    -------
+    BaselineModel
+    """
+    lags = np.arange(int(round(_LAG_S * series.rate_hz)) + 1)
+    states = tuple(s for s in _STATES if s in series)
+    design = _design(series, lags, states, None)
+    use = slice(None) if rows is None else rows
+    coefficients = {o: np.linalg.lstsq(design[use], series[o][use], rcond=None)[0] for o in OUTPUTS}
+    return BaselineModel(coefficients=coefficients, lags=lags, states=states, rate_hz=series.rate_hz)
+
+
+def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...], commands: Commands) -> np.ndarray:
+    inputs = commands if commands is not None else {c: series[c] for c in COMMANDS}
+    columns = [_lagged(series, np.asarray(inputs[c]), lags) for c in COMMANDS]
+    square_lags = lags[:: max(1, lags.size // _N_SQUARE_LAGS)]
+    columns += [_lagged(series, np.asarray(inputs[c]) ** 2, square_lags) for c in COMMANDS]
+    columns.append(np.column_stack([series[s] for s in states] + [np.ones(series.n)]))
+    return np.column_stack(columns)
+
+
+def _lagged(series: FlightSeries, x: np.ndarray, lags: np.ndarray) -> np.ndarray:
+    """Columns x(t - lag) per lag, each piece padded with its first value (no lag reaches across a gap)."""
+    out = np.empty((x.size, lags.size))
+    for rows in series.pieces():
+        piece = x[rows]
+        padded = np.concatenate([np.full(int(lags[-1]), piece[0]), piece])
+        for j, lag in enumerate(lags):
+            out[rows, j] = padded[lags[-1] - lag : lags[-1] - lag + piece.size]
+    return out

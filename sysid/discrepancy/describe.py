@@ -1,0 +1,122 @@
+"""A found effect in physical parameters and in plain language."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from sysid.discrepancy.result import Finding, FittedParameter
+from sysid.discrepancy.selection import TermFit
+from sysid.discrepancy.terms import Candidate
+
+__all__ = ["parameters_of", "describe_finding", "summary_of"]
+
+_GROUND_EFFECT_END = 0.01  # the ground effect "ends" where the thrust gain falls below 1 %
+
+#: Unit of each coefficient name.
+_UNITS: Mapping[str, str] = {
+    "c_m2": "m^2",
+    "d_x_s_m": "s/m",
+    "d_y_s_m": "s/m",
+    "l_wind_rad_m": "rad/m",
+    "m_wind_rad_m": "rad/m",
+    "gain": "1",
+    "exponent": "1",
+    "mass_ratio": "1",
+    "l_rad_m": "rad/m",
+    "m_rad_m": "rad/m",
+}
+_NAMES: Mapping[str, str] = {
+    "c_m2": "coefficient",
+    "gain": "thrust_gain_change",
+    "d_x_s_m": "drag_x",
+    "d_y_s_m": "drag_y",
+    "l_wind_rad_m": "roll_moment_per_wind",
+    "m_wind_rad_m": "pitch_moment_per_wind",
+    "l_rad_m": "roll_moment_per_thrust",
+    "m_rad_m": "pitch_moment_per_thrust",
+}
+
+
+def parameters_of(fit: TermFit) -> tuple[FittedParameter, ...]:
+    """The fitted parameters of a term, with standard deviations, in SI units."""
+    candidate = fit.candidate
+    out: list[FittedParameter] = []
+    if candidate.grid_parameter:
+        name, unit = candidate.grid_parameter.rsplit("_", 1)
+        out.append(
+            FittedParameter(
+                name=candidate.grid_parameter, value=fit.value, uncertainty=fit.value_uncertainty, unit=unit
+            )
+        )
+        del name
+    names = iter(candidate.coefficients)
+    for o in candidate.outputs:
+        if o not in fit.coefficients:
+            continue
+        sigma = np.sqrt(np.maximum(np.diag(fit.covariance[o]), 0.0))
+        for value, spread in zip(fit.coefficients[o], sigma):
+            coefficient = next(names)
+            out.append(
+                FittedParameter(
+                    name=_NAMES.get(coefficient, coefficient),
+                    value=float(value),
+                    uncertainty=float(spread),
+                    unit=_UNITS.get(coefficient, "1"),
+                )
+            )
+    if candidate.effect == "ground_effect" and len(out) > 1:
+        c = out[1]
+        ends = np.sqrt(max(c.value, 0.0) / _GROUND_EFFECT_END)
+        spread = 0.5 * ends * c.uncertainty / c.value if c.value > 0 else float("nan")
+        out.append(FittedParameter(name="ends_at_height", value=float(ends), uncertainty=float(spread), unit="m"))
+    return tuple(out)
+
+
+def _value(finding: Finding, name: str) -> FittedParameter | None:
+    return next((p for p in finding.parameters if p.name == name), None)
+
+
+def describe_finding(finding: Finding, candidate: Candidate) -> str:
+    """One sentence: what the real vehicle does, with the numbers, and the held-out gain."""
+    outputs = ", ".join(finding.outputs)
+    gain = f"modelling it cuts the {outputs} residual by {finding.improvement_percent:.0f} % on held-out data"
+    effect = candidate.effect
+    if effect == "time_delay" and (p := _value(finding, "delay_s")) is not None:
+        what = f"The real vehicle responds {p.value * 1e3:.0f} ± {p.uncertainty * 1e3:.0f} ms later than the simulation"
+    elif effect == "actuator_lag" and (p := _value(finding, "time_constant_s")) is not None:
+        what = (
+            f"The real actuators lag: an extra first-order lag of τ = {p.value * 1e3:.0f} ± {p.uncertainty * 1e3:.0f} ms "
+            "that the simulation lacks (the magnitude rolls off, not only the phase)"
+        )
+    elif effect == "ground_effect" and (p := _value(finding, "ends_at_height")) is not None:
+        what = f"The real vehicle gains thrust near the ground, up to about {p.value:.2f} m; the simulation has no ground effect"
+    elif effect == "mass_change" and (p := _value(finding, "mass_ratio")) is not None:
+        t = _value(finding, "time_s")
+        when = f" at t = {t.value:.1f} ± {t.uncertainty:.1f} s of flight" if t is not None else ""
+        what = (
+            f"The required thrust steps by {p.value * 100:+.1f} ± {p.uncertainty * 100:.1f} %{when}: the mass changed"
+        )
+    elif effect == "battery_sag" and (p := _value(finding, "exponent")) is not None:
+        what = f"Thrust follows the battery voltage (thrust ∝ V^{p.value:.2f} ± {p.uncertainty:.2f}); the simulation keeps it constant"
+    elif effect == "cg_offset":
+        what = "A constant moment follows the thrust: the centre of gravity is off the thrust axis"
+    elif effect == "rotor_drag":
+        what = "A drag force proportional to thrust times airspeed acts in the rotor plane (rotor drag) that the simulation lacks"
+    elif effect == "wind":
+        what = "Forces and moments follow the measured wind: the simulation leaves its drag out"
+    else:
+        what = f"{effect} acts on {outputs}"
+    return f"{what}; {gain}."
+
+
+def summary_of(findings: Sequence[Finding], noise_floor: Mapping[str, float]) -> str:
+    """Plain-language summary, the most important finding first (or that nothing is missing)."""
+    if not findings:
+        floor = ", ".join(f"{o} {v:.3g}" for o, v in noise_floor.items())
+        return (
+            "Nothing is missing: no candidate term explains more of the real flight's residual than it explains of "
+            f"held-out simulated flight (residual RMS floor: {floor})."
+        )
+    return " ".join(f.evidence for f in findings)

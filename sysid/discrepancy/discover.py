@@ -1,0 +1,278 @@
+"""Discrepancy discovery: where a real flight departs from its simulation, which physics explains it, by how much.
+
+1. **Baseline and noise floor.** The simulation's model (:mod:`.baseline`) is
+   fitted on half of SIM's time blocks and its residual on the other half is
+   each output's noise floor: what noise and model error alone leave. Every
+   candidate term is also scored on that held-out SIM residual: its *null*
+   score, what it gains on data where nothing is missing.
+2. **Screen and select.** The model fitted on all of SIM predicts REAL. Each
+   term of the library (:mod:`.terms`) is fitted on five of six time blocks
+   of REAL and scored on the sixth, in turn (:mod:`.selection`). A term
+   passes if its held-out score beats a floor and three times its null
+   score; of those that pass, the one that lowers the Bayesian information
+   criterion most (effective samples, the parameter inside its shape
+   counted) is kept; its contribution joins the model and the others are
+   screened again (forward selection), until none passes. A delay and a lag compete:
+   once one is kept the other is not tried.
+3. **Model, locate and show.** Each kept term is fitted on all of REAL with
+   its uncertainties; its band is where its contribution's power lies, its
+   regime the flight variable its contribution follows; the residual RMS
+   before and after is on held-out blocks.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import welch
+from scipy.stats import spearmanr
+
+from sysid.discrepancy.baseline import BaselineModel, fit_baseline
+from sysid.discrepancy.describe import describe_finding, parameters_of, summary_of
+from sysid.discrepancy.result import DiscrepancyResult, Finding, Regime
+from sysid.discrepancy.selection import TermFit, blocks, cross_validated, effective_samples, fit_term
+from sysid.discrepancy.series import OUTPUTS, FlightSeries
+from sysid.discrepancy.terms import Candidate, candidate_terms
+
+__all__ = ["DiscrepancyOptions", "discover"]
+
+_TRANSFORMS = ("time_delay", "actuator_lag")
+_REGIMES = (("height_agl", "m"), ("airspeed", "m/s"), ("delta_thr", "as logged"), ("battery_v", "V"), ("t_flight", "s"))
+
+Progress = Callable[[str, int, int], None]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DiscrepancyOptions:
+    """Choices of the search.
+
+    Parameters
+    ----------
+    min_improvement : float
+        Held-out share of the weighted residual a term must remove to be kept, whatever its null score.
+    null_margin : float
+        ... and this many times its score on held-out simulation data.
+    max_findings : int
+        Most effects reported.
+    """
+
+    min_improvement: float = 0.05
+    null_margin: float = 3.0
+    max_findings: int = 3
+
+
+def discover(
+    sim: Sequence[FlightSeries],
+    real: Sequence[FlightSeries],
+    options: DiscrepancyOptions = DiscrepancyOptions(),
+    progress: Progress | None = None,
+) -> DiscrepancyResult:
+    """Find, model and prove what REAL does that SIM leaves out.
+
+    Parameters
+    ----------
+    sim, real : sequence of FlightSeries
+        The simulated and the real flights (of the same vehicle, similar missions).
+    options : DiscrepancyOptions, optional
+        Thresholds.
+    progress : callable, optional
+        ``progress(stage, done, total)``.
+
+    Returns
+    -------
+    DiscrepancyResult
+    """
+    simulated, flown = _joined(sim), _joined(real)
+    scale, null = _noise_floor(simulated)
+    _report(progress, "simulation model", 1, 3)
+    baseline = fit_baseline(simulated)
+    y = {o: flown[o] for o in OUTPUTS}
+    base = baseline.predict(flown)
+    additions = {o: np.zeros(flown.n) for o in OUTPUTS}
+    thrust = -base["az"]
+    gain = float(np.dot(thrust, base["az"] - y["az"]) / max(float(np.dot(thrust, thrust)), 1e-300))
+    additions["az"] = -gain * thrust  # the real thrust per input may differ by a constant factor: a trim
+    kept: list[tuple[TermFit, float, dict[str, np.ndarray], dict[str, np.ndarray]]] = []
+    screened: dict[str, float] = {}
+    held_out = _sum(base, additions)  # the baseline is fitted on SIM: on REAL its prediction is held out already
+    while len(kept) < options.max_findings:
+        found = {t.candidate.effect for t, *_ in kept}
+        exclude = tuple(found | (set(_TRANSFORMS) if found & set(_TRANSFORMS) else set()))
+        scores = []
+        for candidate in candidate_terms(flown, baseline, _sum(base, additions), exclude=exclude):
+            score, predicted = cross_validated(candidate, y, base, additions, scale)
+            threshold = max(options.min_improvement, options.null_margin * max(null.get(candidate.effect, 0.0), 0.0))
+            if not kept:
+                screened[candidate.effect] = round(score, 4)
+                screened[f"{candidate.effect}_threshold"] = round(threshold, 4)
+            if score > threshold:
+                fit = fit_term(candidate, y, base, additions, scale)
+                scores.append((_bic_change(fit, y, base, additions), score, fit, predicted))
+        _report(progress, "screening terms", len(kept) + 1, options.max_findings + 1)
+        if not scores:
+            break
+        _, score, fit, predicted = min(scores, key=lambda s: s[0])
+        candidate = fit.candidate
+        before = dict(held_out)
+        for o in candidate.outputs:
+            held_out[o] = predicted[o]
+        kept.append((fit, score, before, dict(held_out)))
+        if candidate.kind == "transform":
+            base = dict(fit.candidate.build(fit.value))
+        else:
+            built = candidate.build(fit.value)
+            for o, coefficients in fit.coefficients.items():
+                additions[o] = additions[o] + built[o] @ coefficients
+    findings = sorted(
+        (_finding(fit, score, before, after, y, flown, scale) for fit, score, before, after in kept),
+        key=lambda f: -f.improvement_percent,
+    )
+    _report(progress, "done", 3, 3)
+    floor = {o: float(np.sqrt(scale[o])) for o in OUTPUTS}
+    return DiscrepancyResult(
+        verdict=findings[0].effect if findings else "none",
+        findings=tuple(findings),
+        summary=summary_of(findings, floor),
+        screened=screened,
+        noise_floor=floor,
+        sim=tuple(s.name for s in sim),
+        real=tuple(s.name for s in real),
+        thrust_scale=round(1.0 + gain, 5),
+    )
+
+
+def _report(progress: Progress | None, stage: str, done: int, total: int) -> None:
+    if progress is not None:
+        progress(stage, done, total)
+
+
+def _sum(a: Mapping[str, np.ndarray], b: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    return {o: a[o] + b[o] for o in a}
+
+
+def _bic_change(
+    fit: TermFit, y: Mapping[str, np.ndarray], base: Mapping[str, np.ndarray], additions: Mapping[str, np.ndarray]
+) -> float:
+    """Change of the Bayesian information criterion on all of REAL when the term joins the model.
+
+    Each output's likelihood counts its effective samples (its residual is correlated), and the term's
+    parameters are its coefficients plus the value inside its shape.
+    """
+    current = _sum(base, additions)
+    with_term = fit.prediction(base, additions)
+    change, samples = 0.0, 0.0
+    for o in fit.candidate.outputs:
+        before, after = y[o] - current[o], y[o] - with_term[o]
+        n_effective = effective_samples(before)
+        change += n_effective * float(np.log(max(np.sum(after**2), 1e-300) / max(np.sum(before**2), 1e-300)))
+        samples += n_effective
+    k = sum(c.size for c in fit.coefficients.values()) + (1 if fit.candidate.grid_parameter else 0)
+    return change + k * float(np.log(max(samples, 2.0)))
+
+
+def _noise_floor(sim: FlightSeries) -> tuple[dict[str, float], dict[str, float]]:
+    """Each output's held-out residual variance on SIM, and every term's held-out score there (its null score)."""
+    parts = blocks(sim.n, 8)
+    fitting, held = np.concatenate(parts[1::2]), np.concatenate(parts[0::2])
+    model: BaselineModel = fit_baseline(sim, fitting)
+    prediction = model.predict(sim)
+    scale = {o: max(float(np.var((sim[o] - prediction[o])[held])), 1e-12) for o in OUTPUTS}
+    rest = sim.subset(held)
+    y = {o: rest[o] for o in OUTPUTS}
+    base = {o: prediction[o][held] for o in OUTPUTS}
+    zeros = {o: np.zeros(rest.n) for o in OUTPUTS}
+    null = {c.effect: cross_validated(c, y, base, zeros, scale)[0] for c in candidate_terms(rest, model, base)}
+    return scale, null
+
+
+def _joined(flights: Sequence[FlightSeries]) -> FlightSeries:
+    if len(flights) == 1:
+        return flights[0]
+    common = set.intersection(*(set(f.signals) for f in flights))
+    offset, pieces = 0, []
+    for f in flights:
+        pieces.append(f.piece + offset)
+        offset = int(pieces[-1].max()) + 1
+    return FlightSeries(
+        name=" + ".join(f.name for f in flights),
+        time_s=np.concatenate([f.time_s for f in flights]),
+        piece=np.concatenate(pieces),
+        signals={s: np.concatenate([f[s] for f in flights]) for s in sorted(common)},
+        rate_hz=flights[0].rate_hz,
+    )
+
+
+def _finding(
+    fit: TermFit,
+    score: float,
+    before: Mapping[str, np.ndarray],
+    after: Mapping[str, np.ndarray],
+    y: Mapping[str, np.ndarray],
+    flown: FlightSeries,
+    scale: Mapping[str, float],
+) -> Finding:
+    outputs = fit.candidate.outputs
+    rms_before = {o: float(np.sqrt(np.mean((y[o] - before[o]) ** 2))) for o in outputs}
+    rms_after = {o: float(np.sqrt(np.mean((y[o] - after[o]) ** 2))) for o in outputs}
+    weighted_before = sum(rms_before[o] ** 2 / scale[o] for o in outputs)
+    weighted_after = sum(rms_after[o] ** 2 / scale[o] for o in outputs)
+    improvement = 100.0 * (1.0 - np.sqrt(weighted_after / weighted_before)) if weighted_before > 0 else 0.0
+    contribution = {o: after[o] - before[o] for o in outputs}
+    finding = Finding(
+        effect=fit.candidate.effect,
+        outputs=outputs,
+        band_rad_s=_band(contribution, flown.rate_hz),
+        regime=_regime(contribution, flown),
+        explained_variance=round(max(score, 0.0), 4),
+        parameters=parameters_of(fit),
+        rmse_before=rms_before,
+        rmse_after=rms_after,
+        improvement_percent=round(float(improvement), 2),
+        evidence="",
+    )
+    return _with_evidence(finding, fit.candidate)
+
+
+def _with_evidence(finding: Finding, candidate: Candidate) -> Finding:
+    from dataclasses import replace
+
+    return replace(finding, evidence=describe_finding(finding, candidate))
+
+
+def _band(contribution: Mapping[str, np.ndarray], rate_hz: float) -> tuple[float, float]:
+    """Frequencies holding 5-95 % of the contribution's power (its mean included at the lowest bin), rad/s."""
+    total = None
+    for x in contribution.values():
+        f, power = welch(x, fs=rate_hz, nperseg=min(x.size, int(64 * rate_hz)), detrend=False)
+        total = power if total is None else total + power
+    assert total is not None
+    cumulative = np.cumsum(total) / max(float(np.sum(total)), 1e-300)
+    lo = f[int(np.searchsorted(cumulative, 0.05))]
+    hi = f[min(int(np.searchsorted(cumulative, 0.95)), f.size - 1)]
+    return (round(float(2 * np.pi * lo), 3), round(float(2 * np.pi * hi), 3))
+
+
+def _regime(contribution: Mapping[str, np.ndarray], flown: FlightSeries) -> Regime:
+    """The flight variable whose value the contribution's size follows most closely, and the range it acts in."""
+    size = np.sqrt(sum(np.asarray(c) ** 2 for c in contribution.values()))
+    variables = {name: flown[name] for name, _ in _REGIMES if name in flown}
+    if "u" in flown and "v" in flown:
+        variables["airspeed"] = np.hypot(flown["u"], flown["v"])
+    units = dict(_REGIMES)
+    best, best_rho = "t_flight", -1.0
+    for name, values in variables.items():
+        if np.ptp(values) <= 0 or np.ptp(size) <= 0:
+            continue
+        rho = abs(float(spearmanr(values, size).statistic))
+        if np.isfinite(rho) and rho > best_rho:
+            best, best_rho = name, rho
+    values = variables[best]
+    order = np.argsort(values)
+    energy = np.cumsum(size[order] ** 2) / max(float(np.sum(size**2)), 1e-300)
+    low = float(values[order][int(np.searchsorted(energy, 0.1))])
+    high = float(values[order][min(int(np.searchsorted(energy, 0.9)), values.size - 1)])
+    return Regime(
+        variable="time" if best == "t_flight" else best, unit=units[best], low=round(low, 3), high=round(high, 3)
+    )

@@ -1,0 +1,152 @@
+"""What the discrepancy search found: frozen results, and their JSON form for scripts."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["FittedParameter", "Regime", "Finding", "DiscrepancyResult"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FittedParameter:
+    """One parameter of a found effect.
+
+    Parameters
+    ----------
+    name : str
+        E.g. ``delay_s``, ``time_constant_s``, ``mass_ratio``.
+    value, uncertainty : float
+        Estimate and its standard deviation (residual correlation accounted for), in `unit`.
+    unit : str
+        SI unit.
+    """
+
+    name: str
+    value: float
+    uncertainty: float
+    unit: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Regime:
+    """Where in the flight an effect acts.
+
+    Parameters
+    ----------
+    variable : str
+        ``height_agl``, ``airspeed``, ``throttle``, ``battery_v`` or ``time`` (flight clock).
+    unit : str
+        Its unit.
+    low, high : float
+        The range holding 80 % of the effect's contribution.
+    """
+
+    variable: str
+    unit: str
+    low: float
+    high: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Finding:
+    """One effect the simulation leaves out, modelled and proven on held-out data.
+
+    Parameters
+    ----------
+    effect : str
+        One of :data:`~sysid.discrepancy.terms.EFFECTS`.
+    outputs : tuple of str
+        Outputs it acts on.
+    band_rad_s : tuple of float
+        Frequency band holding 90 % of its contribution's power, rad/s.
+    regime : Regime
+        Where in the flight it acts.
+    explained_variance : float
+        Share of the residual (noise-normalised) of its outputs it explains on held-out blocks, 0-1.
+    parameters : tuple of FittedParameter
+        Its fitted parameters.
+    rmse_before, rmse_after : dict of str to float
+        Held-out residual RMS per output without and with it (and the findings before it), in output units.
+    improvement_percent : float
+        Held-out cut of the residual RMS of its outputs, %.
+    evidence : str
+        One sentence.
+    """
+
+    effect: str
+    outputs: tuple[str, ...]
+    band_rad_s: tuple[float, float]
+    regime: Regime
+    explained_variance: float
+    parameters: tuple[FittedParameter, ...]
+    rmse_before: dict[str, float]
+    rmse_after: dict[str, float]
+    improvement_percent: float
+    evidence: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DiscrepancyResult:
+    """The answer for one SIM / REAL pair.
+
+    Parameters
+    ----------
+    verdict : str
+        The most important effect, or ``"none"``.
+    findings : tuple of Finding
+        By importance (held-out improvement).
+    summary : str
+        Plain-language sentences, the first naming the verdict.
+    screened : dict of str to float
+        Every effect tried and its held-out improvement on its outputs at the first step (0-1), and the
+        threshold it had to pass (``<effect>_threshold``).
+    noise_floor : dict of str to float
+        RMS of each output's residual on held-out SIM data (model error and noise alone).
+    sim, real : tuple of str
+        The flights compared.
+    thrust_scale : float
+        Real thrust per input over the simulated one, a constant fitted before any term (a trim, not a finding).
+    """
+
+    verdict: str
+    findings: tuple[Finding, ...]
+    summary: str
+    screened: dict[str, float]
+    noise_floor: dict[str, float]
+    sim: tuple[str, ...]
+    real: tuple[str, ...]
+    thrust_scale: float = 1.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: ``verdict``, ``findings[]`` (empty when the verdict is ``none``) and the context."""
+        return {
+            "verdict": self.verdict,
+            "summary": self.summary,
+            "findings": [
+                {
+                    "effect": f.effect,
+                    "outputs": list(f.outputs),
+                    "band_rad_s": list(f.band_rad_s),
+                    "regime": {
+                        "variable": f.regime.variable,
+                        "unit": f.regime.unit,
+                        "range": [f.regime.low, f.regime.high],
+                    },
+                    "explained_variance": f.explained_variance,
+                    "parameters": {
+                        p.name: {"value": p.value, "uncertainty": p.uncertainty, "unit": p.unit} for p in f.parameters
+                    },
+                    "rmse_before": f.rmse_before,
+                    "rmse_after": f.rmse_after,
+                    "improvement_percent": f.improvement_percent,
+                    "evidence": f.evidence,
+                }
+                for f in self.findings
+            ],
+            "screened": self.screened,
+            "noise_floor": self.noise_floor,
+            "sim": list(self.sim),
+            "real": list(self.real),
+            "thrust_scale": self.thrust_scale,
+        }

@@ -1,0 +1,181 @@
+"""Fitting a candidate term and judging it on time blocks it was not fitted on.
+
+The flight is cut into contiguous blocks; a term's coefficients are fitted
+on all blocks but one and scored on that one, in turn. The one parameter
+inside a term's shape (a delay, a lag, a mass step's time) is chosen once on
+the whole flight: a step's time cannot be found from blocks that do not hold
+it, and one value chosen from thousands of samples costs next to nothing in
+honesty (the null score of every term is measured the same way). Its score is the share of the held-out residual it
+removes, each output's residual weighted by the inverse of its noise floor
+(the simulation model's residual on held-out simulation data), so outputs
+in different units count alike and an output the model already fits to its
+noise weighs little.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from sysid.discrepancy.terms import Candidate
+
+__all__ = ["TermFit", "blocks", "cross_validated", "fit_term", "effective_samples"]
+
+_N_BLOCKS = 6
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TermFit:
+    """A term fitted on some samples.
+
+    Parameters
+    ----------
+    candidate : Candidate
+        The term.
+    value : float
+        Its grid value (NaN if it has none).
+    coefficients : Mapping[str, ndarray]
+        Per output, the coefficients of its regressors (linear terms; empty for transforms).
+    covariance : Mapping[str, ndarray]
+        Per output, their covariance, residual correlation accounted for.
+    value_uncertainty : float
+        Standard deviation of the grid value, from the curvature of the cost over the grid (NaN if none).
+    """
+
+    candidate: Candidate
+    value: float
+    coefficients: Mapping[str, np.ndarray]
+    covariance: Mapping[str, np.ndarray]
+    value_uncertainty: float
+
+    def prediction(self, base: Mapping[str, np.ndarray], additions: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """The model's prediction with this term: `base` (the simulation model's) plus `additions` plus its own."""
+        built = self.candidate.build(self.value)
+        if self.candidate.kind == "transform":
+            return {o: built[o] + additions[o] for o in base}
+        out = {o: base[o] + additions[o] for o in base}
+        for o, coefficients in self.coefficients.items():
+            out[o] = out[o] + built[o] @ coefficients
+        return out
+
+
+def blocks(n: int, k: int = _N_BLOCKS) -> list[np.ndarray]:
+    """`k` contiguous blocks of sample indices covering ``range(n)``."""
+    edges = np.linspace(0, n, k + 1).astype(int)
+    return [np.arange(edges[i], edges[i + 1]) for i in range(k)]
+
+
+def cross_validated(
+    candidate: Candidate,
+    y: Mapping[str, np.ndarray],
+    base: Mapping[str, np.ndarray],
+    additions: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+) -> tuple[float, dict[str, np.ndarray]]:
+    """Held-out share of the weighted residual of the term's outputs that the term removes, and its predictions.
+
+    Returns
+    -------
+    improvement : float
+        ``1 - SSE_with / SSE_without`` over the held-out blocks (can be negative).
+    predicted : dict of str to ndarray
+        Each output as predicted on every block by the term fitted on the other blocks, shape (n,).
+    """
+    n = next(iter(y.values())).size
+    current = {o: base[o] + additions[o] for o in base}
+    predicted = {o: current[o].copy() for o in current}
+    fixed = replace(candidate, grid=(fit_term(candidate, y, base, additions, scale).value,))
+    for test in blocks(n):
+        train = np.setdiff1d(np.arange(n), test)
+        fit = fit_term(fixed, y, base, additions, scale, train)
+        with_term = fit.prediction(base, additions)
+        for o in candidate.outputs:
+            predicted[o][test] = with_term[o][test]
+    before = sum(np.sum((y[o] - current[o]) ** 2) / scale[o] for o in candidate.outputs)
+    after = sum(np.sum((y[o] - predicted[o]) ** 2) / scale[o] for o in candidate.outputs)
+    return float(1.0 - after / before) if before > 0 else 0.0, predicted
+
+
+def fit_term(
+    candidate: Candidate,
+    y: Mapping[str, np.ndarray],
+    base: Mapping[str, np.ndarray],
+    additions: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+    rows: np.ndarray | None = None,
+) -> TermFit:
+    """The term fitted on samples `rows` (default all): grid value by least weighted SSE, then coefficients."""
+    n = next(iter(y.values())).size
+    rows = np.arange(n) if rows is None else rows
+    costs, fits = [], []
+    for value in candidate.grid:
+        built = candidate.build(value)
+        coefficients, covariance, cost = {}, {}, 0.0
+        for o in candidate.outputs:
+            if candidate.kind == "transform":
+                residual = y[o][rows] - built[o][rows] - additions[o][rows]
+            else:
+                target = y[o][rows] - base[o][rows] - additions[o][rows]
+                z = built[o][rows]
+                coefficients[o], *_ = np.linalg.lstsq(z, target, rcond=None)
+                residual = target - z @ coefficients[o]
+                covariance[o] = _covariance(z, residual)
+            cost += float(np.sum(residual**2)) / scale[o]
+        costs.append(cost)
+        fits.append((value, coefficients, covariance))
+    best = int(np.argmin(costs))
+    value, coefficients, covariance = fits[best]
+    spread = _grid_spread(np.asarray(candidate.grid), np.asarray(costs), best, rows.size, candidate, y, base, scale)
+    if np.isfinite(spread) and len(candidate.grid) > 1:  # never finer than the grid can tell
+        spread = max(spread, float(np.median(np.diff(candidate.grid))) / np.sqrt(12.0))
+    return TermFit(
+        candidate=candidate, value=value, coefficients=coefficients, covariance=covariance, value_uncertainty=spread
+    )
+
+
+def effective_samples(residual: np.ndarray) -> float:
+    """Samples worth of independent information in a correlated residual (lag-1 autocorrelation, AR(1))."""
+    r = residual - residual.mean()
+    denominator = float(np.dot(r, r))
+    rho = float(np.dot(r[1:], r[:-1]) / denominator) if denominator > 0 else 0.0
+    rho = min(max(rho, 0.0), 0.999)
+    return float(residual.size * (1.0 - rho) / (1.0 + rho))
+
+
+def _covariance(z: np.ndarray, residual: np.ndarray) -> np.ndarray:
+    """Coefficient covariance, the residual variance inflated by its correlation (``n / n_effective``)."""
+    inflation = residual.size / max(effective_samples(residual), 1.0)
+    variance = float(np.mean(residual**2)) * inflation
+    return np.asarray(variance * np.linalg.pinv(z.T @ z))
+
+
+def _grid_spread(
+    grid: np.ndarray,
+    costs: np.ndarray,
+    best: int,
+    n: int,
+    candidate: Candidate,
+    y: Mapping[str, np.ndarray],
+    base: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+) -> float:
+    """Standard deviation of the grid value: the cost's curvature at its minimum, residual correlation counted.
+
+    The weighted cost is a sum of squares whose noise variance is one per effective sample, so
+    ``sigma² = 2 / (d²cost/dvalue²)`` scaled by ``n / n_effective`` (taken from the first output's residual).
+    """
+    if grid.size < 3 or not np.isfinite(grid).all():
+        return float("nan")
+    k = min(max(best, 1), grid.size - 2)
+    h1, h2 = grid[k] - grid[k - 1], grid[k + 1] - grid[k]
+    curvature = 2.0 * (h1 * costs[k + 1] - (h1 + h2) * costs[k] + h2 * costs[k - 1]) / (h1 * h2 * (h1 + h2))
+    if curvature <= 0:
+        return float(h1 + h2)
+    per_sample = costs[best] / max(n * len(candidate.outputs), 1)  # about 1 when the floor is right
+    first = candidate.outputs[0]
+    built = candidate.build(float(grid[best]))
+    residual = (y[first] - (built[first] if candidate.kind == "transform" else base[first])) / np.sqrt(scale[first])
+    inflation = residual.size / max(effective_samples(residual), 1.0)
+    return float(np.sqrt(2.0 * max(per_sample, 1e-12) * inflation / curvature))
