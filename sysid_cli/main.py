@@ -84,6 +84,7 @@ def _register() -> None:
     cli.add_command(__import__("sysid_cli.fit", fromlist=["fit"]).fit)
     cli.add_command(__import__("sysid_cli.modes", fromlist=["modes"]).modes)
     cli.add_command(__import__("sysid_cli.report", fromlist=["report"]).report)
+    cli.add_command(__import__("sysid_cli.discrepancy", fromlist=["discrepancy"]).discrepancy)
 
 
 _register()

@@ -39,8 +39,13 @@ _NAMES: Mapping[str, str] = {
 }
 
 
-def parameters_of(fit: TermFit) -> tuple[FittedParameter, ...]:
-    """The fitted parameters of a term, with standard deviations, in SI units."""
+def parameters_of(fit: TermFit, thrust_scale: float = 1.0) -> tuple[FittedParameter, ...]:
+    """The fitted parameters of a term, with standard deviations, in SI units.
+
+    `thrust_scale` is the real over the simulated thrust per input taken out before the term: the
+    battery's exponent is the log-derivative of thrust against voltage, its coefficient over the
+    thrust scale with the term's own gain change.
+    """
     candidate = fit.candidate
     out: list[FittedParameter] = []
     if candidate.grid_parameter:
@@ -66,12 +71,25 @@ def parameters_of(fit: TermFit) -> tuple[FittedParameter, ...]:
                     unit=_UNITS.get(coefficient, "1"),
                 )
             )
+    if candidate.effect == "battery_sag" and len(out) == 2:
+        exponent, gain = out
+        level = thrust_scale + gain.value
+        out[0] = FittedParameter(
+            name="exponent", value=exponent.value / level, uncertainty=exponent.uncertainty / level, unit="1"
+        )
     if candidate.effect == "ground_effect" and len(out) > 1:
         c = out[1]
         ends = np.sqrt(max(c.value, 0.0) / _GROUND_EFFECT_END)
         spread = 0.5 * ends * c.uncertainty / c.value if c.value > 0 else float("nan")
         out.append(FittedParameter(name="ends_at_height", value=float(ends), uncertainty=float(spread), unit="m"))
     return tuple(out)
+
+
+def _pm(value: float, sigma: float, scale: float = 1.0, sign: bool = False) -> str:
+    """``value ± sigma`` (times `scale`), the value to the sigma's second significant digit."""
+    v, s = value * scale, abs(sigma * scale)
+    digits = max(0, min(6, 1 - int(np.floor(np.log10(s)))) if s > 0 and np.isfinite(s) else 1)
+    return f"{v:{'+' if sign else ''}.{digits}f} ± {s:.{digits}f}"
 
 
 def _value(finding: Finding, name: str) -> FittedParameter | None:
@@ -84,22 +102,20 @@ def describe_finding(finding: Finding, candidate: Candidate) -> str:
     gain = f"modelling it cuts the {outputs} residual by {finding.improvement_percent:.0f} % on held-out data"
     effect = candidate.effect
     if effect == "time_delay" and (p := _value(finding, "delay_s")) is not None:
-        what = f"The real vehicle responds {p.value * 1e3:.0f} ± {p.uncertainty * 1e3:.0f} ms later than the simulation"
+        what = f"The real vehicle responds {_pm(p.value, p.uncertainty, 1e3)} ms later than the simulation"
     elif effect == "actuator_lag" and (p := _value(finding, "time_constant_s")) is not None:
         what = (
-            f"The real actuators lag: an extra first-order lag of τ = {p.value * 1e3:.0f} ± {p.uncertainty * 1e3:.0f} ms "
+            f"The real actuators lag: an extra first-order lag of τ = {_pm(p.value, p.uncertainty, 1e3)} ms "
             "that the simulation lacks (the magnitude rolls off, not only the phase)"
         )
     elif effect == "ground_effect" and (p := _value(finding, "ends_at_height")) is not None:
         what = f"The real vehicle gains thrust near the ground, up to about {p.value:.2f} m; the simulation has no ground effect"
     elif effect == "mass_change" and (p := _value(finding, "mass_ratio")) is not None:
         t = _value(finding, "time_s")
-        when = f" at t = {t.value:.1f} ± {t.uncertainty:.1f} s of flight" if t is not None else ""
-        what = (
-            f"The required thrust steps by {p.value * 100:+.1f} ± {p.uncertainty * 100:.1f} %{when}: the mass changed"
-        )
+        when = f" at t = {_pm(t.value, t.uncertainty)} s of flight" if t is not None else ""
+        what = f"The required thrust steps by {_pm(p.value, p.uncertainty, 100.0, sign=True)} %{when}: the mass changed"
     elif effect == "battery_sag" and (p := _value(finding, "exponent")) is not None:
-        what = f"Thrust follows the battery voltage (thrust ∝ V^{p.value:.2f} ± {p.uncertainty:.2f}); the simulation keeps it constant"
+        what = f"Thrust follows the battery voltage (thrust ∝ V^n, n = {_pm(p.value, p.uncertainty)}); the simulation keeps it constant"
     elif effect == "cg_offset":
         what = "A constant moment follows the thrust: the centre of gravity is off the thrust axis"
     elif effect == "rotor_drag":

@@ -31,7 +31,7 @@ from scipy.stats import spearmanr
 
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
 from sysid.discrepancy.describe import describe_finding, parameters_of, summary_of
-from sysid.discrepancy.result import DiscrepancyResult, Finding, Regime
+from sysid.discrepancy.result import DiscrepancyResult, Finding, FindingTraces, Regime
 from sysid.discrepancy.selection import TermFit, blocks, cross_validated, effective_samples, fit_term
 from sysid.discrepancy.series import OUTPUTS, FlightSeries
 from sysid.discrepancy.terms import Candidate, candidate_terms
@@ -126,7 +126,7 @@ def discover(
             for o, coefficients in fit.coefficients.items():
                 additions[o] = additions[o] + built[o] @ coefficients
     findings = sorted(
-        (_finding(fit, score, before, after, y, flown, scale) for fit, score, before, after in kept),
+        (_finding(fit, score, before, after, y, flown, scale, 1.0 + gain) for fit, score, before, after in kept),
         key=lambda f: -f.improvement_percent,
     )
     _report(progress, "done", 3, 3)
@@ -212,6 +212,7 @@ def _finding(
     y: Mapping[str, np.ndarray],
     flown: FlightSeries,
     scale: Mapping[str, float],
+    thrust_scale: float,
 ) -> Finding:
     outputs = fit.candidate.outputs
     rms_before = {o: float(np.sqrt(np.mean((y[o] - before[o]) ** 2))) for o in outputs}
@@ -220,19 +221,40 @@ def _finding(
     weighted_after = sum(rms_after[o] ** 2 / scale[o] for o in outputs)
     improvement = 100.0 * (1.0 - np.sqrt(weighted_after / weighted_before)) if weighted_before > 0 else 0.0
     contribution = {o: after[o] - before[o] for o in outputs}
+    regime = _regime(contribution, flown)
+    if fit.candidate.grid_parameter == "time_s":  # a change at an instant acts from then on
+        regime = Regime(variable="time", unit="s", low=round(fit.value, 3), high=round(float(flown["t_flight"][-1]), 3))
     finding = Finding(
         effect=fit.candidate.effect,
         outputs=outputs,
         band_rad_s=_band(contribution, flown.rate_hz),
-        regime=_regime(contribution, flown),
+        regime=regime,
         explained_variance=round(max(score, 0.0), 4),
-        parameters=parameters_of(fit),
+        parameters=parameters_of(fit, thrust_scale),
         rmse_before=rms_before,
         rmse_after=rms_after,
         improvement_percent=round(float(improvement), 2),
         evidence="",
+        traces=_traces(flown, regime, {o: y[o] - before[o] for o in outputs}, {o: y[o] - after[o] for o in outputs}),
     )
     return _with_evidence(finding, fit.candidate)
+
+
+_MAX_POINTS = 4000  # samples kept for the report's figures
+
+
+def _traces(
+    flown: FlightSeries, regime: Regime, before: Mapping[str, np.ndarray], after: Mapping[str, np.ndarray]
+) -> FindingTraces:
+    step = max(1, flown.n // _MAX_POINTS)
+    variable = {"time": "t_flight"}.get(regime.variable, regime.variable)
+    values = np.hypot(flown["u"], flown["v"]) if variable == "airspeed" else flown[variable]
+    return FindingTraces(
+        time_s=flown["t_flight"][::step],
+        regime=values[::step],
+        before={o: v[::step] for o, v in before.items()},
+        after={o: v[::step] for o, v in after.items()},
+    )
 
 
 def _with_evidence(finding: Finding, candidate: Candidate) -> Finding:

@@ -2,10 +2,32 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["FittedParameter", "Regime", "Finding", "DiscrepancyResult"]
+import numpy as np
+
+__all__ = ["FittedParameter", "Regime", "FindingTraces", "Finding", "DiscrepancyResult"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FindingTraces:
+    """What the report draws of a finding (not in the JSON).
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (n,)
+        Flight clock, s.
+    regime : ndarray, shape (n,)
+        The regime variable, in its unit.
+    before, after : Mapping of str to ndarray, each shape (n,)
+        Held-out residual of each of the finding's outputs without and with it.
+    """
+
+    time_s: np.ndarray
+    regime: np.ndarray
+    before: dict[str, np.ndarray]
+    after: dict[str, np.ndarray]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -84,6 +106,7 @@ class Finding:
     rmse_after: dict[str, float]
     improvement_percent: float
     evidence: str
+    traces: FindingTraces | None = field(default=None, repr=False, compare=False)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

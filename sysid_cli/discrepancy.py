@@ -1,0 +1,94 @@
+"""``sysid discrepancy``: where a real flight departs from its simulation, the physics left out, and the proof."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from ._common import OutputPath, emit_json, json_option, staged_progress
+from ._flights import conditioned_flights
+from ._wind_options import wind_distance_option, wind_offset_option, wind_option
+
+__all__ = ["discrepancy"]
+
+_EPILOG = """\b
+Examples:
+  sysid discrepancy sitl.ulg real.ulg
+  sysid discrepancy sitl_1.ulg sitl_2.ulg --real flight_1.ulg --real flight_2.ulg -o gap.json --report gap.html
+  sysid discrepancy sitl.bin --real flight.bin --wind anemometer.csv --json -
+"""
+
+
+@click.command(epilog=_EPILOG)
+@click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option(
+    "--real",
+    "real_logs",
+    multiple=True,
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    help="A real flight log of the same vehicle (repeatable); without it, LOGS are SIM REAL.",
+)
+@wind_option("Anemometer CSV, or a folder of them (repeatable), for the real flights: adds the wind term.")
+@wind_distance_option()
+@wind_offset_option()
+@click.option("-o", "--out", type=OutputPath(), help="Write the findings (JSON) here.")
+@click.option("--report", type=OutputPath(), help="Write the HTML report here.")
+@json_option
+@click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")
+def discrepancy(
+    logs: tuple[Path, ...],
+    real_logs: tuple[Path, ...],
+    wind_paths: tuple[Path, ...],
+    wind_distance: float | None,
+    wind_offset: float | None,
+    out: Path | None,
+    report: Path | None,
+    json_path: str | None,
+    quiet: bool,
+) -> None:
+    """Compare simulated flights (LOGS: PX4 SITL, ArduPilot SITL, Gazebo or `sysid simulate`, as ULog or
+    DataFlash) with real flights of the same vehicle: locate where they differ, name the physics the
+    simulation leaves out (ground_effect, rotor_drag, wind, time_delay, actuator_lag, battery_sag,
+    mass_change, cg_offset), fit it with its uncertainty and show the residual it removes on held-out
+    data. "none" is an answer: nothing beyond what noise gives on held-out simulated flight."""
+    from flightlogs.conditioning.condition import ConditioningOptions
+    from flightlogs.errors import DataError
+    from flightlogs.writers.jsonio import write_json
+    from reports.discrepancy_report import write_discrepancy_report
+    from sysid.discrepancy import discover, flight_series
+
+    sim_logs: tuple[Path, ...] = logs
+    if not real_logs:
+        if len(logs) != 2:
+            raise click.UsageError("give SIM REAL, or the simulated logs and --real for each real one")
+        sim_logs, real_logs = logs[:1], logs[1:]
+    for path in sim_logs:
+        if path.suffix.lower() == ".json":
+            raise DataError(f"{path}: a fitted model as SIM is not supported yet; give the simulation's flight log")
+    plain = ConditioningOptions()
+    windy = ConditioningOptions(wind_offset_s=wind_offset, wind_distance_m=wind_distance)
+    log_only = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset}
+    simulated = conditioned_flights(list(sim_logs), [], plain, log_only={}, quiet=quiet)
+    flown = conditioned_flights(list(real_logs), list(wind_paths), windy, log_only=log_only, quiet=quiet)
+    with staged_progress("discrepancy", quiet=quiet) as progress:
+        result = discover(
+            [flight_series(f.source.name, f.records) for f in simulated],
+            [flight_series(f.source.name, f.records) for f in flown],
+            progress=progress,
+        )
+    summary = result.to_dict()
+    if out is not None:
+        write_json(out, summary)
+    if report is not None:
+        write_discrepancy_report(report, result)
+    if not quiet:
+        click.echo(f"verdict: {result.verdict}")
+        for finding in result.findings:
+            click.echo(f"  {finding.effect:14s} {finding.improvement_percent:5.1f} % held-out  {finding.evidence}")
+        if not result.findings:
+            click.echo(f"  {result.summary}")
+        for written in (out, report):
+            if written is not None:
+                click.echo(f"wrote {written}")
+    emit_json(summary, json_path)
