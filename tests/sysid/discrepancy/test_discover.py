@@ -1,6 +1,6 @@
 """Discrepancy discovery on SIM / REAL pairs with one concealed effect (issue 15), through PX4 logs.
 
-The pairs come from our simulator (``tests/discrepancy_pairs.py``): one mission, the REAL flight with
+The pairs come from our simulator (:mod:`simulator.campaign.discrepancy_pairs`): one mission, the REAL flight with
 the effect, another noise seed and its events moved by 2 %. The thresholds (a held-out score of 0.05,
 and three times the term's score on held-out simulated flight) and the terms' shapes were set on seeds
 1, 2, 3 and 5; these tests assert on seed 11. The truth is the simulator's own constants.
@@ -18,10 +18,10 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
-from discrepancy_pairs import write_pairs
 
 from flightlogs.conditioning.condition import condition_flight
 from flightlogs.readers import read_log
+from simulator.campaign.discrepancy_pairs import write_pairs
 from simulator.vehicle.presets import OCTO_S1000
 from sysid.discrepancy import DiscrepancyResult, discover, flight_series
 from sysid_cli.main import cli

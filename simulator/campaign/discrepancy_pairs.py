@@ -1,4 +1,4 @@
-"""SIM / REAL pairs from our simulator with one concealed effect each, written as PX4 logs.
+"""SIM / REAL pairs with a concealed effect, written as PX4 logs: for ``sysid demo --discrepancy``, tests, benchmarks.
 
 A pair is two flights of one mission (hover at 3 m, lon, lat and yaw sweeps, height steps down to
 0.3 m and back), the REAL one with an effect the SIM one lacks, its timing stretched by a few
@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any, Literal
 
 from simulator.autopilot.control import HeightSteps
 from simulator.autopilot.excitation import Maneuver
@@ -19,9 +20,11 @@ from simulator.output.px4 import write_px4_log
 from simulator.vehicle.presets import OCTO_S1000
 from simulator.world.environment import Environment, GroundEffect, PayloadChange
 
+__all__ = ["DURATION_S", "EFFECTS", "MODERATE", "mission", "write_pairs", "write_pair_set"]
+
 DURATION_S = 160.0
 #: Effect name -> (environment changes, vehicle changes) at the "strong" strength.
-EFFECTS = {
+EFFECTS: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {
     "none": ({}, {}),
     "ground_effect": ({"ground_effect": GroundEffect(model="cheeseman_bennett")}, {}),
     "battery_sag": ({"thrust_sag": True}, {}),
@@ -30,7 +33,14 @@ EFFECTS = {
     "time_delay": ({}, {"delays_s": OCTO_S1000.delays_s + 0.03}),
     "actuator_lag": ({}, {"motor_time_constant_s": OCTO_S1000.motor_time_constant_s * 1.6}),
 }
-_BASE = {"ground_effect": GroundEffect(model="none"), "rotor_drag": True, "thrust_sag": False}
+_BASE: dict[str, Any] = {"ground_effect": GroundEffect(model="none"), "rotor_drag": True, "thrust_sag": False}
+
+
+_SWEEPS: tuple[tuple[Literal["lat", "lon", "yaw", "thr"], float, float, float, float], ...] = (
+    ("lon", 8.0, 6.0, 30.0, 6.0),  # axis, start s, amplitude %, length s, top frequency Hz
+    ("lat", 42.0, 6.0, 30.0, 6.0),
+    ("yaw", 76.0, 8.0, 20.0, 4.0),
+)
 
 
 def mission(environment: Environment, seed: int, stretch: float = 0.0) -> Trial:
@@ -47,11 +57,7 @@ def mission(environment: Environment, seed: int, stretch: float = 0.0) -> Trial:
             f_stop_hz=f_stop,
             fade_in_s=2.0,
         )
-        for axis, start, amplitude, length, f_stop in (
-            ("lon", 8, 6.0, 30, 6.0),
-            ("lat", 42, 6.0, 30, 6.0),
-            ("yaw", 76, 8.0, 20, 4.0),
-        )
+        for axis, start, amplitude, length, f_stop in _SWEEPS
     )
     steps = HeightSteps(
         times_s=(0.0, 100 * s, 112 * s, 124 * s, 136 * s, 148 * s), heights_m=(3.0, 1.2, 0.5, 0.3, 0.6, 2.0)
@@ -85,3 +91,43 @@ def write_pairs(effects: list[str], folder: Path, seed: int = 1) -> tuple[Path, 
         (flown[effect],) = simulate_flights([trial], vehicle, method="euler")
     sim = write_px4_log(flown.pop("sim"), folder / f"sim-{seed}.ulg", utc_start=start)
     return sim, {e: write_px4_log(f, folder / f"real-{e}-{seed}.ulg", utc_start=start) for e, f in flown.items()}
+
+
+#: The same effects at half strength ("moderate"; battery sag has one strength: the pack's own).
+MODERATE: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {
+    "ground_effect": ({"ground_effect": GroundEffect(model="exponential", a=0.1372)}, {}),
+    "battery_sag": EFFECTS["battery_sag"],
+    "mass_change": ({"payload": PayloadChange(time_s=70.0, delta_mass_kg=0.2)}, {}),
+    "cg_offset": ({"cg_offset_m": (0.01, 0.0, 0.0)}, {}),
+    "time_delay": ({}, {"delays_s": OCTO_S1000.delays_s + 0.015}),
+    "actuator_lag": ({}, {"motor_time_constant_s": OCTO_S1000.motor_time_constant_s * 1.3}),
+}
+
+
+def write_pair_set(
+    pairs: dict[str, list[tuple[dict[str, Any], dict[str, Any]]]], folder: Path, seed: int
+) -> tuple[Path, dict[str, Path]]:
+    """One SIM ULog and a REAL ULog per named pair, each pair a list of (environment, vehicle) changes combined.
+
+    The REAL flights with the simulated vehicle fly as one batch with SIM; the others one by one.
+    """
+    start = datetime(2024, 6, 1, 10, 0, tzinfo=UTC)
+    combined = {}
+    for name, parts in pairs.items():
+        environment: dict[str, Any] = {}
+        vehicle: dict[str, Any] = {}
+        for env_part, vehicle_part in parts:
+            environment.update(env_part)
+            vehicle.update(vehicle_part)
+        combined[name] = (environment, vehicle)
+    same = [n for n, (_, v) in combined.items() if not v]
+    trials = [mission(Environment(**_BASE), seed)] + [
+        mission(Environment(**{**_BASE, **combined[n][0]}), seed + 1000 + k, 0.02) for k, n in enumerate(same)
+    ]
+    flown = dict(zip(["sim", *same], simulate_flights(trials, OCTO_S1000, method="euler")))
+    for k, name in enumerate(n for n, (_, v) in combined.items() if v):
+        environment, vehicle = combined[name]
+        trial = mission(Environment(**{**_BASE, **environment}), seed + 2000 + k, 0.02)
+        (flown[name],) = simulate_flights([trial], dataclasses.replace(OCTO_S1000, **vehicle), method="euler")
+    sim = write_px4_log(flown.pop("sim"), folder / f"sim-{seed}.ulg", utc_start=start)
+    return sim, {n: write_px4_log(f, folder / f"real-{n}-{seed}.ulg", utc_start=start) for n, f in flown.items()}
