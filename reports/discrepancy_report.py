@@ -77,5 +77,13 @@ def render_discrepancy_report(result: DiscrepancyResult, *, title: str = "Simula
 
 
 def write_discrepancy_report(path: str | Path, result: DiscrepancyResult) -> Path:
-    """Render and write the report atomically; returns the path."""
+    """Render and write the report atomically; returns the path.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination ``.html``.
+    result : DiscrepancyResult
+        The search's answer.
+    """
     return write_html(path, render_discrepancy_report(result))

@@ -44,7 +44,17 @@ _SWEEPS: tuple[tuple[Literal["lat", "lon", "yaw", "thr"], float, float, float, f
 
 
 def mission(environment: Environment, seed: int, stretch: float = 0.0) -> Trial:
-    """The mission, its events moved by ``1 + stretch``."""
+    """The mission, its events moved by ``1 + stretch``.
+
+    Parameters
+    ----------
+    environment : Environment
+        Wind, ground effect, payload, CG, battery sag of the flight.
+    seed : int
+        Noise seed.
+    stretch : float, optional
+        Relative change of the events' times (0.02: 2 % later).
+    """
     s = 1.0 + stretch
     sweeps = tuple(
         Maneuver(
@@ -78,6 +88,22 @@ def write_pairs(effects: list[str], folder: Path, seed: int = 1) -> tuple[Path, 
 
     The flights of one vehicle fly as one batch; an effect of the vehicle itself (delay, lag) flies alone.
     Each REAL flight has its own noise seed and its events moved by 2 %.
+
+    Parameters
+    ----------
+    effects : list of str
+        Keys of :data:`EFFECTS`.
+    folder : Path
+        Where to write.
+    seed : int, optional
+        Noise seed of SIM (each REAL flight another).
+
+    Returns
+    -------
+    sim : Path
+        The simulated flight's log.
+    reals : dict of str to Path
+        Each effect's real flight log.
     """
     start = datetime(2024, 6, 1, 10, 0, tzinfo=UTC)
     same = [e for e in effects if not EFFECTS[e][1]]
@@ -110,6 +136,22 @@ def write_pair_set(
     """One SIM ULog and a REAL ULog per named pair, each pair a list of (environment, vehicle) changes combined.
 
     The REAL flights with the simulated vehicle fly as one batch with SIM; the others one by one.
+
+    Parameters
+    ----------
+    pairs : dict of str to list of (dict, dict)
+        Name -> the (environment changes, vehicle changes) combined in its REAL flight.
+    folder : Path
+        Where to write.
+    seed : int
+        Noise seed of SIM.
+
+    Returns
+    -------
+    sim : Path
+        The simulated flight's log.
+    reals : dict of str to Path
+        Each pair's real flight log.
     """
     start = datetime(2024, 6, 1, 10, 0, tzinfo=UTC)
     combined = {}

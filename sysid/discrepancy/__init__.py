@@ -4,8 +4,8 @@
 from a conditioned flight's records) and returns a :class:`DiscrepancyResult`.
 """
 
-from sysid.discrepancy.discover import DiscrepancyOptions, discover
 from sysid.discrepancy.result import DiscrepancyResult, Finding, FittedParameter, Regime
+from sysid.discrepancy.search import DiscrepancyOptions, discover
 from sysid.discrepancy.series import FlightSeries, flight_series
 from sysid.discrepancy.terms import EFFECTS
 

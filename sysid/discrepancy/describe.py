@@ -45,17 +45,27 @@ def parameters_of(fit: TermFit, thrust_scale: float = 1.0) -> tuple[FittedParame
     `thrust_scale` is the real over the simulated thrust per input taken out before the term: the
     battery's exponent is the log-derivative of thrust against voltage, its coefficient over the
     thrust scale with the term's own gain change.
+
+    Parameters
+    ----------
+    fit : TermFit
+        The term fitted on all of REAL.
+    thrust_scale : float, optional
+        Real over simulated thrust per input (the trim fitted before any term).
+
+    Returns
+    -------
+    tuple of FittedParameter
     """
     candidate = fit.candidate
     out: list[FittedParameter] = []
     if candidate.grid_parameter:
-        name, unit = candidate.grid_parameter.rsplit("_", 1)
+        unit = candidate.grid_parameter.rsplit("_", 1)[1]  # names end in their unit: delay_s, time_s
         out.append(
             FittedParameter(
                 name=candidate.grid_parameter, value=fit.value, uncertainty=fit.value_uncertainty, unit=unit
             )
         )
-        del name
     names = iter(candidate.coefficients)
     for o in candidate.outputs:
         if o not in fit.coefficients:
@@ -97,7 +107,15 @@ def _value(finding: Finding, name: str) -> FittedParameter | None:
 
 
 def describe_finding(finding: Finding, candidate: Candidate) -> str:
-    """One sentence: what the real vehicle does, with the numbers, and the held-out gain."""
+    """One sentence: what the real vehicle does, with the numbers, and the held-out gain.
+
+    Parameters
+    ----------
+    finding : Finding
+        The finding (its evidence not yet set).
+    candidate : Candidate
+        Its term.
+    """
     outputs = ", ".join(finding.outputs)
     gain = f"modelling it cuts the {outputs} residual by {finding.improvement_percent:.0f} % on held-out data"
     effect = candidate.effect
@@ -128,7 +146,15 @@ def describe_finding(finding: Finding, candidate: Candidate) -> str:
 
 
 def summary_of(findings: Sequence[Finding], noise_floor: Mapping[str, float]) -> str:
-    """Plain-language summary, the most important finding first (or that nothing is missing)."""
+    """Plain-language summary, the most important finding first (or that nothing is missing).
+
+    Parameters
+    ----------
+    findings : sequence of Finding
+        By importance.
+    noise_floor : Mapping[str, float]
+        Held-out residual RMS of each output on simulated flight, in its unit.
+    """
     if not findings:
         floor = ", ".join(f"{o} {v:.3g}" for o, v in noise_floor.items())
         return (

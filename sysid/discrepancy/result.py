@@ -94,6 +94,8 @@ class Finding:
         Held-out cut of the residual RMS of its outputs, %.
     evidence : str
         One sentence.
+    traces : FindingTraces or None
+        What the report draws (not in the JSON).
     """
 
     effect: str

@@ -62,7 +62,15 @@ class TermFit:
 
 
 def blocks(n: int, k: int = _N_BLOCKS) -> list[np.ndarray]:
-    """`k` contiguous blocks of sample indices covering ``range(n)``."""
+    """`k` contiguous blocks of sample indices covering ``range(n)``.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+    k : int, optional
+        Number of blocks.
+    """
     edges = np.linspace(0, n, k + 1).astype(int)
     return [np.arange(edges[i], edges[i + 1]) for i in range(k)]
 
@@ -75,6 +83,19 @@ def cross_validated(
     scale: Mapping[str, float],
 ) -> tuple[float, dict[str, np.ndarray]]:
     """Held-out share of the weighted residual of the term's outputs that the term removes, and its predictions.
+
+    Parameters
+    ----------
+    candidate : Candidate
+        The term.
+    y : Mapping[str, ndarray]
+        Each output as flown, shape (n,).
+    base : Mapping[str, ndarray]
+        The simulation model's prediction of each output, shape (n,) (a transform term replaces it).
+    additions : Mapping[str, ndarray]
+        Contributions of the terms already kept, shape (n,) each.
+    scale : Mapping[str, float]
+        Each output's noise-floor variance (the weights are its inverse).
 
     Returns
     -------
@@ -106,7 +127,19 @@ def fit_term(
     scale: Mapping[str, float],
     rows: np.ndarray | None = None,
 ) -> TermFit:
-    """The term fitted on samples `rows` (default all): grid value by least weighted SSE, then coefficients."""
+    """The term fitted on samples `rows` (default all): grid value by least weighted SSE, then coefficients.
+
+    Parameters
+    ----------
+    candidate, y, base, additions, scale
+        As :func:`cross_validated`.
+    rows : ndarray of int, optional
+        Samples to fit on.
+
+    Returns
+    -------
+    TermFit
+    """
     n = next(iter(y.values())).size
     rows = np.arange(n) if rows is None else rows
     costs, fits = [], []
@@ -136,7 +169,13 @@ def fit_term(
 
 
 def effective_samples(residual: np.ndarray) -> float:
-    """Samples worth of independent information in a correlated residual (lag-1 autocorrelation, AR(1))."""
+    """Samples worth of independent information in a correlated residual (lag-1 autocorrelation, AR(1)).
+
+    Parameters
+    ----------
+    residual : ndarray, shape (n,)
+        A residual time series.
+    """
     r = residual - residual.mean()
     denominator = float(np.dot(r, r))
     rho = float(np.dot(r[1:], r[:-1]) / denominator) if denominator > 0 else 0.0

@@ -23,7 +23,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.signal import welch
@@ -258,8 +258,6 @@ def _traces(
 
 
 def _with_evidence(finding: Finding, candidate: Candidate) -> Finding:
-    from dataclasses import replace
-
     return replace(finding, evidence=describe_finding(finding, candidate))
 
 
