@@ -26,7 +26,7 @@ DURATION_S = 160.0
 #: Effect name -> (environment changes, vehicle changes) at the "strong" strength.
 EFFECTS: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {
     "none": ({}, {}),
-    "ground_effect": ({"ground_effect": GroundEffect(model="cheeseman_bennett")}, {}),
+    "ground_effect": ({"ground_effect": GroundEffect(model="exponential")}, {}),
     "battery_sag": ({"thrust_sag": True}, {}),
     "mass_change": ({"payload": PayloadChange(time_s=70.0, delta_mass_kg=0.4)}, {}),
     "cg_offset": ({"cg_offset_m": (0.02, 0.0, 0.0)}, {}),

@@ -27,7 +27,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.signal import welch
-from scipy.stats import spearmanr
 
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
 from sysid.discrepancy.describe import describe_finding, parameters_of, summary_of
@@ -221,7 +220,7 @@ def _finding(
     weighted_after = sum(rms_after[o] ** 2 / scale[o] for o in outputs)
     improvement = 100.0 * (1.0 - np.sqrt(weighted_after / weighted_before)) if weighted_before > 0 else 0.0
     contribution = {o: after[o] - before[o] for o in outputs}
-    regime = _regime(contribution, flown)
+    regime = _regime(contribution, flown, fit.candidate.regime)
     if fit.candidate.grid_parameter == "time_s":  # a change at an instant acts from then on
         regime = Regime(variable="time", unit="s", low=round(fit.value, 3), high=round(float(flown["t_flight"][-1]), 3))
     finding = Finding(
@@ -274,25 +273,44 @@ def _band(contribution: Mapping[str, np.ndarray], rate_hz: float) -> tuple[float
     return (round(float(2 * np.pi * lo), 3), round(float(2 * np.pi * hi), 3))
 
 
-def _regime(contribution: Mapping[str, np.ndarray], flown: FlightSeries) -> Regime:
-    """The flight variable whose value the contribution's size follows most closely, and the range it acts in."""
-    size = np.sqrt(sum(np.asarray(c) ** 2 for c in contribution.values()))
-    variables = {name: flown[name] for name, _ in _REGIMES if name in flown}
+def _regime(contribution: Mapping[str, np.ndarray], flown: FlightSeries, own: str | None) -> Regime:
+    """The range of a flight variable holding the contribution: the term's `own` variable, else the narrowest.
+
+    The range holds 80 % of the contribution's energy (its departures from its median: a trim acts
+    everywhere and locates nothing). Without a variable of its own (a delay, a lag), each flight
+    variable's range is taken as a share of its whole range and the narrowest wins; time only when no
+    flight variable varies: it follows anything.
+    """
+    size = np.sqrt(sum((np.asarray(c) - np.median(c)) ** 2 for c in contribution.values()))
+    variables = {name: flown[name] for name, _ in _REGIMES if name in flown and name != "t_flight"}
     if "u" in flown and "v" in flown:
         variables["airspeed"] = np.hypot(flown["u"], flown["v"])
     units = dict(_REGIMES)
-    best, best_rho = "t_flight", -1.0
-    for name, values in variables.items():
-        if np.ptp(values) <= 0 or np.ptp(size) <= 0:
+    if own is not None and (own in variables or own == "t_flight"):
+        values = variables.get(own, flown["t_flight"])
+        low, high = _energy_range(values, size)
+        return Regime(
+            variable="time" if own == "t_flight" else own, unit=units[own], low=round(low, 3), high=round(high, 3)
+        )
+    best: tuple[float, str, float, float] = (np.inf, "t_flight", 0.0, 0.0)
+    for name, values in {**variables, "t_flight": flown["t_flight"]}.items():
+        spread = float(np.ptp(values))
+        if spread <= 0 or np.ptp(size) <= 0:
             continue
-        rho = abs(float(spearmanr(values, size).statistic))
-        if np.isfinite(rho) and rho > best_rho:
-            best, best_rho = name, rho
-    values = variables[best]
+        low, high = _energy_range(values, size)
+        share = (high - low) / spread if name != "t_flight" else np.inf
+        if share < best[0] or best[1] == "t_flight" and name == "t_flight":
+            best = (share, name, low, high)
+    _, name, low, high = best
+    return Regime(
+        variable="time" if name == "t_flight" else name, unit=units[name], low=round(low, 3), high=round(high, 3)
+    )
+
+
+def _energy_range(values: np.ndarray, size: np.ndarray) -> tuple[float, float]:
+    """The range of `values` holding the middle 80 % of ``size**2``."""
     order = np.argsort(values)
     energy = np.cumsum(size[order] ** 2) / max(float(np.sum(size**2)), 1e-300)
     low = float(values[order][int(np.searchsorted(energy, 0.1))])
     high = float(values[order][min(int(np.searchsorted(energy, 0.9)), values.size - 1)])
-    return Regime(
-        variable="time" if best == "t_flight" else best, unit=units[best], low=round(low, 3), high=round(high, 3)
-    )
+    return low, high

@@ -86,6 +86,9 @@ class Candidate:
         ``build(value)``: the regressors per output (linear) or the new prediction per output (transform).
     coefficients : tuple of str
         Names of the fitted coefficients (linear), in column order.
+    regime : str or None
+        The flight variable its shape depends on (``height_agl``, ``battery_v``, ``airspeed``,
+        ``delta_thr``, ``t_flight``), whose range the finding reports; None: found from the data.
     """
 
     effect: str
@@ -95,6 +98,7 @@ class Candidate:
     grid_parameter: str
     build: Callable[[float], Regressors | Prediction]
     coefficients: tuple[str, ...] = ()
+    regime: str | None = None
 
 
 def candidate_terms(
@@ -128,7 +132,9 @@ def candidate_terms(
     return found
 
 
-def _linear(effect: str, columns: Mapping[str, list[np.ndarray]], names: tuple[str, ...]) -> Candidate:
+def _linear(
+    effect: str, columns: Mapping[str, list[np.ndarray]], names: tuple[str, ...], regime: str | None
+) -> Candidate:
     regressors = {o: np.column_stack(c) for o, c in columns.items()}
     return Candidate(
         effect=effect,
@@ -138,6 +144,7 @@ def _linear(effect: str, columns: Mapping[str, list[np.ndarray]], names: tuple[s
         grid_parameter="",
         build=lambda _value: regressors,
         coefficients=names,
+        regime=regime,
     )
 
 
@@ -158,12 +165,13 @@ def _ground_effect(series: FlightSeries, _baseline: BaselineModel, thrust: np.nd
         grid_parameter="rotor_above_height_m",
         build=build,
         coefficients=("c_m2", "gain"),
+        regime="height_agl",
     )
 
 
 def _rotor_drag(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndarray) -> Candidate | None:
     u, v = _air_velocity(series)
-    return _linear("rotor_drag", {"ax": [-thrust * u], "ay": [-thrust * v]}, ("d_x_s_m", "d_y_s_m"))
+    return _linear("rotor_drag", {"ax": [-thrust * u], "ay": [-thrust * v]}, ("d_x_s_m", "d_y_s_m"), "airspeed")
 
 
 def _wind(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndarray) -> Candidate | None:
@@ -171,7 +179,7 @@ def _wind(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndarray) ->
         return None
     along, across = thrust * series["wind_lon"], thrust * series["wind_lat"]
     columns = {"ax": [along], "ay": [across], "p_dot": [across], "q_dot": [along]}
-    return _linear("wind", columns, ("d_x_s_m", "d_y_s_m", "l_wind_rad_m", "m_wind_rad_m"))
+    return _linear("wind", columns, ("d_x_s_m", "d_y_s_m", "l_wind_rad_m", "m_wind_rad_m"), "airspeed")
 
 
 def _time_delay(series: FlightSeries, baseline: BaselineModel, _thrust: np.ndarray) -> Candidate:
@@ -204,7 +212,7 @@ def _battery_sag(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndar
         return None
     volts = series["battery_v"]
     relative = (volts - volts.mean()) / volts.mean()
-    return _linear("battery_sag", {"az": [-thrust * relative, -thrust]}, ("exponent", "gain"))
+    return _linear("battery_sag", {"az": [-thrust * relative, -thrust]}, ("exponent", "gain"), "battery_v")
 
 
 def _mass_change(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndarray) -> Candidate:
@@ -224,11 +232,12 @@ def _mass_change(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndar
         grid_parameter="time_s",
         build=build,
         coefficients=("mass_ratio", "gain"),
+        regime="t_flight",
     )
 
 
 def _cg_offset(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndarray) -> Candidate:
-    return _linear("cg_offset", {"p_dot": [thrust], "q_dot": [thrust]}, ("l_rad_m", "m_rad_m"))
+    return _linear("cg_offset", {"p_dot": [thrust], "q_dot": [thrust]}, ("l_rad_m", "m_rad_m"), "delta_thr")
 
 
 _MAKERS: Mapping[str, Callable[[FlightSeries, BaselineModel, np.ndarray], Candidate | None]] = {
