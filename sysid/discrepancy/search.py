@@ -31,7 +31,7 @@ from scipy.signal import welch
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
 from sysid.discrepancy.describe import describe_finding, parameters_of, summary_of
 from sysid.discrepancy.result import DiscrepancyResult, Finding, FindingTraces, Regime
-from sysid.discrepancy.selection import TermFit, blocks, cross_validated, effective_samples, fit_term
+from sysid.discrepancy.selection import TermFit, blocks, combined, cross_validated, effective_samples, fit_term
 from sysid.discrepancy.series import OUTPUTS, FlightSeries
 from sysid.discrepancy.terms import Candidate, candidate_terms
 
@@ -95,12 +95,12 @@ def discover(
     additions["az"] = -gain * thrust  # the real thrust per input may differ by a constant factor: a trim
     kept: list[tuple[TermFit, float, dict[str, np.ndarray], dict[str, np.ndarray]]] = []
     screened: dict[str, float] = {}
-    held_out = _sum(base, additions)  # the baseline is fitted on SIM: on REAL its prediction is held out already
+    held_out = combined(base, additions)  # the baseline is fitted on SIM: on REAL its prediction is held out already
     while len(kept) < options.max_findings:
         found = {t.candidate.effect for t, *_ in kept}
         exclude = tuple(found | (set(_TRANSFORMS) if found & set(_TRANSFORMS) else set()))
         scores = []
-        for candidate in candidate_terms(flown, baseline, _sum(base, additions), exclude=exclude):
+        for candidate in candidate_terms(flown, baseline, combined(base, additions), exclude=exclude):
             score, predicted = cross_validated(candidate, y, base, additions, scale)
             threshold = max(options.min_improvement, options.null_margin * max(null.get(candidate.effect, 0.0), 0.0))
             if not kept:
@@ -147,10 +147,6 @@ def _report(progress: Progress | None, stage: str, done: int, total: int) -> Non
         progress(stage, done, total)
 
 
-def _sum(a: Mapping[str, np.ndarray], b: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-    return {o: a[o] + b[o] for o in a}
-
-
 def _bic_change(
     fit: TermFit, y: Mapping[str, np.ndarray], base: Mapping[str, np.ndarray], additions: Mapping[str, np.ndarray]
 ) -> float:
@@ -159,7 +155,7 @@ def _bic_change(
     Each output's likelihood counts its effective samples (its residual is correlated), and the term's
     parameters are its coefficients plus the value inside its shape.
     """
-    current = _sum(base, additions)
+    current = combined(base, additions)
     with_term = fit.prediction(base, additions)
     change, samples = 0.0, 0.0
     for o in fit.candidate.outputs:

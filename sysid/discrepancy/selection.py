@@ -21,7 +21,7 @@ import numpy as np
 
 from sysid.discrepancy.terms import Candidate
 
-__all__ = ["TermFit", "blocks", "cross_validated", "fit_term", "effective_samples"]
+__all__ = ["TermFit", "blocks", "combined", "cross_validated", "fit_term", "effective_samples"]
 
 _N_BLOCKS = 6
 
@@ -55,10 +55,21 @@ class TermFit:
         built = self.candidate.build(self.value)
         if self.candidate.kind == "transform":
             return {o: built[o] + additions[o] for o in base}
-        out = {o: base[o] + additions[o] for o in base}
+        out = combined(base, additions)
         for o, coefficients in self.coefficients.items():
             out[o] = out[o] + built[o] @ coefficients
         return out
+
+
+def combined(base: Mapping[str, np.ndarray], additions: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The model's prediction: the simulation model's `base` plus the kept terms' `additions`, per output.
+
+    Parameters
+    ----------
+    base, additions : Mapping[str, ndarray]
+        Per output, shape (n,) each.
+    """
+    return {o: base[o] + additions[o] for o in base}
 
 
 def blocks(n: int, k: int = _N_BLOCKS) -> list[np.ndarray]:
@@ -105,7 +116,7 @@ def cross_validated(
         Each output as predicted on every block by the term fitted on the other blocks, shape (n,).
     """
     n = next(iter(y.values())).size
-    current = {o: base[o] + additions[o] for o in base}
+    current = combined(base, additions)
     predicted = {o: current[o].copy() for o in current}
     fixed = replace(candidate, grid=(fit_term(candidate, y, base, additions, scale).value,))
     for test in blocks(n):

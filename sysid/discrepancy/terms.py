@@ -170,7 +170,9 @@ def _ground_effect(series: FlightSeries, _baseline: BaselineModel, thrust: np.nd
 
 
 def _rotor_drag(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndarray) -> Candidate | None:
-    u, v = _air_velocity(series)
+    if "u" not in series or "v" not in series:
+        return None
+    u, v = series["u"], series["v"]  # air-relative when the wind is given (the conditioning makes them so)
     return _linear("rotor_drag", {"ax": [-thrust * u], "ay": [-thrust * v]}, ("d_x_s_m", "d_y_s_m"), "airspeed")
 
 
@@ -250,13 +252,6 @@ _MAKERS: Mapping[str, Callable[[FlightSeries, BaselineModel, np.ndarray], Candid
     "mass_change": _mass_change,
     "cg_offset": _cg_offset,
 }
-
-
-def _air_velocity(series: FlightSeries) -> tuple[np.ndarray, np.ndarray]:
-    """Body velocities ``u v`` (air-relative when the wind is given; the conditioning makes them so)."""
-    if "u" in series and "v" in series:
-        return series["u"], series["v"]
-    return np.zeros(series.n), np.zeros(series.n)
 
 
 def _delayed(series: FlightSeries, x: np.ndarray, tau: float) -> np.ndarray:
