@@ -1,14 +1,15 @@
 """Discrepancy discovery over a matrix of SIM / REAL pairs from our simulator: confusion matrix and timings.
 
-    python benchmarks/bench_discrepancy.py [--seeds 21 22 23] [--nulls 20]
+    python benchmarks/bench_discrepancy.py [--vehicles octo quad] [--seeds 21 22 23] [--nulls 4]
 
-For each seed: one SIM flight of the mission of :mod:`simulator.campaign.discrepancy_pairs` (hover, lon/lat/yaw
-sweeps, height steps to 0.3 m; 160 s, octocopter), and REAL flights with each effect at two strengths,
-two doubles (ground_effect+time_delay, mass_change+time_delay) and null flights (no effect, other
-noise seeds and timing). Every pair is written as PX4 ULogs, read back and searched; the table is the
-confusion matrix (rows: truth, columns: verdict), then the share of singles named, of nulls answered
-"none", of doubles with both named, the median held-out improvement and the seconds per pair (reading
-both logs and searching; the simulation is not counted).
+For each vehicle (the chapter 3 octocopter, a 2 kg quad) and seed: one SIM flight of the mission of
+:mod:`simulator.campaign.discrepancy_pairs` (hover, lon/lat/yaw sweeps, legs north and east, height steps
+down to Z/R = 2; 4 minutes), and REAL flights with each of the eight effects at two strengths (battery
+sag has one), four doubles and `--nulls` null flights (no effect, another noise seed), every REAL
+flight's events moved by 5 %, alternately later and earlier. Every pair is written as PX4 ULogs, read
+back and searched; the table is the confusion matrix (rows: truth, columns: verdict), then the share of
+singles named, of nulls answered "none", of doubles with both named, the median held-out improvement and
+the seconds per pair (reading both logs and searching; the simulation is not counted).
 """
 
 from __future__ import annotations
@@ -23,86 +24,101 @@ from pathlib import Path
 
 from flightlogs.conditioning.condition import condition_flight
 from flightlogs.readers import read_log
-from simulator.campaign.discrepancy_pairs import EFFECTS, MODERATE, write_pair_set
+from simulator.campaign.discrepancy_pairs import EFFECTS, STRENGTHS, VEHICLES, write_pair_set
 from sysid.discrepancy import discover, flight_series
 
 SINGLES = [e for e in EFFECTS if e != "none"]
-DOUBLES = {
-    "ground_effect+time_delay": ("ground_effect", "time_delay"),
-    "mass_change+time_delay": ("mass_change", "time_delay"),
-}
+DOUBLES = (
+    ("ground_effect", "time_delay"),
+    ("rotor_drag", "battery_sag"),
+    ("mass_change", "time_delay"),
+    ("wind", "cg_offset"),
+)
+Row = tuple[str, str, str, str, tuple[str, ...], float, float]  # kind, vehicle, truth, verdict, found, improvement, s
 
 
 def _series(path: Path):  # type: ignore[no-untyped-def]
     return flight_series(path.name, condition_flight(read_log(path)).records)
 
 
+def _pairs(nulls: int) -> dict[str, list[tuple[str, str]]]:
+    pairs: dict[str, list[tuple[str, str]]] = {}
+    for strength in STRENGTHS:
+        for effect in SINGLES:
+            if effect != "battery_sag" or strength == "strong":  # the pack's own sag: one strength
+                pairs[f"{effect}@{strength}"] = [(effect, strength)]
+    pairs |= {f"{a}+{b}@strong": [(a, "strong"), (b, "strong")] for a, b in DOUBLES}
+    pairs |= {f"none@{k}": [("none", "strong")] for k in range(nulls)}
+    return pairs
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--vehicles", nargs="+", default=list(VEHICLES), choices=list(VEHICLES))
     parser.add_argument("--seeds", type=int, nargs="+", default=[21, 22, 23])
-    parser.add_argument("--nulls", type=int, default=20, help="null pairs in all (spread over the seeds)")
+    parser.add_argument("--nulls", type=int, default=4, help="null pairs per vehicle and seed")
     args = parser.parse_args()
     warnings.simplefilter("ignore")
-    rows: list[tuple[str, str, str, tuple[str, ...], float, float]] = []  # kind, truth, verdict, found, improvement, s
-    per_seed_nulls = -(-args.nulls // len(args.seeds))
-    for seed in args.seeds:
-        pairs = {f"{e}@strong": [EFFECTS[e]] for e in SINGLES}
-        pairs |= {f"{e}@moderate": [MODERATE[e]] for e in SINGLES if MODERATE[e] is not EFFECTS[e]}
-        pairs |= {f"{name}@strong": [EFFECTS[a], EFFECTS[b]] for name, (a, b) in DOUBLES.items()}
-        pairs |= {f"none@{k}": [EFFECTS["none"]] for k in range(per_seed_nulls)}
-        with tempfile.TemporaryDirectory() as folder:
-            started = time.perf_counter()
-            sim, reals = write_pair_set(pairs, Path(folder), seed)
-            print(f"seed {seed}: {len(reals)} pairs simulated in {time.perf_counter() - started:.0f} s", flush=True)
-            for name, path in reals.items():
-                truth, strength = name.split("@")
+    rows: list[Row] = []
+    for vehicle in args.vehicles:
+        for seed in args.seeds:
+            with tempfile.TemporaryDirectory() as folder:
                 started = time.perf_counter()
-                result = discover([_series(sim)], [_series(path)])
-                seconds = time.perf_counter() - started
-                kind = "double" if "+" in truth else "null" if truth == "none" else "single"
-                found = tuple(f.effect for f in result.findings)
-                improvement = result.findings[0].improvement_percent if result.findings else float("nan")
-                rows.append(
-                    (
-                        kind,
-                        f"{truth}@{strength}" if kind != "null" else "none",
-                        result.verdict,
-                        found,
-                        improvement,
-                        seconds,
+                sim, reals = write_pair_set(_pairs(args.nulls), Path(folder), seed, VEHICLES[vehicle], stretch=0.05)
+                print(f"{vehicle} seed {seed}: {len(reals)} pairs simulated in {time.perf_counter() - started:.0f} s")
+                for name, path in reals.items():
+                    truth, strength = name.split("@")
+                    started = time.perf_counter()
+                    result = discover([_series(sim)], [_series(path)])
+                    seconds = time.perf_counter() - started
+                    kind = "double" if "+" in truth else "null" if truth == "none" else "single"
+                    found = tuple(f.effect for f in result.findings)
+                    improvement = result.findings[0].improvement_percent if result.findings else float("nan")
+                    label = f"{truth}@{strength}" if kind != "null" else "none"
+                    rows.append((kind, vehicle, label, result.verdict, found, improvement, seconds))
+                    print(
+                        f"  {vehicle} {name:30s} -> {result.verdict:14s} {found} {improvement:6.1f} % {seconds:5.1f} s",
+                        flush=True,
                     )
-                )
-                print(f"  {name:34s} -> {result.verdict:14s} {found} {improvement:6.1f} % {seconds:5.1f} s", flush=True)
     _table(rows)
     return 0
 
 
-def _table(rows: list[tuple[str, str, str, tuple[str, ...], float, float]]) -> None:
+def _table(rows: list[Row]) -> None:
     confusion: dict[str, Counter[str]] = defaultdict(Counter)
-    for _kind, truth, verdict, _found, _, _ in rows:
+    for _kind, _vehicle, truth, verdict, _found, _, _ in rows:
         confusion[truth.split("@")[0]][verdict] += 1
     columns = sorted({v for c in confusion.values() for v in c})
     print("\nconfusion (rows truth, columns verdict)")
     print(f"{'':26s}" + "".join(f"{c[:13]:>14s}" for c in columns))
     for truth in sorted(confusion):
         print(f"{truth:26s}" + "".join(f"{confusion[truth][c]:14d}" for c in columns))
+    for vehicle in sorted({r[1] for r in rows}):
+        _shares([r for r in rows if r[1] == vehicle], vehicle)
+    _shares(rows, "all")
+
+
+def _shares(rows: list[Row], label: str) -> None:
     singles = [r for r in rows if r[0] == "single"]
     nulls = [r for r in rows if r[0] == "null"]
     doubles = [r for r in rows if r[0] == "double"]
-    named = sum(r[2] == r[1].split("@")[0] for r in singles)
-    print(f"\nsingles named: {named}/{len(singles)}")
-    for strength in ("strong", "moderate"):
-        subset = [r for r in singles if r[1].endswith(strength)]
-        print(f"  {strength}: {sum(r[2] == r[1].split('@')[0] for r in subset)}/{len(subset)}")
-    print(f"nulls 'none': {sum(r[2] == 'none' for r in nulls)}/{len(nulls)}")
-    both = sum(set(r[1].split("@")[0].split("+")) <= set(r[3]) for r in doubles)
-    print(f"doubles, both named: {both}/{len(doubles)}")
-    improvements = [r[4] for r in singles + doubles if r[4] == r[4]]
-    if improvements:
-        print(f"median held-out improvement (named effects): {statistics.median(improvements):.1f} %")
-    seconds = [r[5] for r in rows]
+    named = [r[3] == r[2].split("@")[0] for r in singles]
+    by_strength = ", ".join(
+        f"{s} {sum(r[3] == r[2].split('@')[0] for r in singles if r[2].endswith(s))}/"
+        f"{sum(r[2].endswith(s) for r in singles)}"
+        for s in ("strong", "moderate")
+    )
+    both = sum(set(r[2].split("@")[0].split("+")) <= set(r[4]) for r in doubles)
     print(
-        f"seconds per pair (read both logs + search): median {statistics.median(seconds):.1f}, max {max(seconds):.1f}"
+        f"\n{label}: singles named {sum(named)}/{len(singles)} ({by_strength}); "
+        f"nulls 'none' {sum(r[3] == 'none' for r in nulls)}/{len(nulls)}; doubles, both named {both}/{len(doubles)}"
+    )
+    improvements = [r[5] for r in singles + doubles if r[5] == r[5]]
+    if improvements:
+        print(f"  median held-out improvement (named effects): {statistics.median(improvements):.1f} %")
+    seconds = [r[6] for r in rows]
+    print(
+        f"  seconds per pair (read both logs + search): median {statistics.median(seconds):.1f}, max {max(seconds):.1f}"
     )
 
 

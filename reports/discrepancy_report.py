@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from sysid.discrepancy import DiscrepancyResult, Finding
+from sysid.discrepancy import FAR_FROM_FLOOR, DiscrepancyResult, Finding
 
 from .html import render_html, write_html
 from .svg import figure_svg, new_figure
@@ -17,7 +17,8 @@ __all__ = ["finding_figure", "render_discrepancy_report", "write_discrepancy_rep
 _BEFORE, _AFTER = "#c0392b", "#1f4e79"
 _LABELS = {
     "height_agl": "height above ground, m",
-    "airspeed": "airspeed, m/s",
+    "ground_speed": "ground speed, m/s",
+    "wind_speed": "wind speed at the vehicle, m/s",
     "delta_thr": "thrust input",
     "battery_v": "battery voltage, V",
     "time": "time in flight, s",
@@ -73,7 +74,9 @@ def render_discrepancy_report(result: DiscrepancyResult, *, title: str = "Simula
         for effect, score in result.screened.items()
         if not effect.endswith("_threshold")
     ]
-    return render_html("discrepancy.html", title=title, result=result, findings=findings, screened=screened)
+    return render_html(
+        "discrepancy.html", title=title, result=result, findings=findings, screened=screened, far=FAR_FROM_FLOOR
+    )
 
 
 def write_discrepancy_report(path: str | Path, result: DiscrepancyResult) -> Path:

@@ -27,6 +27,7 @@ __all__ = [
     "design_gains",
     "Injection",
     "HeightSteps",
+    "Legs",
     "excitation_table",
     "initial_controller_state",
     "controller_step",
@@ -292,6 +293,51 @@ class HeightSteps:
         return cls(
             tuple(hold_s * k for k in range(len(ratios))), tuple(r * rotor_radius_m - rotor_height_m for r in ratios)
         )
+
+
+@dataclass(frozen=True, slots=True)
+class Legs:
+    """A piecewise-constant horizontal position reference: legs flown between hover points.
+
+    Parameters
+    ----------
+    times_s : tuple of float
+        Start of each hold, s (increasing; the first applies from time 0).
+    north_m : tuple of float
+        North position held from each time, m (from the take-off point).
+    east_m : tuple of float
+        East position held from each time, m.
+
+    Notes
+    -----
+    The position loop flies each leg at up to its speed limit
+    (:attr:`ControllerGains.max_speed_m_s`).
+    """
+
+    times_s: tuple[float, ...]
+    north_m: tuple[float, ...]
+    east_m: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if not (len(self.times_s) == len(self.north_m) == len(self.east_m)) or not self.times_s:
+            raise ValueError("times_s, north_m and east_m must be non-empty and of equal length")
+        if np.any(np.diff(self.times_s) <= 0):
+            raise ValueError("times_s must increase")
+
+    def reference(self, time_s: np.ndarray) -> np.ndarray:
+        """North and east position reference, m, shape (n_samples, 2).
+
+        Parameters
+        ----------
+        time_s : ndarray, shape (n_samples,)
+            Times, s.
+
+        Returns
+        -------
+        ndarray, shape (n_samples, 2)
+        """
+        index = np.clip(np.searchsorted(self.times_s, time_s, side="right") - 1, 0, None)
+        return np.column_stack([np.asarray(self.north_m)[index], np.asarray(self.east_m)[index]])
 
 
 def excitation_table(

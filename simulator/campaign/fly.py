@@ -226,9 +226,9 @@ def _simulate(
             )
         return [_simulate_linear(plan) for plan in plans]
     from simulator.flights.nonlinear import simulate_flights
-    from simulator.vehicle.presets import CRAZYFLIE, OCTO_S1000
+    from simulator.vehicle.presets import CRAZYFLIE, OCTO_S1000, QUAD_X500
 
-    vehicle = OCTO_S1000 if scenario.vehicle == "octo-s1000" else CRAZYFLIE
+    vehicle = {"octo-s1000": OCTO_S1000, "quad-x500": QUAD_X500}.get(scenario.vehicle, CRAZYFLIE)
     return list(simulate_flights(scenario_trials(scenario, plans), vehicle, progress=progress))
 
 

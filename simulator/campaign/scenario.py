@@ -6,7 +6,7 @@ trial, how many trials, the anemometer and the log formats to write::
     [scenario]
     name = "chapter3-campaign"
     description = "..."
-    vehicle = "octo-s1000"        # or "crazyflie"
+    vehicle = "octo-s1000"        # or "quad-x500", "crazyflie"
     formats = ["dataflash"]       # and/or "ulog"
     trials = 5                    # repeats of every (condition, maneuver) pair
     seed = 1
@@ -56,7 +56,7 @@ __all__ = [
 
 _T = TypeVar("_T")
 
-VehicleName = Literal["octo-s1000", "crazyflie", "linear-octo"]
+VehicleName = Literal["octo-s1000", "quad-x500", "crazyflie", "linear-octo"]
 LogFormatName = Literal["dataflash", "ulog"]
 ManeuverKind = Literal["sweep", "doublet", "3211", "multisine", "height_steps"]
 _AXES = ("lat", "lon", "yaw", "thr")
@@ -163,7 +163,7 @@ class Scenario:
         Identifier (file stem for built-ins).
     description : str
         One paragraph for ``sysid simulate --list``.
-    vehicle : {"octo-s1000", "crazyflie", "linear-octo"}
+    vehicle : {"octo-s1000", "quad-x500", "crazyflie", "linear-octo"}
         Vehicle preset; ``linear-octo`` flies the Table 3.3 linear model exactly.
     conditions : tuple of WindCondition
         Wind conditions.

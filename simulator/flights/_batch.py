@@ -100,6 +100,7 @@ class _Setup:
     mixer_trim: np.ndarray  # (n, 4)
     reference: np.ndarray  # (n, 4): north, east, height, heading
     height_ref: np.ndarray  # (n_steps, n)
+    position_ref: np.ndarray | None  # (n_steps, n, 2): north, east; None: hold the origin
     excitation: np.ndarray  # (n_steps, n, 4)
     wind: BatchWindField
     fields: list[FrozenField]
@@ -131,6 +132,13 @@ def _trim_for(trial: Trial, vehicle: Vehicle, conditions: Conditions, cache: dic
             height_m=_start_height(trial),
         )
     return cache[key]
+
+
+def _position_reference(trials: list[Trial], time: np.ndarray) -> np.ndarray | None:
+    if all(t.legs is None for t in trials):
+        return None
+    origin = np.zeros((time.size, 2))
+    return np.stack([t.legs.reference(time) if t.legs is not None else origin for t in trials], axis=1)
 
 
 def _start_height(trial: Trial) -> float:
@@ -209,6 +217,7 @@ def _setup(
         mixer_trim=mixer_trim,
         reference=reference,
         height_ref=heights,
+        position_ref=_position_reference(trials, time),
         excitation=excitation,
         wind=BatchWindField.stack([t.environment.wind for t in trials], fields),
         fields=fields,
@@ -301,6 +310,8 @@ def _integrate(
         t = k * setup.dt_s
         wind = setup.wind.at(state[:, 0:2], t)
         reference[:, 2] = setup.height_ref[k]
+        if setup.position_ref is not None:
+            reference[:, :2] = setup.position_ref[k]
         seen = _as_seen(state, setup.seen_noise[k // setup.decimation])
         mixer, integrators = controller_step(gains, integrators, seen, reference, setup.dt_s, gravity)
         mixer = mixer + setup.excitation[k]

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from simulator.autopilot.control import HeightSteps, Injection
+from simulator.autopilot.control import HeightSteps, Injection, Legs
 from simulator.autopilot.excitation import Maneuver
 from simulator.world.environment import Environment
 
@@ -35,6 +35,8 @@ class Trial:
         Heading held, deg; None: nose into the wind (chapter 3).
     height_steps : HeightSteps or None
         A height reference replacing `hover_height_m`.
+    legs : Legs or None
+        A horizontal position reference (default: hold the take-off point).
     battery_used_ah : float
         Charge drawn before the trial, Ah.
     label : str
@@ -49,6 +51,7 @@ class Trial:
     hover_height_m: float = 4.6
     heading_deg: float | None = None
     height_steps: HeightSteps | None = None
+    legs: Legs | None = None
     battery_used_ah: float = 0.0
     label: str = ""
 

@@ -11,13 +11,24 @@ simulated flight is therefore known exactly.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from types import MappingProxyType
 
 import numpy as np
 
 from simulator.vehicle.identified import CALM_HOVER
 from simulator.vehicle.multirotor import Battery, Vehicle
 
-__all__ = ["rotor_ring", "vehicle_from_derivatives", "octocopter", "crazyflie", "OCTO_S1000", "CRAZYFLIE"]
+__all__ = [
+    "rotor_ring",
+    "vehicle_from_derivatives",
+    "octocopter",
+    "quadcopter",
+    "crazyflie",
+    "QUAD_X500_HOVER",
+    "OCTO_S1000",
+    "QUAD_X500",
+    "CRAZYFLIE",
+]
 
 _RHO_AIR = 1.225  # kg/m^3, sea level
 
@@ -244,6 +255,66 @@ def octocopter(
     )
 
 
+#: Hover derivatives assumed for a 2 kg X500-class quad (not identified: a second vehicle for tests that must
+#: not fit one airframe). Per % of mixer input, SI otherwise.
+QUAD_X500_HOVER: Mapping[str, float] = MappingProxyType(
+    {
+        "X_u": -0.25,
+        "M_u": 1.1,
+        "X_lon": -0.08,
+        "M_lon": 1.3,
+        "Y_v": -0.24,
+        "L_v": -1.1,
+        "Y_lat": 0.08,
+        "L_lat": 1.5,
+        "N_yaw": 0.16,
+        "Z_thr": -0.36,
+        "T_a": 0.032,
+        "tau_lat": 0.012,
+        "tau_lon": 0.012,
+        "tau_yaw": 0.010,
+        "tau_thr": 0.0,
+    }
+)
+
+
+def quadcopter(derivatives: Mapping[str, float] = QUAD_X500_HOVER, *, mass_kg: float = 2.0) -> Vehicle:
+    """A 2 kg X500-class quadrotor (0.5 m motor to motor, 10-inch propellers) with a hover model `derivatives`.
+
+    Parameters
+    ----------
+    derivatives : Mapping[str, float], optional
+        Hover derivatives (Table 3.3 names); default :data:`QUAD_X500_HOVER`.
+    mass_kg : float, optional
+        Take-off mass, kg.
+
+    Returns
+    -------
+    Vehicle
+
+    Notes
+    -----
+    Assumed, not measured: 1.0 kgf per rotor at full command, rotor speed
+    1100 rad/s, k_m/k_f = 0.012 m, inertia (0.022, 0.024, 0.040) kg m^2,
+    rotors 0.05 m above the CG, a 4S 5 Ah pack.
+    """
+    positions, spins = rotor_ring(4, 0.25, height_m=0.05)
+    return vehicle_from_derivatives(
+        "quad_x500",
+        positions,
+        spins,
+        derivatives,
+        mass_kg=mass_kg,
+        inertia_kg_m2=(0.022, 0.024, 0.040),
+        rotor_radius_m=0.127,
+        max_thrust_n=1.0 * 9.80665,
+        thrust_expo=1.0,
+        torque_ratio_m=0.012,
+        max_speed_rad_s=1100.0,
+        battery=Battery(full_v=16.8, empty_v=14.0, capacity_ah=5.0, resistance_ohm=0.03, time_constant_s=0.5),
+    )
+
+
 def crazyflie(*, mass_kg: float = 0.03812) -> Vehicle:
     """The chapter 2 modified Crazyflie 2.0 (Table 2.1), thrust linear in PWM (eq. 2.6).
 
@@ -306,5 +377,7 @@ def crazyflie(*, mass_kg: float = 0.03812) -> Vehicle:
 
 #: The chapter 3 octocopter; its hover linearisation is the calm Table 3.3 model.
 OCTO_S1000: Vehicle = octocopter()
+#: A 2 kg X500-class quadrotor (assumed derivatives, see :func:`quadcopter`).
+QUAD_X500: Vehicle = quadcopter()
 #: The chapter 2 Crazyflie of Table 2.1 (mass read as 0.03812 kg, see :func:`crazyflie`).
 CRAZYFLIE: Vehicle = crazyflie()

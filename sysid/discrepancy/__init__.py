@@ -4,6 +4,7 @@
 from a conditioned flight's records) and returns a :class:`DiscrepancyResult`.
 """
 
+from sysid.discrepancy.describe import FAR_FROM_FLOOR
 from sysid.discrepancy.result import DiscrepancyResult, Finding, FittedParameter, Regime
 from sysid.discrepancy.search import DiscrepancyOptions, discover
 from sysid.discrepancy.series import FlightSeries, flight_series
@@ -11,6 +12,7 @@ from sysid.discrepancy.terms import EFFECTS
 
 __all__ = [
     "EFFECTS",
+    "FAR_FROM_FLOOR",
     "DiscrepancyOptions",
     "DiscrepancyResult",
     "Finding",

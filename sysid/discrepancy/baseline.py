@@ -14,6 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries
 
@@ -58,8 +59,18 @@ class BaselineModel:
         commands : Mapping[str, ndarray], optional
             Mixer inputs to use instead of the logged ones (delayed, lagged).
         """
-        design = _design(series, self.lags, self.states, commands)
-        return {o: design @ c for o, c in self.coefficients.items()}
+        inputs = commands if commands is not None else {c: series[c] for c in COMMANDS}
+        square_lags = _square_lags(self.lags)
+        n_lags, n_squares, n_in = self.lags.size, square_lags.size, len(COMMANDS)
+        weights = np.column_stack(list(self.coefficients.values()))  # (n_regressors, n_outputs)
+        fixed = np.column_stack([series[s] for s in self.states] + [np.ones(series.n)])
+        total = fixed @ weights[n_in * (n_lags + n_squares) :]
+        for k, name in enumerate(COMMANDS):  # lagged inputs times all outputs' weights at once: no whole design
+            x = np.asarray(inputs[name])
+            total += _lagged(series, x, self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
+            first = n_in * n_lags + k * n_squares
+            total += _lagged(series, x**2, square_lags) @ weights[first : first + n_squares]
+        return {o: total[:, j] for j, o in enumerate(self.coefficients)}
 
 
 def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> BaselineModel:
@@ -87,18 +98,21 @@ def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> Baseli
 def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...], commands: Commands) -> np.ndarray:
     inputs = commands if commands is not None else {c: series[c] for c in COMMANDS}
     columns = [_lagged(series, np.asarray(inputs[c]), lags) for c in COMMANDS]
-    square_lags = lags[:: max(1, lags.size // _N_SQUARE_LAGS)]
-    columns += [_lagged(series, np.asarray(inputs[c]) ** 2, square_lags) for c in COMMANDS]
+    columns += [_lagged(series, np.asarray(inputs[c]) ** 2, _square_lags(lags)) for c in COMMANDS]
     columns.append(np.column_stack([series[s] for s in states] + [np.ones(series.n)]))
     return np.column_stack(columns)
+
+
+def _square_lags(lags: np.ndarray) -> np.ndarray:
+    return lags[:: max(1, lags.size // _N_SQUARE_LAGS)]
 
 
 def _lagged(series: FlightSeries, x: np.ndarray, lags: np.ndarray) -> np.ndarray:
     """Columns x(t - lag) per lag, each piece padded with its first value (no lag reaches across a gap)."""
     out = np.empty((x.size, lags.size))
+    longest = int(lags[-1])
     for rows in series.pieces():
         piece = x[rows]
-        padded = np.concatenate([np.full(int(lags[-1]), piece[0]), piece])
-        for j, lag in enumerate(lags):
-            out[rows, j] = padded[lags[-1] - lag : lags[-1] - lag + piece.size]
+        padded = np.concatenate([np.full(longest, piece[0]), piece])
+        out[rows] = sliding_window_view(padded, longest + 1)[:, longest - lags]  # row t holds x(t - L) .. x(t)
     return out

@@ -10,8 +10,11 @@ from sysid.discrepancy.result import Finding, FittedParameter
 from sysid.discrepancy.selection import TermFit
 from sysid.discrepancy.terms import Candidate
 
-__all__ = ["parameters_of", "describe_finding", "summary_of"]
+__all__ = ["FAR_FROM_FLOOR", "parameters_of", "describe_finding", "summary_of"]
 
+#: Residual over the noise floor, with the findings modelled, above which the summary warns that the
+#: simulation is no close model of the real vehicle (synthetic pairs of one vehicle end at 1-3).
+FAR_FROM_FLOOR = 10.0
 _GROUND_EFFECT_END = 0.01  # the ground effect "ends" where the thrust gain falls below 1 %
 
 #: Unit of each coefficient name.
@@ -136,16 +139,24 @@ def describe_finding(finding: Finding, candidate: Candidate) -> str:
         what = f"Thrust follows the battery voltage (thrust ∝ V^n, n = {_pm(p.value, p.uncertainty)}); the simulation keeps it constant"
     elif effect == "cg_offset":
         what = "A constant moment follows the thrust: the centre of gravity is off the thrust axis"
-    elif effect == "rotor_drag":
-        what = "A drag force proportional to thrust times airspeed acts in the rotor plane (rotor drag) that the simulation lacks"
-    elif effect == "wind":
-        what = "Forces and moments follow the measured wind: the simulation leaves its drag out"
+    elif effect == "rotor_drag" and (p := _value(finding, "drag_x")) is not None:
+        what = (
+            "The real rotors drag more: a force in the rotor plane of specific thrust × ground speed × "
+            f"{_pm(p.value, p.uncertainty)} s/m along the nose that the simulation lacks"
+        )
+    elif effect == "wind" and (p := _value(finding, "drag_x")) is not None:
+        what = (
+            "Forces and moments follow the wind the real vehicle flew in (a drag of specific thrust × wind × "
+            f"{_pm(p.value, p.uncertainty)} s/m along the nose); the simulation flew in a calm"
+        )
     else:
         what = f"{effect} acts on {outputs}"
     return f"{what}; {gain}."
 
 
-def summary_of(findings: Sequence[Finding], noise_floor: Mapping[str, float]) -> str:
+def summary_of(
+    findings: Sequence[Finding], noise_floor: Mapping[str, float], unexplained: Mapping[str, float] | None = None
+) -> str:
     """Plain-language summary, the most important finding first (or that nothing is missing).
 
     Parameters
@@ -154,11 +165,26 @@ def summary_of(findings: Sequence[Finding], noise_floor: Mapping[str, float]) ->
         By importance.
     noise_floor : Mapping[str, float]
         Held-out residual RMS of each output on simulated flight, in its unit.
+    unexplained : Mapping[str, float], optional
+        Per output, the real residual left with the findings modelled, over the noise floor; where it stays
+        above :data:`FAR_FROM_FLOOR` the summary says the simulation is no close model of the real vehicle.
     """
+    left = dict(unexplained or {})
+    far = sorted((o for o, r in left.items() if r > FAR_FROM_FLOOR), key=lambda o: -left[o])
+    caveat = ""
+    if far:
+        ratios = ", ".join(f"{o} {left[o]:.0f}×" for o in far)
+        caveat = (
+            f" Caution: the real flight's residual stays far above the simulation's noise floor ({ratios}) even with "
+            f"{'these findings' if findings else 'every candidate tried'}: the simulation is not a close model of this "
+            "vehicle (another airframe, controller or mission, or far noisier sensors), or what differs is outside the "
+            "library; read the findings as leads, not as the answer."
+        )
     if not findings:
         floor = ", ".join(f"{o} {v:.3g}" for o, v in noise_floor.items())
+        what = "No candidate term" if far else "Nothing is missing: no candidate term"
         return (
-            "Nothing is missing: no candidate term explains more of the real flight's residual than it explains of "
-            f"held-out simulated flight (residual RMS floor: {floor})."
+            f"{what} explains more of the real flight's residual than it explains of "
+            f"held-out simulated flight (residual RMS floor: {floor})." + caveat
         )
-    return " ".join(f.evidence for f in findings)
+    return " ".join(f.evidence for f in findings) + caveat

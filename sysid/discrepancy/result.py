@@ -57,7 +57,7 @@ class Regime:
     Parameters
     ----------
     variable : str
-        ``height_agl``, ``airspeed``, ``throttle``, ``battery_v`` or ``time`` (flight clock).
+        ``height_agl``, ``ground_speed``, ``wind_speed``, ``delta_thr``, ``battery_v`` or ``time`` (flight clock).
     unit : str
         Its unit.
     low, high : float
@@ -132,6 +132,10 @@ class DiscrepancyResult:
         The flights compared.
     thrust_scale : float
         Real thrust per input over the simulated one, a constant fitted before any term (a trim, not a finding).
+    unexplained : dict of str to float
+        Per output, the real flight's held-out residual RMS with every finding modelled, over the noise floor:
+        about 1 when the findings account for the difference, far above it when the simulation is not a close
+        model of the real vehicle or an effect outside the library remains.
     """
 
     verdict: str
@@ -142,6 +146,7 @@ class DiscrepancyResult:
     sim: tuple[str, ...]
     real: tuple[str, ...]
     thrust_scale: float = 1.0
+    unexplained: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: ``verdict``, ``findings[]`` (empty when the verdict is ``none``) and the context."""
@@ -174,4 +179,5 @@ class DiscrepancyResult:
             "sim": list(self.sim),
             "real": list(self.real),
             "thrust_scale": self.thrust_scale,
+            "unexplained": self.unexplained,
         }

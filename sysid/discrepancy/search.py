@@ -38,7 +38,14 @@ from sysid.discrepancy.terms import Candidate, candidate_terms
 __all__ = ["DiscrepancyOptions", "discover"]
 
 _TRANSFORMS = ("time_delay", "actuator_lag")
-_REGIMES = (("height_agl", "m"), ("airspeed", "m/s"), ("delta_thr", "as logged"), ("battery_v", "V"), ("t_flight", "s"))
+_REGIMES = (
+    ("height_agl", "m"),
+    ("ground_speed", "m/s"),
+    ("wind_speed", "m/s"),
+    ("delta_thr", "as logged"),
+    ("battery_v", "V"),
+    ("t_flight", "s"),
+)
 
 Progress = Callable[[str, int, int], None]
 
@@ -84,6 +91,7 @@ def discover(
     DiscrepancyResult
     """
     simulated, flown = _joined(sim), _joined(real)
+    simulated = simulated.without([s for s in simulated.signals if s not in flown])  # a model of what both logged
     scale, null = _noise_floor(simulated)
     _report(progress, "simulation model", 1, 3)
     baseline = fit_baseline(simulated)
@@ -108,6 +116,8 @@ def discover(
                 screened[f"{candidate.effect}_threshold"] = round(threshold, 4)
             if score > threshold:
                 fit = fit_term(candidate, y, base, additions, scale)
+                if candidate.kind == "transform" and fit.value >= candidate.grid[-1]:
+                    continue  # at the end of the range searched: a bound, not a measured delay or lag
                 scores.append((_bic_change(fit, y, base, additions), score, fit, predicted))
         _report(progress, "screening terms", len(kept) + 1, options.max_findings + 1)
         if not scores:
@@ -130,10 +140,12 @@ def discover(
     )
     _report(progress, "done", 3, 3)
     floor = {o: float(np.sqrt(scale[o])) for o in OUTPUTS}
+    unexplained = {o: round(float(np.sqrt(np.mean((y[o] - held_out[o]) ** 2))) / floor[o], 2) for o in OUTPUTS}
     return DiscrepancyResult(
         verdict=findings[0].effect if findings else "none",
         findings=tuple(findings),
-        summary=summary_of(findings, floor),
+        summary=summary_of(findings, floor, unexplained),
+        unexplained=unexplained,
         screened=screened,
         noise_floor=floor,
         sim=tuple(s.name for s in sim),
@@ -243,7 +255,7 @@ def _traces(
 ) -> FindingTraces:
     step = max(1, flown.n // _MAX_POINTS)
     variable = {"time": "t_flight"}.get(regime.variable, regime.variable)
-    values = np.hypot(flown["u"], flown["v"]) if variable == "airspeed" else flown[variable]
+    values = _regime_variables(flown).get(variable, flown["t_flight"])
     return FindingTraces(
         time_s=flown["t_flight"][::step],
         regime=values[::step],
@@ -269,6 +281,16 @@ def _band(contribution: Mapping[str, np.ndarray], rate_hz: float) -> tuple[float
     return (round(float(2 * np.pi * lo), 3), round(float(2 * np.pi * hi), 3))
 
 
+def _regime_variables(flown: FlightSeries) -> dict[str, np.ndarray]:
+    """The flight variables a finding may be located by (time apart), each shape (n,)."""
+    variables = {name: flown[name] for name, _ in _REGIMES if name in flown and name != "t_flight"}
+    if "u" in flown and "v" in flown:
+        variables["ground_speed"] = np.hypot(flown["u"], flown["v"])
+    if "wind_lon" in flown and "wind_lat" in flown:
+        variables["wind_speed"] = np.hypot(flown["wind_lon"], flown["wind_lat"])
+    return variables
+
+
 def _regime(contribution: Mapping[str, np.ndarray], flown: FlightSeries, own: str | None) -> Regime:
     """The range of a flight variable holding the contribution: the term's `own` variable, else the narrowest.
 
@@ -278,9 +300,7 @@ def _regime(contribution: Mapping[str, np.ndarray], flown: FlightSeries, own: st
     flight variable varies: it follows anything.
     """
     size = np.sqrt(sum((np.asarray(c) - np.median(c)) ** 2 for c in contribution.values()))
-    variables = {name: flown[name] for name, _ in _REGIMES if name in flown and name != "t_flight"}
-    if "u" in flown and "v" in flown:
-        variables["airspeed"] = np.hypot(flown["u"], flown["v"])
+    variables = _regime_variables(flown)
     units = dict(_REGIMES)
     if own is not None and (own in variables or own == "t_flight"):
         values = variables.get(own, flown["t_flight"])

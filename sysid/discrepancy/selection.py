@@ -154,29 +154,44 @@ def fit_term(
     n = next(iter(y.values())).size
     rows = np.arange(n) if rows is None else rows
     costs, fits = [], []
+    kept = {o: y[o][rows] - additions[o][rows] for o in candidate.outputs}  # what the term and the base must explain
+    targets = {o: kept[o] - base[o][rows] for o in candidate.outputs}
     for value in candidate.grid:
         built = candidate.build(value)
-        coefficients, covariance, cost = {}, {}, 0.0
+        coefficients, cost = {}, 0.0
         for o in candidate.outputs:
             if candidate.kind == "transform":
-                residual = y[o][rows] - built[o][rows] - additions[o][rows]
+                residual = kept[o] - built[o][rows]
             else:
-                target = y[o][rows] - base[o][rows] - additions[o][rows]
+                target = targets[o]
                 z = built[o][rows]
-                coefficients[o], *_ = np.linalg.lstsq(z, target, rcond=None)
+                coefficients[o] = _least_squares(z, target)
                 residual = target - z @ coefficients[o]
-                covariance[o] = _covariance(z, residual)
             cost += float(np.sum(residual**2)) / scale[o]
         costs.append(cost)
-        fits.append((value, coefficients, covariance))
+        fits.append((value, coefficients))
     best = int(np.argmin(costs))
-    value, coefficients, covariance = fits[best]
+    value, coefficients = fits[best]
+    covariance = {}
+    if candidate.kind == "linear":  # the covariance of the chosen grid value's coefficients only
+        built = candidate.build(value)
+        for o in candidate.outputs:
+            z = built[o][rows]
+            covariance[o] = _covariance(z, targets[o] - z @ coefficients[o])
     spread = _grid_spread(np.asarray(candidate.grid), np.asarray(costs), best, rows.size, candidate, y, base, scale)
     if np.isfinite(spread) and len(candidate.grid) > 1:  # never finer than the grid can tell
         spread = max(spread, float(np.median(np.diff(candidate.grid))) / np.sqrt(12.0))
     return TermFit(
         candidate=candidate, value=value, coefficients=coefficients, covariance=covariance, value_uncertainty=spread
     )
+
+
+def _least_squares(z: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Coefficients minimising ``|target - z c|``: the normal equations when well conditioned (a few columns), else SVD."""
+    gram = z.T @ z
+    if np.linalg.cond(gram) < 1e10:
+        return np.asarray(np.linalg.solve(gram, z.T @ target))
+    return np.asarray(np.linalg.lstsq(z, target, rcond=None)[0])
 
 
 def effective_samples(residual: np.ndarray) -> float:

@@ -5,8 +5,15 @@ forces ``ax ay az`` (m/s²) as logged and the angular accelerations
 ``p_dot q_dot r_dot`` (rad/s², a Savitzky-Golay derivative of the rates).
 Every record of a conditioned flight is resampled to one rate and kept
 apart (lags never reach across a gap); only the samples where the vehicle
-flies (thrust above a third of its 95th percentile, and off the ground
-where a height is logged) are used.
+flies (thrust above a third of its 95th percentile and above 85 % of the
+hover's, and off the ground where a height is logged) are used.
+
+The body velocities ``u v w`` are ground-relative here, whatever the
+conditioning made of them: a simulation flown in a calm and a model of it
+know nothing of the air, so drag on the wind is a discrepancy to find, not
+something to hide in the states. The wind, where the log has one, is kept
+apart in body axes (``wind_lon wind_lat``, m/s): the anemometer's when one
+was given, else the autopilot's own estimate.
 """
 
 from __future__ import annotations
@@ -18,6 +25,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from flightlogs.errors import DataError
+from flightlogs.frames import earth_to_body, wind_to_body_axes
 from flightlogs.record import Record
 
 __all__ = ["OUTPUTS", "COMMANDS", "FlightSeries", "flight_series"]
@@ -30,7 +38,9 @@ _NEEDED = ("p", "q", "r", "ax", "ay", "az", *COMMANDS)
 _RATE_HZ = 50.0  # the search's sample rate
 _SMOOTH_S = 0.1  # Savitzky-Golay window of the rate derivatives
 _THRUST_ON = 1.0 / 3.0  # flying: thrust above this fraction of its 95th percentile
+_LIFT_OFF = 0.85  # and above this fraction of its median there (a take-off ramp on the ground is not flight)
 _ON_GROUND_M = 0.05  # and, where a height is logged, above this
+_WIND = ("wind_lon", "wind_lat")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -73,6 +83,11 @@ class FlightSeries:
         """Sample indices of each contiguous piece, in order."""
         edges = np.flatnonzero(np.diff(self.piece)) + 1
         return np.split(np.arange(self.n), edges)
+
+    def without(self, names: Sequence[str]) -> FlightSeries:
+        """The same samples without the signals `names`."""
+        kept = {k: v for k, v in self.signals.items() if k not in names}
+        return FlightSeries(name=self.name, time_s=self.time_s, piece=self.piece, signals=kept, rate_hz=self.rate_hz)
 
     def subset(self, rows: np.ndarray) -> FlightSeries:
         """The samples `rows` (sorted indices), pieces split where rows skip samples."""
@@ -137,13 +152,30 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
     if flown.sum() < 10 * rate_hz:
         raise DataError(f"{name}: less than 10 s of flight (thrust on, off the ground)")
     signals["t_flight"] = time_s - time_s[flown][0]
+    _ground_relative(signals)
     whole = FlightSeries(name=name, time_s=time_s, piece=piece, signals=signals, rate_hz=rate_hz)
-    return whole.subset(np.flatnonzero(flown))
+    series = whole.subset(np.flatnonzero(flown))
+    if not all(np.all(np.isfinite(series[w])) for w in _WIND if w in series):
+        return series.without(_WIND)  # a wind with holes is no regressor
+    return series
+
+
+def _ground_relative(signals: dict[str, np.ndarray]) -> None:
+    """Put ground-relative body velocities in ``u v w``; add the estimator's wind in body axes if none is given."""
+    if {"vn", "ve", "vd", "phi", "theta", "psi"} <= signals.keys():
+        ned = np.column_stack([signals["vn"], signals["ve"], signals["vd"]])
+        uvw = earth_to_body(ned, signals["phi"], signals["theta"], signals["psi"])
+        signals["u"], signals["v"], signals["w"] = uvw.T
+    if "wind_lon" not in signals and {"est_wind_n", "est_wind_e", "psi"} <= signals.keys():
+        wind_ne = np.column_stack([signals["est_wind_n"], signals["est_wind_e"]])
+        signals["wind_lon"], signals["wind_lat"] = wind_to_body_axes(wind_ne, signals["psi"]).T
 
 
 def _flown(signals: Mapping[str, np.ndarray]) -> np.ndarray:
     thrust = signals["delta_thr"]
     on = thrust > _THRUST_ON * float(np.percentile(thrust, 95))
+    if np.any(on):  # on the ground the thrust ramps up to the hover's without lifting: not flight yet
+        on &= thrust > _LIFT_OFF * float(np.median(thrust[on]))
     if "height_agl" in signals:
         on &= signals["height_agl"] > _ON_GROUND_M
     return np.asarray(on & np.all([np.isfinite(signals[s]) for s in _NEEDED], axis=0))

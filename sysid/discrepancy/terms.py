@@ -10,7 +10,7 @@ the data that judge.
 
 ``T`` below is the specific thrust the simulation model expects, ``-az``
 predicted from the inputs (m/s², about g in hover); velocities are body
-axes, air-relative when the wind is given. The real vehicle's thrust may
+axes, ground-relative (the wind is a term of its own). The real vehicle's thrust may
 differ from the simulated one by a constant factor (a trim, fitted before
 any term and again with every term on az): those are judged by what they
 explain beyond it.
@@ -57,6 +57,7 @@ EFFECTS: tuple[str, ...] = (
 )
 _DELAYS_S = tuple(np.round(np.arange(0.0025, 0.1501, 0.0025), 4))
 _LAGS_S = tuple(np.round(np.arange(0.0025, 0.1501, 0.0025), 4))
+_CALM_M_S = 0.5  # RMS wind below which the wind term is not tried, m/s
 _STEP_EDGE = 0.1  # a mass step lies within the middle 80 % of the flight
 _STEP_GRID_S = 0.25  # times tried for it
 _ROTOR_ABOVE_M = tuple(np.round(np.arange(0.0, 0.501, 0.05), 3))  # rotor plane above the logged height, m
@@ -87,7 +88,7 @@ class Candidate:
     coefficients : tuple of str
         Names of the fitted coefficients (linear), in column order.
     regime : str or None
-        The flight variable its shape depends on (``height_agl``, ``battery_v``, ``airspeed``,
+        The flight variable its shape depends on (``height_agl``, ``battery_v``, ``ground_speed``, ``wind_speed``,
         ``delta_thr``, ``t_flight``), whose range the finding reports; None: found from the data.
     """
 
@@ -172,16 +173,18 @@ def _ground_effect(series: FlightSeries, _baseline: BaselineModel, thrust: np.nd
 def _rotor_drag(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndarray) -> Candidate | None:
     if "u" not in series or "v" not in series:
         return None
-    u, v = series["u"], series["v"]  # air-relative when the wind is given (the conditioning makes them so)
-    return _linear("rotor_drag", {"ax": [-thrust * u], "ay": [-thrust * v]}, ("d_x_s_m", "d_y_s_m"), "airspeed")
+    u, v = series["u"], series["v"]  # ground-relative: drag on the wind is the wind term's
+    return _linear("rotor_drag", {"ax": [-thrust * u], "ay": [-thrust * v]}, ("d_x_s_m", "d_y_s_m"), "ground_speed")
 
 
 def _wind(series: FlightSeries, _baseline: BaselineModel, thrust: np.ndarray) -> Candidate | None:
     if "wind_lon" not in series or "wind_lat" not in series:
         return None
+    if np.sqrt(np.mean(series["wind_lon"] ** 2 + series["wind_lat"] ** 2)) < _CALM_M_S:
+        return None  # a calm: its drag is below anything the search can tell from noise
     along, across = thrust * series["wind_lon"], thrust * series["wind_lat"]
     columns = {"ax": [along], "ay": [across], "p_dot": [across], "q_dot": [along]}
-    return _linear("wind", columns, ("d_x_s_m", "d_y_s_m", "l_wind_rad_m", "m_wind_rad_m"), "airspeed")
+    return _linear("wind", columns, ("d_x_s_m", "d_y_s_m", "l_wind_rad_m", "m_wind_rad_m"), "wind_speed")
 
 
 def _time_delay(series: FlightSeries, baseline: BaselineModel, _thrust: np.ndarray) -> Candidate:

@@ -7,7 +7,7 @@ from datetime import UTC, datetime
 import numpy as np
 import pytest
 
-from simulator.autopilot.control import HeightSteps, Injection
+from simulator.autopilot.control import HeightSteps, Injection, Legs
 from simulator.autopilot.excitation import Maneuver
 from simulator.campaign.fly import scenario_trials
 from simulator.campaign.scenario import load_builtin
@@ -209,3 +209,15 @@ def test_campaign_has_120_trials_and_euler_agrees_with_rk4() -> None:
     rk4, euler = simulate_flights([trial], method="rk4")[0], simulate_flights([trial], method="euler")[0]
     assert np.max(np.abs(rk4.signals["q"] - euler.signals["q"])) < 0.02 * np.max(np.abs(rk4.signals["q"]))
     assert OCTO_S1000.n_rotors == 8
+
+
+def test_legs_are_flown_at_the_speed_limit_and_end_on_their_point() -> None:
+    """A 20 m leg north at 2 s and back at 14 s: the position loop saturates at its 3 m/s and settles on each point."""
+    legs = Legs(times_s=(0.0, 2.0, 14.0), north_m=(0.0, 20.0, 0.0), east_m=(0.0, 0.0, 0.0))
+    trial = Trial(duration_s=26.0, legs=legs, heading_deg=0.0, environment=Environment(sensors=SensorNoise.off()))
+    flight = simulate_flights([trial])[0]
+    time, truth = flight.time_s, flight.truth
+    assert np.max(truth["vn"]) == pytest.approx(3.0, abs=0.3)
+    assert np.min(truth["vn"]) == pytest.approx(-3.0, abs=0.3)
+    assert np.interp(13.5, time, truth["pn"]) == pytest.approx(20.0, abs=0.5)
+    assert abs(truth["pn"][-1]) < 0.5 and np.max(np.abs(truth["pe"])) < 0.2

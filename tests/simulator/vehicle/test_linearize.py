@@ -15,7 +15,7 @@ from simulator.vehicle.linearize import (
     reference_model,
     trim_hover,
 )
-from simulator.vehicle.presets import CRAZYFLIE, OCTO_S1000, octocopter
+from simulator.vehicle.presets import CRAZYFLIE, OCTO_S1000, QUAD_X500, QUAD_X500_HOVER, octocopter
 from simulator.world.environment import GroundEffect
 
 
@@ -122,3 +122,19 @@ def test_a_cg_offset_is_trimmed_by_the_pitch_input_it_needs() -> None:
     expected = OCTO_S1000.mass_kg * 9.81 * dx / (CALM_HOVER["M_lon"] * OCTO_S1000.inertia_kg_m2[1])
     assert trim.mixer_input[1] == pytest.approx(expected, rel=0.01)
     assert trim.total_thrust_n == pytest.approx(OCTO_S1000.mass_kg * 9.81, rel=1e-3)
+
+
+def test_the_quad_linearises_to_its_own_derivatives() -> None:
+    """The second vehicle is built the same way: its hover eigenvalues are those of its derivatives' model."""
+    comparison = compare_eigenvalues(reference_model(QUAD_X500_HOVER), linearize_hover(QUAD_X500))
+    nonzero = np.abs(comparison.reference) > 1e-9
+    assert np.all(comparison.error[nonzero] < 0.05), comparison
+
+
+def test_a_cg_offset_trims_the_quad_with_the_moment_it_needs() -> None:
+    """dx = 9.5 mm on the quad: the solver's own convergence flag once refused this converged trim."""
+    dx = 0.0095
+    conditions = Conditions(cg_offset_m=np.array([[dx, 0.0, 0.0]]), rotor_drag=np.ones(1), thrust_sag=np.zeros(1))
+    trim = trim_hover(QUAD_X500, conditions=conditions, height_m=3.0)
+    expected = QUAD_X500.mass_kg * 9.81 * dx / (QUAD_X500_HOVER["M_lon"] * QUAD_X500.inertia_kg_m2[1])
+    assert trim.mixer_input[1] == pytest.approx(expected, rel=0.02)

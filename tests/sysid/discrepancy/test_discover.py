@@ -18,20 +18,42 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
 from flightlogs.conditioning.condition import condition_flight
 from flightlogs.readers import read_log
-from simulator.campaign.discrepancy_pairs import write_pairs
-from simulator.vehicle.presets import OCTO_S1000
+from simulator.campaign.discrepancy_pairs import VEHICLES, mission, write_pairs
+from simulator.vehicle.multirotor import Vehicle
+from simulator.world.environment import Environment
 from sysid.discrepancy import DiscrepancyResult, discover, flight_series
 from sysid_cli.main import cli
 
-pytestmark = [pytest.mark.slow, pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning")]
+# the pairs fly 17 four-minute flights: over the default 300 s when the other worker is busy too
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.timeout(1200),
+    pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning"),
+]
 
 SEED = 11  # held out: the search was tuned on seeds 1, 2, 3 and 5
-EFFECTS = ["none", "ground_effect", "battery_sag", "mass_change", "cg_offset", "time_delay", "actuator_lag"]
+#: Per vehicle, the effects flown (the quad's a subset, for time: the benchmark flies all of them).
+EFFECTS: dict[str, list[str]] = {
+    "octo": [
+        "none",
+        "ground_effect",
+        "rotor_drag",
+        "wind",
+        "battery_sag",
+        "mass_change",
+        "cg_offset",
+        "time_delay",
+        "actuator_lag",
+    ],
+    "quad": ["none", "ground_effect", "rotor_drag", "wind", "cg_offset", "actuator_lag"],
+}
+CASES = [(v, e) for v, effects in EFFECTS.items() for e in effects]
 
 
 def _series(path: Path):  # type: ignore[no-untyped-def]
@@ -39,20 +61,27 @@ def _series(path: Path):  # type: ignore[no-untyped-def]
 
 
 @pytest.fixture(scope="module", name="pairs")
-def pairs_fixture(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Path]]:
-    return write_pairs(EFFECTS, tmp_path_factory.mktemp("discrepancy"), SEED)
+def pairs_fixture(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path, dict[str, Path]]]:
+    return {
+        v: write_pairs(e, tmp_path_factory.mktemp(f"discrepancy-{v}"), SEED, VEHICLES[v]) for v, e in EFFECTS.items()
+    }
 
 
 @pytest.fixture(scope="module", name="results")
-def results_fixture(pairs: tuple[Path, dict[str, Path]]) -> dict[str, DiscrepancyResult]:
-    sim, reals = pairs
-    simulated = _series(sim)
-    return {effect: discover([simulated], [_series(path)]) for effect, path in reals.items()}
+def results_fixture(pairs: dict[str, tuple[Path, dict[str, Path]]]) -> dict[tuple[str, str], DiscrepancyResult]:
+    out = {}
+    for vehicle, (sim, reals) in pairs.items():
+        simulated = _series(sim)
+        out |= {(vehicle, effect): discover([simulated], [_series(path)]) for effect, path in reals.items()}
+    return out
 
 
-@pytest.mark.parametrize("effect", EFFECTS)
-def test_the_verdict_names_the_concealed_effect_and_only_it(results: dict[str, DiscrepancyResult], effect: str) -> None:
-    result = results[effect]
+Results = dict[tuple[str, str], DiscrepancyResult]
+
+
+@pytest.mark.parametrize(("vehicle", "effect"), CASES)
+def test_the_verdict_names_the_concealed_effect_and_only_it(results: Results, vehicle: str, effect: str) -> None:
+    result = results[vehicle, effect]
     assert result.verdict == effect, result.summary
     assert [f.effect for f in result.findings] == ([] if effect == "none" else [effect])
     for finding in result.findings:
@@ -60,9 +89,10 @@ def test_the_verdict_names_the_concealed_effect_and_only_it(results: dict[str, D
         assert all(finding.rmse_after[o] < finding.rmse_before[o] for o in finding.outputs)
 
 
-def test_nothing_missing_is_said_in_words(results: dict[str, DiscrepancyResult]) -> None:
-    assert results["none"].summary.startswith("Nothing is missing")
-    assert results["none"].to_dict()["findings"] == []
+def test_nothing_missing_is_said_in_words(results: Results) -> None:
+    for vehicle in EFFECTS:
+        assert results[vehicle, "none"].summary.startswith("Nothing is missing")
+        assert results[vehicle, "none"].to_dict()["findings"] == []
 
 
 def _parameter(result: DiscrepancyResult, name: str) -> tuple[float, float]:
@@ -70,28 +100,52 @@ def _parameter(result: DiscrepancyResult, name: str) -> tuple[float, float]:
     return p.value, p.uncertainty
 
 
-def test_the_delay_is_the_one_added(results: dict[str, DiscrepancyResult]) -> None:
+def test_the_delay_is_the_one_added(results: Results) -> None:
     """30 ms added to every input; the grid is 2.5 ms, so within a grid step and within 3 sigma."""
-    value, sigma = _parameter(results["time_delay"], "delay_s")
+    value, sigma = _parameter(results["octo", "time_delay"], "delay_s")
     assert abs(value - 0.030) <= 0.0025 and abs(value - 0.030) <= 3 * sigma + 1e-9
 
 
-def test_the_mass_step_has_its_size_and_time(results: dict[str, DiscrepancyResult]) -> None:
-    """0.4 kg picked up at 70 s by a 7.0 kg vehicle: the specific force per thrust drops by 0.4 / 7.4."""
-    ratio, _ = _parameter(results["mass_change"], "mass_ratio")
-    time_s, time_sigma = _parameter(results["mass_change"], "time_s")
-    assert ratio == pytest.approx(0.4 / 7.4, rel=0.05)
+def test_the_mass_step_has_its_size_and_time(results: Results) -> None:
+    """5.7 % of the mass picked up at 70 s: the specific force per thrust drops by 0.057 / 1.057."""
+    ratio, _ = _parameter(results["octo", "mass_change"], "mass_ratio")
+    time_s, time_sigma = _parameter(results["octo", "mass_change"], "time_s")
+    assert ratio == pytest.approx(0.057 / 1.057, rel=0.05)
     assert abs(time_s - 70.0) <= max(0.5, 3 * time_sigma)
-    assert results["mass_change"].findings[0].regime.variable == "time"
+    assert results["octo", "mass_change"].findings[0].regime.variable == "time"
 
 
-def test_the_cg_moment_is_mass_times_offset_over_inertia(results: dict[str, DiscrepancyResult]) -> None:
-    """The CG 2 cm forward: pitch acceleration per specific thrust -m dx / I_yy (nose down)."""
-    moment, _ = _parameter(results["cg_offset"], "pitch_moment_per_thrust")
-    truth = -OCTO_S1000.mass_kg * 0.02 / OCTO_S1000.inertia_kg_m2[1]
+def _arm_m(vehicle: Vehicle) -> float:
+    return float(np.max(np.hypot(*vehicle.rotor_positions_m[:, :2].T)))
+
+
+@pytest.mark.parametrize("name", ["octo", "quad"])
+def test_the_cg_moment_is_mass_times_offset_over_inertia(results: Results, name: str) -> None:
+    """The CG 3.8 % of the arm forward: pitch acceleration per specific thrust -m dx / I_yy (nose down)."""
+    vehicle = VEHICLES[name]
+    moment, _ = _parameter(results[name, "cg_offset"], "pitch_moment_per_thrust")
+    truth = -vehicle.mass_kg * 0.038 * _arm_m(vehicle) / vehicle.inertia_kg_m2[1]
     assert moment == pytest.approx(truth, rel=0.05)
-    roll, _ = _parameter(results["cg_offset"], "roll_moment_per_thrust")
+    roll, _ = _parameter(results[name, "cg_offset"], "roll_moment_per_thrust")
     assert abs(roll) < 0.05 * abs(truth)
+
+
+@pytest.mark.parametrize("name", ["octo", "quad"])
+def test_the_extra_rotor_drag_is_the_simulated_one_again(results: Results, name: str) -> None:
+    """The real rotors drag twice the simulated: the term's coefficient is the simulation's own d = -X_u / g."""
+    finding = results[name, "rotor_drag"].findings[0]
+    drag, _ = _parameter(results[name, "rotor_drag"], "drag_x")
+    assert drag == pytest.approx(VEHICLES[name].drag_s_m[0], rel=0.05)
+    assert finding.regime.variable == "ground_speed"
+
+
+@pytest.mark.parametrize("name", ["octo", "quad"])
+def test_the_drag_on_the_wind_is_the_rotor_drag(results: Results, name: str) -> None:
+    """Hovering in a wind the simulation lacked, the drag per thrust and wind speed is the rotors' drag coefficient."""
+    finding = results[name, "wind"].findings[0]
+    drag, _ = _parameter(results[name, "wind"], "drag_x")
+    assert drag == pytest.approx(VEHICLES[name].drag_s_m[0], rel=0.05)
+    assert finding.regime.variable == "wind_speed"
 
 
 @pytest.mark.xfail(
@@ -99,27 +153,32 @@ def test_the_cg_moment_is_mass_times_offset_over_inertia(results: dict[str, Disc
     reason="open (issue 15): through the PX4 log the exponent reads 2.22 +- 0.016 on seeds 11-13 (1.9 on the "
     "simulator's own signals), 11 % high with a standard deviation that does not cover it",
 )
-def test_the_battery_exponent_is_that_of_thrust_on_rotor_speed(results: dict[str, DiscrepancyResult]) -> None:
+def test_the_battery_exponent_is_that_of_thrust_on_rotor_speed(results: Results) -> None:
     """Thrust grows with the rotor speed squared (thrust_expo 1) and the speed with the voltage: exponent 2."""
-    assert OCTO_S1000.thrust_expo == 1.0
-    exponent, _ = _parameter(results["battery_sag"], "exponent")
+    assert VEHICLES["octo"].thrust_expo == 1.0
+    exponent, _ = _parameter(results["octo", "battery_sag"], "exponent")
     assert exponent == pytest.approx(2.0, rel=0.1)
 
 
-def test_the_lag_lies_between_the_added_and_the_whole_motor_lag(results: dict[str, DiscrepancyResult]) -> None:
-    """Motors of 73 ms against 46 ms simulated: one extra first-order lag between their difference and the whole."""
-    value, _ = _parameter(results["actuator_lag"], "time_constant_s")
-    real = OCTO_S1000.motor_time_constant_s * 1.6
-    assert real - OCTO_S1000.motor_time_constant_s <= value <= real
+@pytest.mark.parametrize("name", ["octo", "quad"])
+def test_the_lag_lies_between_the_added_and_the_whole_motor_lag(results: Results, name: str) -> None:
+    """Motors 1.6 times slower than simulated: one extra first-order lag between their difference and the whole."""
+    vehicle = VEHICLES[name]
+    value, _ = _parameter(results[name, "actuator_lag"], "time_constant_s")
+    real = vehicle.motor_time_constant_s * 1.6
+    assert real - vehicle.motor_time_constant_s <= value <= real
 
 
-def test_the_ground_effect_is_located_near_the_ground(results: dict[str, DiscrepancyResult]) -> None:
-    finding = results["ground_effect"].findings[0]
-    assert finding.regime.variable == "height_agl" and finding.regime.high <= 1.2
+@pytest.mark.parametrize("name", ["octo", "quad"])
+def test_the_ground_effect_is_located_near_the_ground(results: Results, name: str) -> None:
+    """Located below the mission's second height step (6.7 rotor radii), where the thrust gain is under 0.1 %."""
+    finding = results[name, "ground_effect"].findings[0]
+    second_step = mission(Environment(), SEED, vehicle=VEHICLES[name]).height_steps.heights_m[1]  # type: ignore[union-attr]
+    assert finding.regime.variable == "height_agl" and finding.regime.high <= second_step
 
 
-def test_the_command_writes_json_and_report(pairs: tuple[Path, dict[str, Path]], tmp_path: Path) -> None:
-    sim, reals = pairs
+def test_the_command_writes_json_and_report(pairs: dict[str, tuple[Path, dict[str, Path]]], tmp_path: Path) -> None:
+    sim, reals = pairs["octo"]
     out, report = tmp_path / "gap.json", tmp_path / "gap.html"
     result = CliRunner().invoke(
         cli, ["discrepancy", str(sim), str(reals["time_delay"]), "-o", str(out), "--report", str(report), "-q"]
@@ -147,9 +206,9 @@ def test_the_command_writes_json_and_report(pairs: tuple[Path, dict[str, Path]],
 
 
 def test_bad_input_is_one_sentence_and_exit_1(
-    pairs: tuple[Path, dict[str, Path]], tmp_path: Path, real_data: Path
+    pairs: dict[str, tuple[Path, dict[str, Path]]], tmp_path: Path, real_data: Path
 ) -> None:
-    sim, reals = pairs
+    sim, reals = pairs["octo"]
     model = tmp_path / "model.json"
     model.write_text("{}")
     runner = CliRunner()
