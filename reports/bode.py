@@ -33,6 +33,7 @@ def bode_figure(
     models: Mapping[str, ModelResponse] | None = None,
     n_cols: int | None = None,
     min_coherence: float | None = None,
+    labels: tuple[str, str] = ("flight data", "model"),
 ) -> Figure:
     """Magnitude (dB), phase (deg) and coherence against frequency (rad/s, log) for each response.
 
@@ -54,6 +55,8 @@ def bode_figure(
         Blocks per row; default 1 for one response, else 2.
     min_coherence : float, optional
         Draw this gamma^2 threshold on the coherence panels.
+    labels : tuple of str, optional
+        Legend names of the responses and of the overlay.
 
     Returns
     -------
@@ -92,7 +95,7 @@ def bode_figure(
         row, col = divmod(k, columns)
         panels = grid[3 * row : 3 * row + 3, col]
         model = _model_values(models, response)
-        _draw(panels, response, model, min_coherence)
+        _draw(panels, response, model, min_coherence, labels)
         if model is not None and legend:  # one legend per figure: the same two lines in every block
             panels[0].legend(loc="best", fontsize=7, frameon=False)
             legend = False
@@ -167,6 +170,15 @@ def _hide_frequency_labels(ax: Axes) -> None:
     ax.tick_params(axis="x", which="both", labelbottom=False)
 
 
+def _unwrapped(values: np.ndarray) -> np.ndarray:
+    """Unwrapped phase, rad, of the finite values (a model known on part of the grid is NaN elsewhere)."""
+    angle = np.angle(values)
+    finite = np.isfinite(angle)
+    out = np.full(angle.shape, np.nan)
+    out[finite] = np.unwrap(angle[finite])
+    return out
+
+
 def _nearest_branch(data: np.ndarray, model: np.ndarray) -> np.ndarray:
     """The model's phase moved by whole turns onto the data's branch, point by point (median of 9 points).
 
@@ -193,19 +205,21 @@ def _model_values(models: Mapping[str, ModelResponse] | None, response: Frequenc
 
 
 def _draw(
-    panels: np.ndarray, response: FrequencyResponse, model: np.ndarray | None, min_coherence: float | None
+    panels: np.ndarray,
+    response: FrequencyResponse,
+    model: np.ndarray | None,
+    min_coherence: float | None,
+    labels: tuple[str, str],
 ) -> None:
     magnitude, phase, coherence = panels
     omega = response.omega
-    magnitude.semilogx(omega, response.magnitude_db, color=_DATA, lw=1.2, label="flight data")
+    magnitude.semilogx(omega, response.magnitude_db, color=_DATA, lw=1.2, label=labels[0])
     phase.semilogx(omega, response.phase_deg, color=_DATA, lw=1.2)
     coherence.semilogx(omega, response.coherence, color=_DATA, lw=1.2)
     if model is not None:
-        model_phase = _nearest_branch(
-            np.asarray(response.phase_deg, dtype=float), np.degrees(np.unwrap(np.angle(model)))
-        )
+        model_phase = _nearest_branch(np.asarray(response.phase_deg, dtype=float), np.degrees(_unwrapped(model)))
         magnitude.semilogx(
-            omega, 20 * np.log10(np.maximum(np.abs(model), 1e-300)), color=_MODEL, lw=1.2, ls="--", label="model"
+            omega, 20 * np.log10(np.maximum(np.abs(model), 1e-300)), color=_MODEL, lw=1.2, ls="--", label=labels[1]
         )
         phase.semilogx(omega, model_phase, color=_MODEL, lw=1.2, ls="--")
     if response.fit_range is not None:

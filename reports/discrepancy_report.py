@@ -2,17 +2,19 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from sysid.discrepancy import FAR_FROM_FLOOR, DiscrepancyResult, Finding
+from sysid.discrepancy import FAR_FROM_FLOOR, DiscrepancyResult, Finding, ResponseComparison
 
+from .bode import bode_figure
 from .html import render_html, write_html
 from .svg import figure_svg, new_figure
 
-__all__ = ["finding_figure", "render_discrepancy_report", "write_discrepancy_report"]
+__all__ = ["finding_figure", "responses_figure", "render_discrepancy_report", "write_discrepancy_report"]
 
 _BEFORE, _AFTER = "#c0392b", "#1f4e79"
 _LABELS = {
@@ -58,13 +60,44 @@ def finding_figure(finding: Finding) -> str:
     return figure_svg(figure)
 
 
-def render_discrepancy_report(result: DiscrepancyResult, *, title: str = "Simulation against flight") -> str:
+def responses_figure(comparisons: Sequence[ResponseComparison]) -> str:
+    """SVG: each compared pair's real response (solid) with the simulation's (dashed) on magnitude and phase.
+
+    Parameters
+    ----------
+    comparisons : sequence of ResponseComparison
+        From :func:`sysid.discrepancy.compare_responses`.
+
+    Returns
+    -------
+    str
+        Inline SVG ("" with nothing to compare).
+    """
+    if not comparisons:
+        return ""
+    figure = bode_figure(
+        [c.real for c in comparisons],
+        models={c.pair: c.sim_on_real_omega for c in comparisons},
+        min_coherence=0.6,
+        labels=("real flight", "simulation"),
+    )
+    return figure_svg(figure)
+
+
+def render_discrepancy_report(
+    result: DiscrepancyResult,
+    comparisons: Sequence[ResponseComparison] = (),
+    *,
+    title: str = "Simulation against flight",
+) -> str:
     """The report as one HTML document.
 
     Parameters
     ----------
     result : DiscrepancyResult
         The search's answer.
+    comparisons : sequence of ResponseComparison, optional
+        Real against simulated frequency responses of the sweeps both flew.
     title : str, optional
         Page title.
     """
@@ -75,11 +108,20 @@ def render_discrepancy_report(result: DiscrepancyResult, *, title: str = "Simula
         if not effect.endswith("_threshold")
     ]
     return render_html(
-        "discrepancy.html", title=title, result=result, findings=findings, screened=screened, far=FAR_FROM_FLOOR
+        "discrepancy.html",
+        title=title,
+        result=result,
+        findings=findings,
+        screened=screened,
+        far=FAR_FROM_FLOOR,
+        bode=responses_figure(comparisons),
+        compared=[c.pair for c in comparisons],
     )
 
 
-def write_discrepancy_report(path: str | Path, result: DiscrepancyResult) -> Path:
+def write_discrepancy_report(
+    path: str | Path, result: DiscrepancyResult, comparisons: Sequence[ResponseComparison] = ()
+) -> Path:
     """Render and write the report atomically; returns the path.
 
     Parameters
@@ -88,5 +130,7 @@ def write_discrepancy_report(path: str | Path, result: DiscrepancyResult) -> Pat
         Destination ``.html``.
     result : DiscrepancyResult
         The search's answer.
+    comparisons : sequence of ResponseComparison, optional
+        Real against simulated frequency responses.
     """
-    return write_html(path, render_discrepancy_report(result))
+    return write_html(path, render_discrepancy_report(result, comparisons))

@@ -154,7 +154,7 @@ def _discrepancy_demo(ctx: click.Context, out_dir: Path) -> None:
     from .discrepancy import discrepancy
 
     out_dir.mkdir(parents=True, exist_ok=True)
-    click.echo(f"simulating a flight and its 'real' twin into {out_dir}/ (about 30 s) ...")
+    click.echo(f"simulating a flight and its 'real' twin into {out_dir}/ (about a minute) ...")
     sim, reals = write_pairs(["time_delay"], out_dir, seed=7)
     real = out_dir / "real.ulg"
     reals["time_delay"].replace(real)  # the file name must not tell
@@ -167,6 +167,7 @@ def _discrepancy_demo(ctx: click.Context, out_dir: Path) -> None:
         wind_paths=(),
         wind_distance=None,
         wind_offset=None,
+        rotor_radius=None,
         out=out_dir / "discrepancy.json",
         report=page,
         json_path=None,

@@ -14,7 +14,7 @@ __all__ = ["discrepancy"]
 
 _EPILOG = """\b
 Examples:
-  sysid discrepancy sitl.ulg real.ulg
+  sysid discrepancy sitl.ulg real.ulg --rotor-radius 0.19
   sysid discrepancy sitl_1.ulg sitl_2.ulg --real flight_1.ulg --real flight_2.ulg -o gap.json --report gap.html
   sysid discrepancy sitl.bin --real flight.bin --wind anemometer.csv --json -
 """
@@ -32,6 +32,12 @@ Examples:
 @wind_option("Anemometer CSV, or a folder of them (repeatable), for the real flights: adds the wind term.")
 @wind_distance_option()
 @wind_offset_option()
+@click.option(
+    "--rotor-radius",
+    "rotor_radius",
+    type=click.FloatRange(min=0.0, min_open=True),
+    help="Propeller radius, m, if known: where the ground effect ends is also given as Z/R.",
+)
 @click.option("-o", "--out", type=OutputPath(), help="Write the findings (JSON) here.")
 @click.option("--report", type=OutputPath(), help="Write the HTML report here.")
 @json_option
@@ -42,6 +48,7 @@ def discrepancy(
     wind_paths: tuple[Path, ...],
     wind_distance: float | None,
     wind_offset: float | None,
+    rotor_radius: float | None,
     out: Path | None,
     report: Path | None,
     json_path: str | None,
@@ -56,7 +63,7 @@ def discrepancy(
     from flightlogs.errors import DataError
     from flightlogs.writers.jsonio import write_json
     from reports.discrepancy_report import write_discrepancy_report
-    from sysid.discrepancy import discover, flight_series
+    from sysid.discrepancy import DiscrepancyOptions, compare_responses, discover, flight_series
 
     sim_logs: tuple[Path, ...] = logs
     if not real_logs:
@@ -75,13 +82,14 @@ def discrepancy(
         result = discover(
             [flight_series(f.source.name, f.records) for f in simulated],
             [flight_series(f.source.name, f.records) for f in flown],
+            DiscrepancyOptions(rotor_radius_m=rotor_radius),
             progress=progress,
         )
     summary = result.to_dict()
     if out is not None:
         write_json(out, summary)
     if report is not None:
-        write_discrepancy_report(report, result)
+        write_discrepancy_report(report, result, compare_responses(simulated, flown))
     if not quiet:
         click.echo(f"verdict: {result.verdict}")
         for finding in result.findings:

@@ -5,6 +5,7 @@ from a conditioned flight's records) and returns a :class:`DiscrepancyResult`.
 """
 
 from sysid.discrepancy.describe import FAR_FROM_FLOOR
+from sysid.discrepancy.responses import RATE_PAIRS, ResponseComparison, compare_responses
 from sysid.discrepancy.result import DiscrepancyResult, Finding, FittedParameter, Regime
 from sysid.discrepancy.search import DiscrepancyOptions, discover
 from sysid.discrepancy.series import FlightSeries, flight_series
@@ -18,7 +19,10 @@ __all__ = [
     "Finding",
     "FittedParameter",
     "FlightSeries",
+    "RATE_PAIRS",
+    "ResponseComparison",
     "Regime",
+    "compare_responses",
     "discover",
     "flight_series",
 ]

@@ -42,7 +42,9 @@ _NAMES: Mapping[str, str] = {
 }
 
 
-def parameters_of(fit: TermFit, thrust_scale: float = 1.0) -> tuple[FittedParameter, ...]:
+def parameters_of(
+    fit: TermFit, thrust_scale: float = 1.0, rotor_radius_m: float | None = None
+) -> tuple[FittedParameter, ...]:
     """The fitted parameters of a term, with standard deviations, in SI units.
 
     `thrust_scale` is the real over the simulated thrust per input taken out before the term: the
@@ -55,6 +57,8 @@ def parameters_of(fit: TermFit, thrust_scale: float = 1.0) -> tuple[FittedParame
         The term fitted on all of REAL.
     thrust_scale : float, optional
         Real over simulated thrust per input (the trim fitted before any term).
+    rotor_radius_m : float, optional
+        Propeller radius, m: the ground effect's end is also given as the rotor plane's Z/R (chapter 2).
 
     Returns
     -------
@@ -91,10 +95,20 @@ def parameters_of(fit: TermFit, thrust_scale: float = 1.0) -> tuple[FittedParame
             name="exponent", value=exponent.value / level, uncertainty=exponent.uncertainty / level, unit="1"
         )
     if candidate.effect == "ground_effect" and len(out) > 1:
-        c = out[1]
-        ends = np.sqrt(max(c.value, 0.0) / _GROUND_EFFECT_END)
-        spread = 0.5 * ends * c.uncertainty / c.value if c.value > 0 else float("nan")
+        rotors_above, c = out[0], out[1]
+        plane = np.sqrt(max(c.value, 0.0) / _GROUND_EFFECT_END)  # rotor-plane height where the gain falls to 1 %
+        spread = 0.5 * plane * c.uncertainty / c.value if c.value > 0 else float("nan")
+        ends = plane - rotors_above.value
         out.append(FittedParameter(name="ends_at_height", value=float(ends), uncertainty=float(spread), unit="m"))
+        if rotor_radius_m is not None:
+            out.append(
+                FittedParameter(
+                    name="ends_at_height_over_radius",
+                    value=float(plane / rotor_radius_m),
+                    uncertainty=float(spread / rotor_radius_m),
+                    unit="1",
+                )
+            )
     return tuple(out)
 
 
@@ -130,7 +144,12 @@ def describe_finding(finding: Finding, candidate: Candidate) -> str:
             "that the simulation lacks (the magnitude rolls off, not only the phase)"
         )
     elif effect == "ground_effect" and (p := _value(finding, "ends_at_height")) is not None:
-        what = f"The real vehicle gains thrust near the ground, up to about {p.value:.2f} m; the simulation has no ground effect"
+        ratio = _value(finding, "ends_at_height_over_radius")
+        where = f" (rotor plane at Z/R = {ratio.value:.1f})" if ratio is not None else ""
+        what = (
+            f"The real vehicle gains thrust near the ground, up to about {p.value:.2f} m{where}; "
+            "the simulation has no ground effect"
+        )
     elif effect == "mass_change" and (p := _value(finding, "mass_ratio")) is not None:
         t = _value(finding, "time_s")
         when = f" at t = {_pm(t.value, t.uncertainty)} s of flight" if t is not None else ""

@@ -31,7 +31,16 @@ from scipy.signal import welch
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
 from sysid.discrepancy.describe import describe_finding, parameters_of, summary_of
 from sysid.discrepancy.result import DiscrepancyResult, Finding, FindingTraces, Regime
-from sysid.discrepancy.selection import TermFit, blocks, combined, cross_validated, effective_samples, fit_term
+from sysid.discrepancy.selection import (
+    TermFit,
+    blocks,
+    combined,
+    cross_validated,
+    effective_samples,
+    fit_term,
+    joined,
+    split_joined,
+)
 from sysid.discrepancy.series import OUTPUTS, FlightSeries
 from sysid.discrepancy.terms import Candidate, candidate_terms
 
@@ -62,11 +71,14 @@ class DiscrepancyOptions:
         ... and this many times its score on held-out simulation data.
     max_findings : int
         Most effects reported.
+    rotor_radius_m : float or None
+        Propeller radius, m, if known: the ground effect's end is also given as Z/R.
     """
 
     min_improvement: float = 0.05
     null_margin: float = 3.0
     max_findings: int = 3
+    rotor_radius_m: float | None = None
 
 
 def discover(
@@ -108,34 +120,47 @@ def discover(
         found = {t.candidate.effect for t, *_ in kept}
         exclude = tuple(found | (set(_TRANSFORMS) if found & set(_TRANSFORMS) else set()))
         scores = []
+        linear = [fit for fit, *_ in kept if fit.candidate.kind == "linear"]
+        without = _without(additions, linear)  # the kept linear terms refit with each linear newcomer
         for candidate in candidate_terms(flown, baseline, combined(base, additions), exclude=exclude):
-            score, predicted = cross_validated(candidate, y, base, additions, scale)
+            together = candidate.kind == "linear" and bool(linear)
+            trial, adds = (joined(candidate, linear), without) if together else (candidate, additions)
+            current = combined(base, additions)
+            reference = held_out if together else None  # judged against the kept terms' held-out prediction
+            score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
             threshold = max(options.min_improvement, options.null_margin * max(null.get(candidate.effect, 0.0), 0.0))
             if not kept:
                 screened[candidate.effect] = round(score, 4)
                 screened[f"{candidate.effect}_threshold"] = round(threshold, 4)
             if score > threshold:
-                fit = fit_term(candidate, y, base, additions, scale)
+                fit = fit_term(trial, y, base, adds, scale)
                 if candidate.kind == "transform" and fit.value >= candidate.grid[-1]:
                     continue  # at the end of the range searched: a bound, not a measured delay or lag
-                scores.append((_bic_change(fit, y, base, additions), score, fit, predicted))
+                change = _bic_change(fit, y, fit.prediction(base, adds), current, len(candidate.coefficients))
+                scores.append((change, score, fit, predicted, candidate, adds))
         _report(progress, "screening terms", len(kept) + 1, options.max_findings + 1)
         if not scores:
             break
-        _, score, fit, predicted = min(scores, key=lambda s: s[0])
-        candidate = fit.candidate
+        _, score, fit, predicted, candidate, adds = min(scores, key=lambda s: s[0])
         before = dict(held_out)
-        for o in candidate.outputs:
+        for o in fit.candidate.outputs:
             held_out[o] = predicted[o]
-        kept.append((fit, score, before, dict(held_out)))
         if candidate.kind == "transform":
-            base = dict(fit.candidate.build(fit.value))
-        else:
-            built = candidate.build(fit.value)
-            for o, coefficients in fit.coefficients.items():
-                additions[o] = additions[o] + built[o] @ coefficients
+            base = dict(candidate.build(fit.value))
+            kept.append((fit, score, before, dict(held_out)))
+            continue
+        own, *refit = split_joined(fit, candidate, linear) if fit.candidate is not candidate else [fit]
+        kept = [(refit.pop(0) if k.candidate.kind == "linear" and refit else k, sc, b, a) for k, sc, b, a in kept]
+        kept.append((own, score, before, dict(held_out)))
+        additions = dict(adds)
+        built = fit.candidate.build(fit.value)
+        for o, coefficients in fit.coefficients.items():
+            additions[o] = additions[o] + built[o] @ coefficients
     findings = sorted(
-        (_finding(fit, score, before, after, y, flown, scale, 1.0 + gain) for fit, score, before, after in kept),
+        (
+            _finding(fit, score, before, after, y, flown, scale, 1.0 + gain, options.rotor_radius_m)
+            for fit, score, before, after in kept
+        ),
         key=lambda f: -f.improvement_percent,
     )
     _report(progress, "done", 3, 3)
@@ -154,28 +179,40 @@ def discover(
     )
 
 
+def _without(additions: Mapping[str, np.ndarray], linear: Sequence[TermFit]) -> dict[str, np.ndarray]:
+    """`additions` less the contributions of the kept `linear` terms (the thrust trim stays)."""
+    out = {o: np.array(v, dtype=float) for o, v in additions.items()}
+    for fit in linear:
+        built = fit.candidate.build(fit.value)
+        for o, coefficients in fit.coefficients.items():
+            out[o] = out[o] - built[o] @ coefficients
+    return out
+
+
 def _report(progress: Progress | None, stage: str, done: int, total: int) -> None:
     if progress is not None:
         progress(stage, done, total)
 
 
 def _bic_change(
-    fit: TermFit, y: Mapping[str, np.ndarray], base: Mapping[str, np.ndarray], additions: Mapping[str, np.ndarray]
+    fit: TermFit,
+    y: Mapping[str, np.ndarray],
+    with_term: Mapping[str, np.ndarray],
+    current: Mapping[str, np.ndarray],
+    n_coefficients: int,
 ) -> float:
     """Change of the Bayesian information criterion on all of REAL when the term joins the model.
 
     Each output's likelihood counts its effective samples (its residual is correlated), and the term's
-    parameters are its coefficients plus the value inside its shape.
+    parameters are its `n_coefficients` (a transform: none) plus the value inside its shape.
     """
-    current = combined(base, additions)
-    with_term = fit.prediction(base, additions)
     change, samples = 0.0, 0.0
     for o in fit.candidate.outputs:
         before, after = y[o] - current[o], y[o] - with_term[o]
         n_effective = effective_samples(before)
         change += n_effective * float(np.log(max(np.sum(after**2), 1e-300) / max(np.sum(before**2), 1e-300)))
         samples += n_effective
-    k = sum(c.size for c in fit.coefficients.values()) + (1 if fit.candidate.grid_parameter else 0)
+    k = n_coefficients + (1 if fit.candidate.grid_parameter else 0)
     return change + k * float(np.log(max(samples, 2.0)))
 
 
@@ -220,6 +257,7 @@ def _finding(
     flown: FlightSeries,
     scale: Mapping[str, float],
     thrust_scale: float,
+    rotor_radius_m: float | None,
 ) -> Finding:
     outputs = fit.candidate.outputs
     rms_before = {o: float(np.sqrt(np.mean((y[o] - before[o]) ** 2))) for o in outputs}
@@ -237,7 +275,7 @@ def _finding(
         band_rad_s=_band(contribution, flown.rate_hz),
         regime=regime,
         explained_variance=round(max(score, 0.0), 4),
-        parameters=parameters_of(fit, thrust_scale),
+        parameters=parameters_of(fit, thrust_scale, rotor_radius_m),
         rmse_before=rms_before,
         rmse_after=rms_after,
         improvement_percent=round(float(improvement), 2),

@@ -14,14 +14,23 @@ noise weighs little.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from sysid.discrepancy.terms import Candidate
 
-__all__ = ["TermFit", "blocks", "combined", "cross_validated", "fit_term", "effective_samples"]
+__all__ = [
+    "TermFit",
+    "blocks",
+    "combined",
+    "cross_validated",
+    "fit_term",
+    "joined",
+    "split_joined",
+    "effective_samples",
+]
 
 _N_BLOCKS = 6
 
@@ -92,6 +101,8 @@ def cross_validated(
     base: Mapping[str, np.ndarray],
     additions: Mapping[str, np.ndarray],
     scale: Mapping[str, float],
+    reference: Mapping[str, np.ndarray] | None = None,
+    judged: tuple[str, ...] | None = None,
 ) -> tuple[float, dict[str, np.ndarray]]:
     """Held-out share of the weighted residual of the term's outputs that the term removes, and its predictions.
 
@@ -107,6 +118,11 @@ def cross_validated(
         Contributions of the terms already kept, shape (n,) each.
     scale : Mapping[str, float]
         Each output's noise-floor variance (the weights are its inverse).
+    reference : Mapping[str, ndarray], optional
+        The prediction the term is judged against, shape (n,) each (default ``base + additions``): the
+        held-out prediction of the terms already kept when a :func:`joined` term refits them.
+    judged : tuple of str, optional
+        Outputs the score sums over (default the term's).
 
     Returns
     -------
@@ -116,7 +132,7 @@ def cross_validated(
         Each output as predicted on every block by the term fitted on the other blocks, shape (n,).
     """
     n = next(iter(y.values())).size
-    current = combined(base, additions)
+    current = dict(reference) if reference is not None else combined(base, additions)
     predicted = {o: current[o].copy() for o in current}
     fixed = replace(candidate, grid=(fit_term(candidate, y, base, additions, scale).value,))
     for test in blocks(n):
@@ -125,9 +141,80 @@ def cross_validated(
         with_term = fit.prediction(base, additions)
         for o in candidate.outputs:
             predicted[o][test] = with_term[o][test]
-    before = sum(np.sum((y[o] - current[o]) ** 2) / scale[o] for o in candidate.outputs)
-    after = sum(np.sum((y[o] - predicted[o]) ** 2) / scale[o] for o in candidate.outputs)
+    outputs = judged if judged is not None else candidate.outputs
+    before = sum(np.sum((y[o] - current[o]) ** 2) / scale[o] for o in outputs)
+    after = sum(np.sum((y[o] - predicted[o]) ** 2) / scale[o] for o in outputs)
     return float(1.0 - after / before) if before > 0 else 0.0, predicted
+
+
+def joined(candidate: Candidate, kept: Sequence[TermFit]) -> Candidate:
+    """`candidate` with the regressors of the linear terms already `kept` beside its own, to be fitted together.
+
+    Two effects whose regressors overlap are told apart only when fitted jointly (a CG offset's constant
+    moment and the hub moment of a steady wind): a kept term's coefficients, fitted alone, have taken up
+    part of the newcomer's. Per output the columns are the candidate's, then each kept term's, in order.
+
+    Parameters
+    ----------
+    candidate : Candidate
+        A linear term.
+    kept : sequence of TermFit
+        Linear terms already kept (their grid values stay).
+
+    Returns
+    -------
+    Candidate
+        Named, gridded and located as `candidate`.
+    """
+    parts = [(candidate, None), *((k.candidate, k.value) for k in kept)]
+    outputs = tuple(dict.fromkeys(o for c, _ in parts for o in c.outputs))
+
+    def build(value: float) -> dict[str, np.ndarray]:
+        built = [c.build(value if v is None else v) for c, v in parts]
+        return {o: np.column_stack([b[o] for (c, _), b in zip(parts, built) if o in c.outputs]) for o in outputs}
+
+    names = candidate.coefficients + tuple(n for k in kept for n in k.candidate.coefficients)
+    return replace(candidate, outputs=outputs, build=build, coefficients=names)
+
+
+def split_joined(fit: TermFit, candidate: Candidate, kept: Sequence[TermFit]) -> list[TermFit]:
+    """A :func:`joined` fit back into one fit per term: the candidate's, then each kept term's.
+
+    Parameters
+    ----------
+    fit : TermFit
+        The joined term's fit.
+    candidate : Candidate
+        The candidate it was joined from.
+    kept : sequence of TermFit
+        The kept terms it holds, in the order given to :func:`joined`.
+    """
+    parts = [
+        (candidate, fit.value, fit.value_uncertainty),
+        *((k.candidate, k.value, k.value_uncertainty) for k in kept),
+    ]
+    first = dict.fromkeys(fit.coefficients, 0)
+    out = []
+    for term, value, spread in parts:
+        built = term.build(value)
+        coefficients, covariance = {}, {}
+        for o in term.outputs:
+            if o not in fit.coefficients:
+                continue
+            width = built[o].shape[1]
+            span = slice(first[o], first[o] + width)
+            coefficients[o], covariance[o] = fit.coefficients[o][span], fit.covariance[o][span, span]
+            first[o] += width
+        out.append(
+            TermFit(
+                candidate=term,
+                value=value,
+                coefficients=coefficients,
+                covariance=covariance,
+                value_uncertainty=spread,
+            )
+        )
+    return out
 
 
 def fit_term(

@@ -163,6 +163,9 @@ class Case:
         Seed of everything random.
     description : str
         One line on what the case is for.
+    plant_changes : tuple of (str, float)
+        :class:`~independent_sim.plant.HoverPlant` fields set to other values (a vehicle that differs from
+        the Table 3.3 one: a longer delay, a slower actuator, more drag).
     """
 
     name: str
@@ -176,6 +179,7 @@ class Case:
     px4_accel_topic: Literal["vehicle_acceleration", "sensor_combined"] = "vehicle_acceleration"
     seed: int = 0
     description: str = ""
+    plant_changes: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         if self.fmt not in ("ulog", "dataflash"):

@@ -59,7 +59,7 @@ def simulate(case: Case, fmt: LogFormat | None = None) -> Flight:
     fmt = fmt or case.fmt
     plan, rng = case.plan, np.random.default_rng(case.seed)
     psi0 = math.radians(case.wind.from_deg if case.wind is not None else case.heading_deg)
-    plant = hover_plant(case.condition, psi0=psi0)
+    plant = replace(hover_plant(case.condition, psi0=psi0), **dict(case.plant_changes))
     gains = px4_gains(plant) if fmt == "ulog" else ardupilot_gains(plant)
     loop = closed_loop(plant, gains, n_sub=_SUB_STEPS[fmt])
     grid = _Grid.of(case, gains.rate_hz, loop.n_sub)
