@@ -115,7 +115,6 @@ def render_discrepancy_report(
         screened=screened,
         far=FAR_FROM_FLOOR,
         bode=responses_figure(comparisons),
-        compared=[c.pair for c in comparisons],
     )
 
 

@@ -261,8 +261,7 @@ class HeightSteps:
         -------
         ndarray, shape (n_samples,)
         """
-        index = np.clip(np.searchsorted(self.times_s, time_s, side="right") - 1, 0, None)
-        return np.asarray(self.heights_m)[index]
+        return _held(self.times_s, self.heights_m, time_s)
 
     @classmethod
     def ground_effect_descent(
@@ -336,8 +335,13 @@ class Legs:
         -------
         ndarray, shape (n_samples, 2)
         """
-        index = np.clip(np.searchsorted(self.times_s, time_s, side="right") - 1, 0, None)
-        return np.column_stack([np.asarray(self.north_m)[index], np.asarray(self.east_m)[index]])
+        return np.column_stack([_held(self.times_s, self.north_m, time_s), _held(self.times_s, self.east_m, time_s)])
+
+
+def _held(times_s: tuple[float, ...], values: tuple[float, ...], time_s: np.ndarray) -> np.ndarray:
+    """Each value held from its time to the next (the first also before it), at `time_s`."""
+    index = np.clip(np.searchsorted(times_s, time_s, side="right") - 1, 0, None)
+    return np.asarray(values, dtype=np.float64)[index]
 
 
 def excitation_table(

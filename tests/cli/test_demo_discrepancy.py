@@ -21,5 +21,5 @@ def test_the_discrepancy_demo_finds_the_delay_and_ends_with_its_report(tmp_path:
     assert saved["findings"][0]["parameters"]["delay_s"]["value"] == pytest.approx(0.030, abs=0.0025)
     assert {p.name for p in tmp_path.glob("*.ulg")} == {"sim-7.ulg", "real.ulg"}  # no name tells the effect
     page = tmp_path / "discrepancy.html"
-    assert result.output.strip().splitlines()[-1] == f"report: {page.resolve()}"
+    assert result.stdout.strip().splitlines()[-1] == f"report: {page.resolve()}"
     assert "Real against simulated frequency responses" in page.read_text()
