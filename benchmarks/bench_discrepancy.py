@@ -22,7 +22,7 @@ import warnings
 from collections import Counter, defaultdict
 from pathlib import Path
 
-from flightlogs.conditioning.condition import condition_flight
+from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
 from flightlogs.readers import read_log
 from simulator.campaign.discrepancy_pairs import EFFECTS, STRENGTHS, VEHICLES, write_pair_set
 from sysid.discrepancy import discover, flight_series
@@ -38,7 +38,8 @@ Row = tuple[str, str, str, str, tuple[str, ...], float, float]  # kind, vehicle,
 
 
 def _series(path: Path):  # type: ignore[no-untyped-def]
-    return flight_series(path.name, condition_flight(read_log(path)).records)
+    # as `sysid discrepancy` without --report: no maneuver detection (the search needs none)
+    return flight_series(path.name, condition_flight(read_log(path), options=ConditioningOptions(segments=())).records)
 
 
 def _pairs(nulls: int) -> dict[str, list[tuple[str, str]]]:

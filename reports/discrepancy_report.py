@@ -44,7 +44,7 @@ def finding_figure(finding: Finding) -> str:
     if traces is None:
         return ""
     outputs = list(finding.outputs)[:4]
-    figure, axes = new_figure(len(outputs), 2, width_in=7.5, height_in=1.9 * len(outputs) + 0.4)
+    figure, axes = new_figure(len(outputs), 2, width_in=7.5, height_in=2.2 * len(outputs) + 0.4)
     grid = np.asarray(axes).reshape(len(outputs), 2)
     for row, output in zip(grid, outputs):
         for ax, x, label in (

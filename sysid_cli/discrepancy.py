@@ -73,8 +73,10 @@ def discrepancy(
     for path in sim_logs:
         if path.suffix.lower() == ".json":
             raise DataError(f"{path}: a fitted model as SIM is not supported yet; give the simulation's flight log")
-    plain = ConditioningOptions()
-    windy = ConditioningOptions(wind_offset_s=wind_offset, wind_distance_m=wind_distance)
+    # the search needs no maneuvers; the report's frequency responses need the sweeps (2 s a log to find)
+    maneuvers = None if report is not None else ()
+    plain = ConditioningOptions(segments=maneuvers)
+    windy = ConditioningOptions(wind_offset_s=wind_offset, wind_distance_m=wind_distance, segments=maneuvers)
     log_only = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset}
     simulated = conditioned_flights(list(sim_logs), [], plain, log_only={}, quiet=quiet)
     flown = conditioned_flights(list(real_logs), list(wind_paths), windy, log_only=log_only, quiet=quiet)

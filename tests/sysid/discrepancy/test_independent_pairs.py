@@ -19,7 +19,7 @@ from independent_sim.maneuvers import Chirp, Maneuver
 from independent_sim.plant import hover_plant
 from independent_sim.scenario import Case, FlightPlan, Reposition
 
-from flightlogs.conditioning.condition import condition_flight
+from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
 from flightlogs.readers import read_log
 from sysid.discrepancy import DiscrepancyResult, discover, flight_series
 
@@ -63,7 +63,7 @@ def _case(name: str, seed: int, changes: tuple[tuple[str, float], ...]) -> Case:
 
 
 def _series(path: Path):  # type: ignore[no-untyped-def]
-    return flight_series(path.name, condition_flight(read_log(path)).records)
+    return flight_series(path.name, condition_flight(read_log(path), options=ConditioningOptions(segments=())).records)
 
 
 @pytest.fixture(scope="module", name="results")

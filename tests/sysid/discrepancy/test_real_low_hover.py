@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from flightlogs.conditioning.condition import condition_flight
+from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
 from flightlogs.readers import read_log
 from sysid.discrepancy import FAR_FROM_FLOOR, discover, flight_series
 from sysid_cli.main import cli
@@ -25,7 +25,7 @@ pytestmark = [pytest.mark.slow, pytest.mark.filterwarnings("ignore::flightlogs.e
 
 
 def _series(path: Path):  # type: ignore[no-untyped-def]
-    return flight_series(path.name, condition_flight(read_log(path)).records)
+    return flight_series(path.name, condition_flight(read_log(path), options=ConditioningOptions(segments=())).records)
 
 
 def test_the_take_off_ramp_on_the_ground_is_not_flight(real_data: Path) -> None:
