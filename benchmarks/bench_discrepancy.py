@@ -1,12 +1,13 @@
 """Discrepancy discovery over a matrix of SIM / REAL pairs from our simulator: confusion matrix and timings.
 
     python benchmarks/bench_discrepancy.py [--vehicles octo quad] [--seeds 21 22 23] [--nulls 4]
+        [--effects ...] [--no-doubles]
 
 For each vehicle (the chapter 3 octocopter, a 2 kg quad) and seed: one SIM flight of the mission of
 :mod:`simulator.campaign.discrepancy_pairs` (hover, lon/lat/yaw sweeps, legs north and east, height steps
-down to Z/R = 2; 4 minutes), and REAL flights with each of the eight effects at two strengths (battery
-sag has one), four doubles and `--nulls` null flights (no effect, another noise seed), every REAL
-flight's events moved by 5 %, alternately later and earlier. Every pair is written as PX4 ULogs, read
+down to Z/R = 2; 4 minutes), and REAL flights with each of the eight effects at two strengths, four
+doubles and `--nulls` null flights (no effect, another noise seed), every REAL flight's events moved
+by 5 %, alternately later and earlier. Every pair is written as PX4 ULogs, read
 back and searched; the table is the confusion matrix (rows: truth, columns: verdict), then the share of
 singles named, of nulls answered "none", of doubles with both named, the median held-out improvement and
 the seconds per pair (reading both logs and searching; the simulation is not counted).
@@ -42,13 +43,13 @@ def _series(path: Path):  # type: ignore[no-untyped-def]
     return flight_series(path.name, condition_flight(read_log(path), options=ConditioningOptions(segments=())).records)
 
 
-def _pairs(nulls: int) -> dict[str, list[tuple[str, str]]]:
+def _pairs(nulls: int, effects: list[str], doubles: bool) -> dict[str, list[tuple[str, str]]]:
     pairs: dict[str, list[tuple[str, str]]] = {}
     for strength in STRENGTHS:
-        for effect in SINGLES:
-            if effect != "battery_sag" or strength == "strong":  # the pack's own sag: one strength
-                pairs[f"{effect}@{strength}"] = [(effect, strength)]
-    pairs |= {f"{a}+{b}@strong": [(a, "strong"), (b, "strong")] for a, b in DOUBLES}
+        for effect in effects:
+            pairs[f"{effect}@{strength}"] = [(effect, strength)]
+    if doubles:
+        pairs |= {f"{a}+{b}@strong": [(a, "strong"), (b, "strong")] for a, b in DOUBLES}
     pairs |= {f"none@{k}": [("none", "strong")] for k in range(nulls)}
     return pairs
 
@@ -58,6 +59,8 @@ def main() -> int:
     parser.add_argument("--vehicles", nargs="+", default=list(VEHICLES), choices=list(VEHICLES))
     parser.add_argument("--seeds", type=int, nargs="+", default=[21, 22, 23])
     parser.add_argument("--nulls", type=int, default=4, help="null pairs per vehicle and seed")
+    parser.add_argument("--effects", nargs="+", default=SINGLES, choices=SINGLES, help="single effects to fly")
+    parser.add_argument("--no-doubles", action="store_true", help="leave the doubles out")
     args = parser.parse_args()
     warnings.simplefilter("ignore")
     rows: list[Row] = []
@@ -65,7 +68,13 @@ def main() -> int:
         for seed in args.seeds:
             with tempfile.TemporaryDirectory() as folder:
                 started = time.perf_counter()
-                sim, reals = write_pair_set(_pairs(args.nulls), Path(folder), seed, VEHICLES[vehicle], stretch=0.05)
+                sim, reals = write_pair_set(
+                    _pairs(args.nulls, args.effects, not args.no_doubles),
+                    Path(folder),
+                    seed,
+                    VEHICLES[vehicle],
+                    stretch=0.05,
+                )
                 print(f"{vehicle} seed {seed}: {len(reals)} pairs simulated in {time.perf_counter() - started:.0f} s")
                 for name, path in reals.items():
                     truth, strength = name.split("@")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any, Literal
@@ -66,8 +67,18 @@ _CHANGES: Mapping[str, Callable[[Vehicle, float], Changes]] = {
     ),
     "time_delay": lambda v, k: ({}, {"delays_s": v.delays_s + 0.030 * k}),
     "actuator_lag": lambda v, k: ({}, {"motor_time_constant_s": v.motor_time_constant_s * (1.0 + 0.6 * k)}),
-    # one strength: the pack's own sag
-    "battery_sag": lambda v, k: ({"thrust_sag": True}, {}),
+    # the thrust follows the pack's voltage; at moderate a pack of twice the charge and half the resistance
+    # (about half the sag over the mission)
+    "battery_sag": lambda v, k: (
+        {"thrust_sag": True},
+        {}
+        if k == 1.0
+        else {
+            "battery": replace(
+                v.battery, capacity_ah=2 * v.battery.capacity_ah, resistance_ohm=v.battery.resistance_ohm / 2
+            )
+        },
+    ),
     "mass_change": lambda v, k: ({"payload": PayloadChange(time_s=70.0, delta_mass_kg=0.057 * k * v.mass_kg)}, {}),
     "cg_offset": lambda v, k: ({"cg_offset_m": (0.038 * k * _arm_m(v), 0.0, 0.0)}, {}),
 }
@@ -86,7 +97,7 @@ def changes(effect: str, vehicle: Vehicle, strength: Strength = "strong") -> Cha
     vehicle : Vehicle
         The simulated vehicle.
     strength : {"strong", "moderate"}, optional
-        Strength (battery sag has one).
+        Strength.
 
     Returns
     -------

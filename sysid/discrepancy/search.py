@@ -122,10 +122,10 @@ def discover(
         scores = []
         linear = [fit for fit, *_ in kept if fit.candidate.kind == "linear"]
         without = _without(additions, linear)  # the kept linear terms refit with each linear newcomer
-        for candidate in candidate_terms(flown, baseline, combined(base, additions), exclude=exclude):
+        current = combined(base, additions)
+        for candidate in candidate_terms(flown, baseline, current, exclude=exclude):
             together = candidate.kind == "linear" and bool(linear)
             trial, adds = (joined(candidate, linear), without) if together else (candidate, additions)
-            current = combined(base, additions)
             reference = held_out if together else None  # judged against the kept terms' held-out prediction
             score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
             threshold = max(options.min_improvement, options.null_margin * max(null.get(candidate.effect, 0.0), 0.0))
