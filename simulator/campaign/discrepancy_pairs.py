@@ -9,7 +9,6 @@ mass, a CG offset of 3.8 % of its arm): ``strong`` and ``moderate`` (about half)
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from datetime import UTC, datetime
@@ -265,6 +264,6 @@ def write_pair_set(
     flown = dict(zip(same, simulate_flights([trials[n] for n in same], vehicle, method="euler")))
     for name, (_, own) in combined.items():
         if own:
-            (flown[name],) = simulate_flights([trials[name]], dataclasses.replace(vehicle, **own), method="euler")
+            (flown[name],) = simulate_flights([trials[name]], replace(vehicle, **own), method="euler")
     sim = write_px4_log(flown.pop("sim"), folder / f"sim-{seed}.ulg", utc_start=start)
     return sim, {n: write_px4_log(f, folder / f"real-{n}-{seed}.ulg", utc_start=start) for n, f in flown.items()}

@@ -89,16 +89,16 @@ def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> Baseli
     """
     lags = np.arange(int(round(_LAG_S * series.rate_hz)) + 1)
     states = tuple(s for s in _STATES if s in series)
-    design = _design(series, lags, states, None)
+    design = _design(series, lags, states)
     use = slice(None) if rows is None else rows
     coefficients = {o: np.linalg.lstsq(design[use], series[o][use], rcond=None)[0] for o in OUTPUTS}
     return BaselineModel(coefficients=coefficients, lags=lags, states=states, rate_hz=series.rate_hz)
 
 
-def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...], commands: Commands) -> np.ndarray:
-    inputs = commands if commands is not None else {c: series[c] for c in COMMANDS}
-    columns = [_lagged(series, np.asarray(inputs[c]), lags) for c in COMMANDS]
-    columns += [_lagged(series, np.asarray(inputs[c]) ** 2, _square_lags(lags)) for c in COMMANDS]
+def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...]) -> np.ndarray:
+    """The regressors of the fit, shape (n, n_regressors), in the order :meth:`BaselineModel.predict` reads them."""
+    columns = [_lagged(series, series[c], lags) for c in COMMANDS]
+    columns += [_lagged(series, series[c] ** 2, _square_lags(lags)) for c in COMMANDS]
     columns.append(np.column_stack([series[s] for s in states] + [np.ones(series.n)]))
     return np.column_stack(columns)
 
