@@ -79,7 +79,7 @@ def responses_figure(comparisons: Sequence[ResponseComparison]) -> str:
         [c.real for c in comparisons],
         models={c.pair: c.sim_on_real_omega for c in comparisons},
         min_coherence=0.6,
-        labels=("real flight", "simulation"),
+        labels=("real flight", comparisons[0].sim_label),
     )
     return figure_svg(figure)
 
@@ -89,6 +89,7 @@ def render_discrepancy_report(
     comparisons: Sequence[ResponseComparison] = (),
     *,
     title: str = "Simulation against flight",
+    model: str | None = None,
 ) -> str:
     """The report as one HTML document.
 
@@ -100,6 +101,8 @@ def render_discrepancy_report(
         Real against simulated frequency responses of the sweeps both flew.
     title : str, optional
         Page title.
+    model : str, optional
+        The model file in the simulation's place, if it was one.
     """
     findings: list[dict[str, Any]] = [{"finding": f, "svg": finding_figure(f)} for f in result.findings]
     screened = [
@@ -115,11 +118,16 @@ def render_discrepancy_report(
         screened=screened,
         far=FAR_FROM_FLOOR,
         bode=responses_figure(comparisons),
+        model=model,
     )
 
 
 def write_discrepancy_report(
-    path: str | Path, result: DiscrepancyResult, comparisons: Sequence[ResponseComparison] = ()
+    path: str | Path,
+    result: DiscrepancyResult,
+    comparisons: Sequence[ResponseComparison] = (),
+    *,
+    model: str | None = None,
 ) -> Path:
     """Render and write the report atomically; returns the path.
 
@@ -131,5 +139,7 @@ def write_discrepancy_report(
         The search's answer.
     comparisons : sequence of ResponseComparison, optional
         Real against simulated frequency responses.
+    model : str, optional
+        The model file in the simulation's place, if it was one.
     """
-    return write_html(path, render_discrepancy_report(result, comparisons))
+    return write_html(path, render_discrepancy_report(result, comparisons, model=model))

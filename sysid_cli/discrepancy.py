@@ -17,6 +17,7 @@ Examples:
   sysid discrepancy sitl.ulg real.ulg --rotor-radius 0.19
   sysid discrepancy sitl_1.ulg sitl_2.ulg --real flight_1.ulg --real flight_2.ulg -o gap.json --report gap.html
   sysid discrepancy sitl.bin --real flight.bin --wind anemometer.csv --json -
+  sysid discrepancy model.json flight.ulg --report gap.html
 """
 
 
@@ -55,7 +56,7 @@ def discrepancy(
     quiet: bool,
 ) -> None:
     """Compare simulated flights (LOGS: PX4 SITL, ArduPilot SITL, Gazebo or `sysid simulate`, as ULog or
-    DataFlash) with real flights of the same vehicle: locate where they differ, name the physics the
+    DataFlash; or one model from `sysid fit -o`, evaluated along the real flights) with real flights of the same vehicle: locate where they differ, name the physics the
     simulation leaves out (ground_effect, rotor_drag, wind, time_delay, actuator_lag, battery_sag,
     mass_change, cg_offset), fit it with its uncertainty and show the residual it removes on held-out
     data. "none" is an answer: nothing beyond what noise gives on held-out simulated flight."""
@@ -63,35 +64,46 @@ def discrepancy(
     from flightlogs.errors import DataError
     from flightlogs.writers.jsonio import write_json
     from reports.discrepancy_report import write_discrepancy_report
-    from sysid.discrepancy import DiscrepancyOptions, compare_responses, discover, flight_series
+    from sysid.discrepancy import (
+        DiscrepancyOptions,
+        compare_model_responses,
+        compare_responses,
+        discover,
+        flight_series,
+        model_flight,
+    )
+    from sysid.fit.model_file import read_model
 
     sim_logs: tuple[Path, ...] = logs
     if not real_logs:
         if len(logs) != 2:
             raise click.UsageError("give SIM REAL, or the simulated logs and --real for each real one")
         sim_logs, real_logs = logs[:1], logs[1:]
-    for path in sim_logs:
-        if path.suffix.lower() == ".json":
-            raise DataError(f"{path}: a fitted model as SIM is not supported yet; give the simulation's flight log")
+    models = [p for p in sim_logs if p.suffix.lower() == ".json"]
+    if models and len(sim_logs) > 1:
+        raise DataError(f"{models[0]}: a fitted model is the whole simulation; give it alone, or only flight logs")
+    model = read_model(models[0]).linear_model(include_wind=False) if models else None
     # the search needs no maneuvers; the report's frequency responses need the sweeps (2 s a log to find)
     maneuvers = None if report is not None else ()
-    plain = ConditioningOptions(segments=maneuvers)
     windy = ConditioningOptions(wind_offset_s=wind_offset, wind_distance_m=wind_distance, segments=maneuvers)
     log_only = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset}
-    simulated = conditioned_flights(list(sim_logs), [], plain, log_only={}, quiet=quiet)
     flown = conditioned_flights(list(real_logs), list(wind_paths), windy, log_only=log_only, quiet=quiet)
-    with staged_progress("discrepancy", quiet=quiet) as progress:
-        result = discover(
-            [flight_series(f.source.name, f.records) for f in simulated],
-            [flight_series(f.source.name, f.records) for f in flown],
-            DiscrepancyOptions(rotor_radius_m=rotor_radius),
-            progress=progress,
+    real_series = [flight_series(f.source.name, f.records) for f in flown]
+    if model is None:
+        simulated = conditioned_flights(
+            list(sim_logs), [], ConditioningOptions(segments=maneuvers), log_only={}, quiet=quiet
         )
+        sim_series = [flight_series(f.source.name, f.records) for f in simulated]
+    else:
+        sim_series = [model_flight(model, s, source=models[0].name) for s in real_series]
+    with staged_progress("discrepancy", quiet=quiet) as progress:
+        result = discover(sim_series, real_series, DiscrepancyOptions(rotor_radius_m=rotor_radius), progress=progress)
     summary = result.to_dict()
     if out is not None:
         write_json(out, summary)
     if report is not None:
-        write_discrepancy_report(report, result, compare_responses(simulated, flown))
+        comparisons = compare_responses(simulated, flown) if model is None else compare_model_responses(model, flown)
+        write_discrepancy_report(report, result, comparisons, model=models[0].name if models else None)
     if not quiet:
         click.echo(f"verdict: {result.verdict}")
         for finding in result.findings:

@@ -28,9 +28,9 @@ from flightlogs.record import Record
 from simulator.vehicle.identified import CALM_HOVER
 from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate, Provenance, ReductionStep, synthetic_responses
 from sysid.model import parse_structure
+from sysid.model.discrete import discretize, simulate
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify import Verification, verify
-from sysid.verify._discrete import discretize, simulate
 
 # ------------------------------------------------------------------ a closed-loop roll hold
 

@@ -68,6 +68,7 @@ FORBIDDEN_THIRD_PARTY = {
 # freqresp        2    -
 # fit             3    core, model, freqresp
 # verify          4    core, model, fit
+# discrepancy     3    model, freqresp
 SUBPACKAGE_LAYERS: dict[str, dict[str, tuple[int, frozenset[str]]]] = {
     "flightlogs": {
         "core": (0, frozenset()),
@@ -93,7 +94,7 @@ SUBPACKAGE_LAYERS: dict[str, dict[str, tuple[int, frozenset[str]]]] = {
         "freqresp": (2, frozenset()),
         "fit": (3, frozenset({"core", "model", "freqresp"})),
         "verify": (4, frozenset({"core", "model", "fit"})),
-        "discrepancy": (3, frozenset({"freqresp"})),  # equation error on flight series; the sweeps' responses
+        "discrepancy": (3, frozenset({"model", "freqresp"})),  # equation error on flight series or a model; responses
     },
 }
 NAMESPACE = "__init__"  # a top package's own __init__: above all its units, imported by none of them

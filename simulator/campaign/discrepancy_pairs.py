@@ -18,7 +18,7 @@ from typing import Any, Literal
 import numpy as np
 
 from simulator.autopilot.control import HeightSteps, Legs
-from simulator.autopilot.excitation import Maneuver
+from simulator.autopilot.excitation import Axis, Maneuver
 from simulator.flights.nonlinear import simulate_flights
 from simulator.flights.trial import Trial
 from simulator.output.px4 import write_px4_log
@@ -37,6 +37,7 @@ __all__ = [
     "mission",
     "write_pairs",
     "write_pair_set",
+    "write_sweep_flight",
 ]
 
 DURATION_S = 240.0
@@ -108,10 +109,17 @@ def changes(effect: str, vehicle: Vehicle, strength: Strength = "strong") -> Cha
     return _CHANGES[effect](vehicle, _SCALE[strength])
 
 
-_SWEEPS: tuple[tuple[Literal["lat", "lon", "yaw", "thr"], float, float, float, float], ...] = (
+_SWEEPS: tuple[tuple[Axis, float, float, float, float], ...] = (
     ("lon", 8.0, 6.0, 30.0, 6.0),  # axis, start s, amplitude %, length s, top frequency Hz
     ("lat", 42.0, 6.0, 30.0, 6.0),
     ("yaw", 76.0, 8.0, 20.0, 4.0),
+)
+#: The sweeps a model of the simulation is fitted from: every axis, the throttle's too.
+_MODEL_SWEEPS: tuple[tuple[Axis, float, float, float, float], ...] = (
+    ("lon", 6.0, 6.0, 40.0, 6.0),
+    ("lat", 52.0, 6.0, 40.0, 6.0),
+    ("yaw", 98.0, 8.0, 30.0, 4.0),
+    ("thr", 134.0, 4.0, 30.0, 4.0),
 )
 _LEGS = ((0.0, 0.0, 0.0), (102.0, 20.0, 0.0), (117.0, 0.0, 0.0), (132.0, 0.0, 20.0), (147.0, 0.0, 0.0))
 _USED = 0.375  # share of the pack drawn before the mission
@@ -151,22 +159,9 @@ def mission(
         The vehicle (its rotor radius and the rotors' height above the CG set the low steps).
     """
     s = 1.0 + stretch
-    sweeps = tuple(
-        Maneuver(
-            axis=axis,
-            kind="sweep",
-            start_s=start * s,
-            amplitude=amplitude,
-            duration_s=length,
-            f_start_hz=0.3,
-            f_stop_hz=f_stop,
-            fade_in_s=2.0,
-        )
-        for axis, start, amplitude, length, f_stop in _SWEEPS
-    )
     return Trial(
         duration_s=DURATION_S,
-        maneuvers=sweeps,
+        maneuvers=_sweeps(_SWEEPS, s),
         environment=environment,
         seed=seed,
         hover_height_m=3.0,
@@ -177,6 +172,53 @@ def mission(
         legs=Legs(tuple(t * s for t, _, _ in _LEGS), tuple(n for _, n, _ in _LEGS), tuple(e for _, _, e in _LEGS)),
         battery_used_ah=battery_used_ah,
     )
+
+
+def _sweeps(plan: Sequence[tuple[Axis, float, float, float, float]], stretch: float = 1.0) -> tuple[Maneuver, ...]:
+    """Log chirps from 0.3 Hz with a 2 s fade-in: (axis, start s, amplitude %, length s, top frequency Hz)."""
+    return tuple(
+        Maneuver(
+            axis=axis,
+            kind="sweep",
+            start_s=start * stretch,
+            amplitude=amplitude,
+            duration_s=length,
+            f_start_hz=0.3,
+            f_stop_hz=f_stop,
+            fade_in_s=2.0,
+        )
+        for axis, start, amplitude, length, f_stop in plan
+    )
+
+
+def write_sweep_flight(folder: Path, seed: int = 1, vehicle: Vehicle = OCTO_S1000) -> Path:
+    """SIM's vehicle, in SIM's air, sweeping each axis in turn at 3 m: what a model of the simulation is fitted from.
+
+    Parameters
+    ----------
+    folder : Path
+        Where to write ``sweeps-{seed}.ulg``.
+    seed : int, optional
+        Noise seed.
+    vehicle : Vehicle, optional
+        The vehicle.
+
+    Returns
+    -------
+    Path
+        The log (for ``sysid fit --model hover``).
+    """
+    trial = Trial(
+        duration_s=_MODEL_SWEEPS[-1][1] + _MODEL_SWEEPS[-1][3] + 8.0,
+        maneuvers=_sweeps(_MODEL_SWEEPS),
+        environment=Environment(**_BASE),
+        seed=seed,
+        hover_height_m=3.0,
+        heading_deg=0.0,
+        battery_used_ah=_USED * vehicle.battery.capacity_ah,
+    )
+    (flight,) = simulate_flights([trial], vehicle, method="euler")
+    return write_px4_log(flight, folder / f"sweeps-{seed}.ulg", utc_start=datetime(2024, 6, 1, 9, 0, tzinfo=UTC))
 
 
 def _height(value: float, unit: Literal["m", "Z/R"], vehicle: Vehicle) -> float:

@@ -1,11 +1,13 @@
 """Discrepancy discovery: where a real flight departs from its simulation, the physics left out, and the proof.
 
 :func:`discover` compares flights as :class:`FlightSeries` (:func:`flight_series`
-from a conditioned flight's records) and returns a :class:`DiscrepancyResult`.
+from a conditioned flight's records) and returns a :class:`DiscrepancyResult`. A fitted model
+takes the simulation's place through :func:`model_flight`.
 """
 
 from sysid.discrepancy.describe import FAR_FROM_FLOOR
-from sysid.discrepancy.responses import RATE_PAIRS, ResponseComparison, compare_responses
+from sysid.discrepancy.model_flight import model_flight, model_outputs
+from sysid.discrepancy.responses import RATE_PAIRS, ResponseComparison, compare_model_responses, compare_responses
 from sysid.discrepancy.result import DiscrepancyResult, Finding, FittedParameter, Regime
 from sysid.discrepancy.search import DiscrepancyOptions, discover
 from sysid.discrepancy.series import FlightSeries, flight_series
@@ -22,7 +24,10 @@ __all__ = [
     "RATE_PAIRS",
     "ResponseComparison",
     "Regime",
+    "compare_model_responses",
     "compare_responses",
     "discover",
     "flight_series",
+    "model_flight",
+    "model_outputs",
 ]

@@ -13,8 +13,9 @@ from sysid.discrepancy.terms import Candidate
 __all__ = ["FAR_FROM_FLOOR", "parameters_of", "describe_finding", "summary_of"]
 
 #: Residual over the noise floor, with the findings modelled, above which the summary warns that the
-#: simulation is no close model of the real vehicle (synthetic pairs of one vehicle end at 1-3).
-FAR_FROM_FLOOR = 10.0
+#: simulation is no close model of the real vehicle (synthetic pairs of one vehicle end at 1-3, against a log
+#: of the simulation or a model fitted from one; a model fitted badly, at 4-7).
+FAR_FROM_FLOOR = 4.0
 _GROUND_EFFECT_END = 0.01  # the ground effect "ends" where the thrust gain falls below 1 %
 
 #: Unit of each coefficient name.

@@ -28,7 +28,7 @@ from flightlogs.errors import DataError
 from flightlogs.frames import earth_to_body, wind_to_body_axes
 from flightlogs.record import Record
 
-__all__ = ["OUTPUTS", "COMMANDS", "FlightSeries", "flight_series"]
+__all__ = ["OUTPUTS", "COMMANDS", "FlightSeries", "flight_series", "smoothed_as_derivative"]
 
 #: Outputs the terms act on: specific forces (m/s²) and angular accelerations (rad/s²).
 OUTPUTS: tuple[str, ...] = ("ax", "ay", "az", "p_dot", "q_dot", "r_dot")
@@ -158,6 +158,31 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
     if not all(np.all(np.isfinite(series[w])) for w in _WIND if w in series):
         return series.without(_WIND)  # a wind with holes is no regressor
     return series
+
+
+def smoothed_as_derivative(series: FlightSeries, x: np.ndarray) -> np.ndarray:
+    """An angular acceleration smoothed as :func:`flight_series` smooths the logged ones, shape (n,).
+
+    The slope of a quadratic fitted over a window is the rate's change across it weighted by a
+    parabola: the same as the acceleration averaged with a parabolic kernel over the window. An
+    acceleration known sample by sample (a model's) is made comparable to the logged ones by it.
+
+    Parameters
+    ----------
+    series : FlightSeries
+        Its sample rate and pieces (no kernel reaches across a gap).
+    x : ndarray, shape (n,)
+        Angular acceleration at the series' samples, rad/s².
+    """
+    half = _SMOOTH_S / 2.0
+    reach = int(half * series.rate_hz)
+    offsets = np.arange(-reach, reach + 1) / series.rate_hz
+    kernel = half**2 - offsets**2
+    kernel /= kernel.sum()
+    out = np.empty_like(x, dtype=float)
+    for rows in series.pieces():
+        out[rows] = np.convolve(np.pad(x[rows], reach, mode="edge"), kernel, mode="valid")
+    return out
 
 
 def _ground_relative(signals: dict[str, np.ndarray]) -> None:

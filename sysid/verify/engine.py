@@ -4,7 +4,7 @@ Per record:
 
 1. the model is discretised exactly (zero-order hold) at the record's rate,
    each input delay split into whole samples and a fraction handled by the
-   modified z-transform (:mod:`sysid.verify._discrete`);
+   modified z-transform (:mod:`sysid.model.discrete`);
 2. the initial state is taken from the record: a state whose name is a
    record column starts at that column's value at the first sample (a line
    fitted over the first `initial_window_s`, so sensor noise is averaged);
@@ -49,9 +49,9 @@ import numpy as np
 from flightlogs.errors import DataError
 from flightlogs.record import Record
 from sysid.model.axes import reachable
+from sysid.model.discrete import DiscreteModel, delayed_inputs, discretize, predict_one_step, simulate
 from sysid.model.modes import state_modes
 from sysid.model.statespace import DelayedStateSpace
-from sysid.verify._discrete import DiscreteModel, delayed_inputs, discretize, predict_one_step, simulate
 from sysid.verify.results import (
     OutputSummary,
     OutputVerification,

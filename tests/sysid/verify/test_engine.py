@@ -26,6 +26,7 @@ from flightlogs.record import Record
 from simulator.autopilot.excitation import Maneuver
 from simulator.flights.linear import SimulatedFlight, WindField, simulate_hover
 from simulator.vehicle.identified import CALM_HOVER, STRONG_WIND_TERMS
+from sysid.model.discrete import discretize, simulate
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify import (
     RecordVerification,
@@ -37,7 +38,6 @@ from sysid.verify import (
     verify,
     verify_record,
 )
-from sysid.verify._discrete import discretize, simulate
 
 G = 9.81
 UNITS = {

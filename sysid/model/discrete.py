@@ -21,6 +21,16 @@ from scipy import linalg
 
 from sysid.model.statespace import DelayedStateSpace
 
+__all__ = [
+    "DiscreteModel",
+    "discretize",
+    "shifted",
+    "delayed_inputs",
+    "output_feedthrough",
+    "simulate",
+    "predict_one_step",
+]
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class DiscreteModel:
@@ -64,7 +74,19 @@ def _phi_gamma(a: np.ndarray, b: np.ndarray, h: float) -> tuple[np.ndarray, np.n
 
 
 def discretize(model: DelayedStateSpace, dt_s: float) -> DiscreteModel:
-    """Discretise `model` at `dt_s` with its delays as whole plus fractional samples."""
+    """Discretise `model` at `dt_s` with its delays as whole plus fractional samples.
+
+    Parameters
+    ----------
+    model : DelayedStateSpace
+        The continuous model.
+    dt_s : float
+        Sample interval, s.
+
+    Returns
+    -------
+    DiscreteModel
+    """
     a, b = np.asarray(model.a, dtype=float), np.asarray(model.b, dtype=float)
     samples = np.asarray(model.input_delays_s, dtype=float) / dt_s
     whole = np.floor(samples + 1e-9).astype(int)
@@ -105,12 +127,28 @@ def shifted(inputs: np.ndarray, lag: np.ndarray) -> np.ndarray:
 
 
 def delayed_inputs(model: DiscreteModel, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``u[k - m]`` and ``u[k - m - 1]`` for every input, each shape (n_samples, n_inputs)."""
+    """``u[k - m]`` and ``u[k - m - 1]`` for every input, each shape (n_samples, n_inputs).
+
+    Parameters
+    ----------
+    model : DiscreteModel
+        Its whole-sample delays.
+    inputs : ndarray, shape (n_samples, n_inputs)
+        Inputs at the sample times.
+    """
     return shifted(inputs, model.whole), shifted(inputs, model.whole + 1)
 
 
 def output_feedthrough(model: DiscreteModel, now: np.ndarray, prev: np.ndarray) -> np.ndarray:
-    """``D u(t_k - tau)``: the held value at the delayed instant, shape (n_samples, n_outputs)."""
+    """``D u(t_k - tau)``: the held value at the delayed instant, shape (n_samples, n_outputs).
+
+    Parameters
+    ----------
+    model : DiscreteModel
+        Its feedthrough and fractional delays.
+    now, prev : ndarray, shape (n_samples, n_inputs)
+        ``u[k - m]`` and ``u[k - m - 1]`` (:func:`delayed_inputs`).
+    """
     held = np.where(model.fraction[None, :] > 0, prev, now)
     return cast(np.ndarray, held @ model.d.T)
 

@@ -1,0 +1,172 @@
+"""A fitted model in the simulation's place: each real flight as the model would have flown it.
+
+``sysid discrepancy model.json REAL`` compares REAL with a model from ``sysid fit -o`` rather than
+with a simulated log. The model is evaluated along each real flight by equation error: the states
+the log measures (``u v w p q r phi theta``) and the mixer inputs, delayed as the model delays them,
+give the angular accelerations (the rows ``A x + B u(t - tau)`` of ``p q r``, smoothed as the logged
+ones are: :func:`~sysid.discrepancy.series.smoothed_as_derivative`) and the specific forces
+(``C x + D u(t - tau)`` of ``ax ay az``); the states no log measures (the actuators' lag) are the
+model's own, simulated from the inputs one step at a time, from rest. The logged inputs are
+samples of a signal that moves between them, so they are read between samples by linear
+interpolation (a held sample would add half a sample of delay: 10 ms at 50 Hz). The model is linear about
+the trim it was fitted at (its inputs, states and specific forces, as in the model file): a real
+flight trimmed elsewhere (a heavier vehicle, an offset centre of gravity) departs from it. Where
+the model has no trim of a signal, the flight's median stands in.
+
+To that the noise REAL leaves is added: the residual of the best linear model of REAL itself
+(:func:`~sysid.discrepancy.baseline.fit_baseline`), moved by half of each piece in time so that it
+follows no regime of the flight. The result is a simulated flight: the search then runs as on a
+log, its noise floor and null scores those of noise of REAL's size.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from flightlogs.errors import ModelError
+from sysid.discrepancy.baseline import fit_baseline
+from sysid.discrepancy.series import OUTPUTS, FlightSeries, smoothed_as_derivative
+from sysid.model.discrete import discretize, predict_one_step
+from sysid.model.statespace import DelayedStateSpace
+
+__all__ = ["model_outputs", "model_flight"]
+
+_RATES = {"p_dot": "p", "q_dot": "q", "r_dot": "r"}  # an angular acceleration is its rate's row of A x + B u
+_FORCES = ("ax", "ay", "az")
+
+
+def model_outputs(model: DelayedStateSpace, flight: FlightSeries, *, source: str = "model") -> dict[str, np.ndarray]:
+    """The six outputs the model gives along `flight`, perturbations from its trim, each shape (n,).
+
+    Parameters
+    ----------
+    model : DelayedStateSpace
+        The model (states, inputs and outputs by canonical name; ``ax ay az`` among the outputs).
+    flight : FlightSeries
+        A flight that logs every input of the model.
+    source : str, optional
+        The model's name, for messages.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``ax ay az`` (m/s²) and ``p_dot q_dot r_dot`` (rad/s²), each shape (n,), perturbations from the
+        model's trim.
+
+    Raises
+    ------
+    ModelError
+        If the model lacks a rate or specific force, or has an input the flight did not log.
+    """
+    lacking = [s for s in _RATES.values() if s not in model.states] + [o for o in _FORCES if o not in model.outputs]
+    if lacking:
+        raise ModelError(
+            f"{source}: no {', '.join(lacking)} in the model (an unidentified axis?); "
+            "the discrepancy search compares all three rates and specific forces"
+        )
+    unlogged = [i for i in model.inputs if i not in flight]
+    if unlogged:
+        raise ModelError(f"{source}: input {', '.join(unlogged)} is not logged by {flight.name}")
+    a, b, c, d = (np.asarray(m, dtype=float) for m in (model.a, model.b, model.c, model.d))
+    rows = np.vstack(
+        [a[[model.states.index(s) for s in _RATES.values()]], c[[model.outputs.index(o) for o in _FORCES]]]
+    )
+    through = np.vstack(
+        [b[[model.states.index(s) for s in _RATES.values()]], d[[model.outputs.index(o) for o in _FORCES]]]
+    )
+    n_x = len(model.states)
+    own = DelayedStateSpace(  # the states themselves as outputs; the delays are applied to the inputs here
+        a=a,
+        b=b,
+        c=np.eye(n_x),
+        d=np.zeros((n_x, len(model.inputs))),
+        states=model.states,
+        inputs=model.inputs,
+        outputs=model.states,
+        input_delays_s=np.zeros(len(model.inputs)),
+    )
+    step_s = 1.0 / flight.rate_hz
+    discrete = discretize(own, step_s)
+    inputs = _about_trim(flight, model.inputs, model.trim)
+    measured = _about_trim(flight, model.states, model.trim)
+    delays = np.asarray(model.input_delays_s, dtype=float)
+    out = np.empty((flight.n, rows.shape[0]))
+    for piece in flight.pieces():
+        t, x = flight.time_s[piece], measured[piece]
+        delayed = _shifted(t, inputs[piece], delays)  # u(t_k - tau)
+        midway = _shifted(t, inputs[piece], delays - step_s / 2.0)  # across each step: its middle, not its start
+        states = predict_one_step(discrete, midway, x, _at_rest(a, b, x[0], delayed[0]))
+        out[piece] = np.where(np.isfinite(x), x, states) @ rows.T + delayed @ through.T
+    named = {o: out[:, k] for k, o in enumerate((*_RATES, *_FORCES))}
+    return named | {o: smoothed_as_derivative(flight, named[o]) for o in _RATES}
+
+
+def model_flight(model: DelayedStateSpace, flight: FlightSeries, *, source: str = "model") -> FlightSeries:
+    """`flight` with its six outputs the model's, plus noise of REAL's size: a simulated flight.
+
+    Parameters
+    ----------
+    model : DelayedStateSpace
+        The model (see :func:`model_outputs`).
+    flight : FlightSeries
+        A real flight.
+    source : str, optional
+        The model's name, for messages and the flight's name.
+
+    Returns
+    -------
+    FlightSeries
+        The same samples and signals; ``ax ay az p_dot q_dot r_dot`` replaced.
+
+    Raises
+    ------
+    ModelError
+        As :func:`model_outputs`.
+    """
+    outputs = model_outputs(model, flight, source=source)
+    own = fit_baseline(flight).predict(flight)  # the best linear model of REAL: its residual is REAL's noise
+    signals = dict(flight.signals)
+    for o in OUTPUTS:
+        noise = flight[o] - own[o]
+        for piece in flight.pieces():
+            noise[piece] = np.roll(noise[piece], piece.size // 2)
+        level = _trim(flight, o, model.trim) if o in _FORCES else 0.0  # an angular acceleration's trim is 0
+        signals[o] = level + outputs[o] + noise
+    return FlightSeries(
+        name=f"{source} on {flight.name}",
+        time_s=flight.time_s,
+        piece=flight.piece,
+        signals=signals,
+        rate_hz=flight.rate_hz,
+    )
+
+
+def _shifted(t: np.ndarray, columns: np.ndarray, delays_s: np.ndarray) -> np.ndarray:
+    """Column j at ``t - delays_s[j]``, linear between samples, the end values held beyond; shape of `columns`."""
+    return np.column_stack([np.interp(t - d, t, c) for c, d in zip(columns.T, delays_s)])
+
+
+def _at_rest(a: np.ndarray, b: np.ndarray, measured: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+    """The state at the first sample: the measured part as measured, the rest at rest with it and the inputs."""
+    x: np.ndarray = np.nan_to_num(measured)
+    free = ~np.isfinite(measured)
+    if np.any(free):  # A_ff x_f + A_fm x_m + B_f u = 0
+        rest = a[np.ix_(free, ~free)] @ x[~free] + b[free] @ inputs
+        x[free] = np.linalg.lstsq(a[np.ix_(free, free)], -rest, rcond=None)[0]
+    return x
+
+
+def _about_trim(flight: FlightSeries, names: tuple[str, ...], trim: Mapping[str, float]) -> np.ndarray:
+    """Columns of `names` less the model's trim (the flight's median where it has none), shape (n, len(names)).
+
+    NaN where the flight has no such signal.
+    """
+    columns = [flight[s] - _trim(flight, s, trim) if s in flight else np.full(flight.n, np.nan) for s in names]
+    return np.column_stack(columns)
+
+
+def _trim(flight: FlightSeries, name: str, trim: Mapping[str, float]) -> float:
+    value = trim.get(name)
+    return float(np.median(flight[name])) if value is None or not np.isfinite(value) else float(value)
