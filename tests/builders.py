@@ -23,9 +23,12 @@ from typing import TypeVar
 import numpy as np
 import pandas as pd
 
+from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
 from flightlogs.errors import SysidWarning
+from flightlogs.readers import read_log
 from flightlogs.record import Record
 from simulator.vehicle.identified import CALM_HOVER
+from sysid.discrepancy import FlightSeries, flight_series
 from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate, Provenance, ReductionStep, synthetic_responses
 from sysid.model import parse_structure
 from sysid.model.discrete import discretize, simulate
@@ -321,3 +324,9 @@ def with_unidentified(
         for a in changed.axis_status
     )
     return dataclasses.replace(changed, axes=axes)
+
+
+def discrepancy_series(path: Path) -> FlightSeries:
+    """A log's flown samples as the discrepancy search reads them (no maneuver detection: it needs none)."""
+    flight = condition_flight(read_log(path), options=ConditioningOptions(segments=()))
+    return flight_series(path.name, flight.records)

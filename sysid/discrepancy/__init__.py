@@ -6,7 +6,7 @@ takes the simulation's place through :func:`model_flight`.
 """
 
 from sysid.discrepancy.describe import FAR_FROM_FLOOR
-from sysid.discrepancy.model_flight import model_flight, model_outputs
+from sysid.discrepancy.fitted_model import model_flight, model_outputs
 from sysid.discrepancy.responses import RATE_PAIRS, ResponseComparison, compare_model_responses, compare_responses
 from sysid.discrepancy.result import DiscrepancyResult, Finding, FittedParameter, Regime
 from sysid.discrepancy.search import DiscrepancyOptions, discover

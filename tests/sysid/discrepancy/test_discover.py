@@ -20,15 +20,17 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
+from flightlogs.conditioning.condition import condition_flight
 from flightlogs.readers import read_log
 from simulator.campaign.discrepancy_pairs import VEHICLES, mission, write_pairs, write_sweep_flight
 from simulator.vehicle.linearize import hover_derivatives, linearize_hover
 from simulator.vehicle.multirotor import Vehicle
 from simulator.world.environment import Environment
-from sysid.discrepancy import DiscrepancyResult, compare_responses, discover, flight_series, model_flight
+from sysid.discrepancy import DiscrepancyResult, compare_responses, discover, model_flight
 from sysid.fit.model_file import read_model
 from sysid_cli.main import cli
+
+from builders import discrepancy_series
 
 # the pairs fly 17 four-minute flights: over the default 300 s when the other worker is busy too
 pytestmark = [
@@ -56,10 +58,6 @@ EFFECTS: dict[str, list[str]] = {
 CASES = [(v, e) for v, effects in EFFECTS.items() for e in effects]
 
 
-def _series(path: Path):  # type: ignore[no-untyped-def]
-    return flight_series(path.name, condition_flight(read_log(path), options=ConditioningOptions(segments=())).records)
-
-
 @pytest.fixture(scope="module", name="pairs")
 def pairs_fixture(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path, dict[str, Path]]]:
     return {
@@ -71,8 +69,8 @@ def pairs_fixture(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[P
 def results_fixture(pairs: dict[str, tuple[Path, dict[str, Path]]]) -> dict[tuple[str, str], DiscrepancyResult]:
     out = {}
     for vehicle, (sim, reals) in pairs.items():
-        simulated = _series(sim)
-        out |= {(vehicle, effect): discover([simulated], [_series(path)]) for effect, path in reals.items()}
+        simulated = discrepancy_series(sim)
+        out |= {(vehicle, effect): discover([simulated], [discrepancy_series(path)]) for effect, path in reals.items()}
     return out
 
 
@@ -109,7 +107,7 @@ def against_models_fixture(
     for kind, path in models.items():
         model = read_model(path).linear_model(include_wind=False)
         for effect in MODEL_CASES:
-            real = _series(reals[effect])
+            real = discrepancy_series(reals[effect])
             out[kind, effect] = discover([model_flight(model, real, source=path.name)], [real])
     return out
 

@@ -11,17 +11,13 @@ damping X_u and Y_v). The search's thresholds and terms were set on our simulato
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 from independent_sim.corpus import write_case
-from independent_sim.maneuvers import Chirp, Maneuver
-from independent_sim.plant import hover_plant
-from independent_sim.scenario import Case, FlightPlan, Reposition
+from independent_sim.pairs import PLANT, Changes, delayed, pair_case, scaled
 
-from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
-from flightlogs.readers import read_log
-from sysid.discrepancy import DiscrepancyResult, discover, flight_series
+from sysid.discrepancy import DiscrepancyResult, discover
+
+from builders import discrepancy_series
 
 pytestmark = [
     pytest.mark.slow,
@@ -29,49 +25,24 @@ pytestmark = [
     pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning"),
 ]
 
-_PLANT = hover_plant("calm")
-_AXES = ("lat", "lon", "yaw", "thr")
-
-
-def _delayed(extra_s: float) -> tuple[tuple[str, float], ...]:
-    return tuple((f"tau_{a}", getattr(_PLANT, f"tau_{a}") + extra_s) for a in _AXES)
-
-
 #: Pair name -> (the effect concealed, the REAL vehicle's plant changes). The 8 and 15 ms delays are
 #: those the hand-made pysindy baseline of the issue split between "delay" and "lag".
-PAIRS: dict[str, tuple[str, tuple[tuple[str, float], ...]]] = {
+PAIRS: dict[str, tuple[str, Changes]] = {
     "none": ("none", ()),
-    "time_delay": ("time_delay", _delayed(0.030)),
-    "time_delay_15ms": ("time_delay", _delayed(0.015)),
-    "time_delay_8ms": ("time_delay", _delayed(0.008)),
-    "actuator_lag": ("actuator_lag", (("T_a", 1.6 * _PLANT.T_a),)),
-    "rotor_drag": ("rotor_drag", (("X_u", 2.0 * _PLANT.X_u), ("Y_v", 2.0 * _PLANT.Y_v))),
+    "time_delay": ("time_delay", delayed(0.030)),
+    "time_delay_15ms": ("time_delay", delayed(0.015)),
+    "time_delay_8ms": ("time_delay", delayed(0.008)),
+    "actuator_lag": ("actuator_lag", scaled(1.6, "T_a")),
+    "rotor_drag": ("rotor_drag", scaled(2.0, "X_u", "Y_v")),
 }
-
-
-def _case(name: str, seed: int, changes: tuple[tuple[str, float], ...]) -> Case:
-    sweep = Chirp(duration_s=40.0, f_min_hz=0.1, f_max_hz=6.0)
-    maneuvers = tuple(
-        Maneuver(axis=axis, design=sweep, start_s=start, amplitude=amplitude)  # type: ignore[arg-type]
-        for axis, start, amplitude in (("lon", 10.0, 0.06), ("lat", 56.0, 0.07), ("yaw", 102.0, 0.08))
-    )
-    plan = FlightPlan(
-        duration_s=200.0,
-        repositions=(Reposition(start_s=150.0, north_m=15.0), Reposition(start_s=170.0, north_m=-15.0)),
-    )
-    return Case(name=name, fmt="ulog", plan=plan, maneuvers=maneuvers, seed=seed, plant_changes=changes)
-
-
-def _series(path: Path):  # type: ignore[no-untyped-def]
-    return flight_series(path.name, condition_flight(read_log(path), options=ConditioningOptions(segments=())).records)
 
 
 @pytest.fixture(scope="module", name="results")
 def results_fixture(tmp_path_factory: pytest.TempPathFactory) -> dict[str, DiscrepancyResult]:
     folder = tmp_path_factory.mktemp("independent-pairs")
-    sim = _series(write_case(_case("sim", 501, ()), folder).log)
+    sim = discrepancy_series(write_case(pair_case("sim", 501, ()), folder).log)
     return {
-        name: discover([sim], [_series(write_case(_case(f"real-{k}", 601 + k, changes), folder).log)])
+        name: discover([sim], [discrepancy_series(write_case(pair_case(f"real-{k}", 601 + k, changes), folder).log)])
         for k, (name, (_, changes)) in enumerate(PAIRS.items())
     }
 
@@ -107,9 +78,9 @@ def test_the_delay_is_measured_on_another_generators_logs(
 def test_the_extra_drag_is_the_one_added(results: dict[str, DiscrepancyResult]) -> None:
     """X_u and Y_v doubled: the term's coefficient is the added -X_u / g (its sigma is optimistic: 5 % allowed)."""
     value, _ = _value(results["rotor_drag"], "drag_x")
-    assert value == pytest.approx(-_PLANT.X_u / 9.81, rel=0.05)
+    assert value == pytest.approx(-PLANT.X_u / 9.81, rel=0.05)
 
 
 def test_the_lag_lies_between_the_added_and_the_whole_actuator_lag(results: dict[str, DiscrepancyResult]) -> None:
     value, _ = _value(results["actuator_lag"], "time_constant_s")
-    assert 0.6 * _PLANT.T_a <= value <= 1.6 * _PLANT.T_a
+    assert 0.6 * PLANT.T_a <= value <= 1.6 * PLANT.T_a

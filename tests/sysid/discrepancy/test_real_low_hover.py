@@ -16,16 +16,14 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
+from flightlogs.conditioning.condition import condition_flight
 from flightlogs.readers import read_log
 from sysid.discrepancy import FAR_FROM_FLOOR, discover, flight_series
 from sysid_cli.main import cli
 
+from builders import discrepancy_series
+
 pytestmark = [pytest.mark.slow, pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning")]
-
-
-def _series(path: Path):  # type: ignore[no-untyped-def]
-    return flight_series(path.name, condition_flight(read_log(path), options=ConditioningOptions(segments=())).records)
 
 
 def test_the_take_off_ramp_on_the_ground_is_not_flight(real_data: Path) -> None:
@@ -44,7 +42,7 @@ def test_a_simulation_of_another_airframe_is_flagged_not_trusted(real_data: Path
     result = CliRunner().invoke(cli, ["simulate", "low-hover-quad", "-o", str(tmp_path), "-q"])
     assert result.exit_code == 0, result.output
     (sim,) = tmp_path.glob("*.ulg")
-    found = discover([_series(sim)], [_series(real_data / "px4-ulog-rs/quadrotor_local.ulg")])
+    found = discover([discrepancy_series(sim)], [discrepancy_series(real_data / "px4-ulog-rs/quadrotor_local.ulg")])
     assert max(found.unexplained.values()) > FAR_FROM_FLOOR
     assert "Caution" in found.summary and "not a close model of this vehicle" in found.summary
     assert found.to_dict()["unexplained"] == found.unexplained
