@@ -9,7 +9,8 @@
    term of the library (:mod:`.terms`) is fitted on five of six time blocks
    of REAL and scored on the sixth, in turn (:mod:`.selection`). A term
    passes if its held-out score beats a floor and three times its null
-   score; of those that pass, the one that lowers the Bayesian information
+   score, and if 80 % of what it changes lies in at least 2 s of flight
+   (a touchdown's spike is no physics); of those that pass, the one that lowers the Bayesian information
    criterion most (effective samples, the parameter inside its shape
    counted) is kept; its contribution joins the model and the others are
    screened again (forward selection), until none passes. A delay and a lag compete:
@@ -55,6 +56,9 @@ _REGIMES = (
     ("battery_v", "V"),
     ("t_flight", "s"),
 )
+
+_SUPPORT_SHARE = 0.8  # a term's support: the samples that hold this share of its contribution ...
+_MIN_SUPPORT_S = 2.0  # ... must span this much flight (a touchdown's spike: 0.3 s; a 15 m reposition's drag: 5 s)
 
 Progress = Callable[[str, int, int], None]
 
@@ -136,7 +140,10 @@ def discover(
                 fit = fit_term(trial, y, base, adds, scale)
                 if candidate.kind == "transform" and fit.value >= candidate.grid[-1]:
                     continue  # at the end of the range searched: a bound, not a measured delay or lag
-                change = _bic_change(fit, y, fit.prediction(base, adds), current, len(candidate.coefficients))
+                prediction = fit.prediction(base, adds)
+                if _support_s(prediction, current, scale, flown.rate_hz) < _MIN_SUPPORT_S:
+                    continue  # a few seconds of flight (a touchdown, a spike) are no physical effect
+                change = _bic_change(fit, y, prediction, current, len(candidate.coefficients))
                 scores.append((change, score, fit, predicted, candidate, adds))
         _report(progress, "screening terms", len(kept) + 1, options.max_findings + 1)
         if not scores:
@@ -214,6 +221,18 @@ def _bic_change(
         samples += n_effective
     k = n_coefficients + (1 if fit.candidate.grid_parameter else 0)
     return change + k * float(np.log(max(samples, 2.0)))
+
+
+def _support_s(
+    prediction: Mapping[str, np.ndarray], current: Mapping[str, np.ndarray], scale: Mapping[str, float], rate_hz: float
+) -> float:
+    """Seconds of flight holding 80 % of a term's weighted contribution (its change to the prediction)."""
+    energy = sum(((prediction[o] - current[o]) ** 2 / scale[o] for o in OUTPUTS), np.zeros(len(current[OUTPUTS[0]])))
+    ranked = np.sort(energy)[::-1]
+    total = float(ranked.sum())
+    if total <= 0.0:
+        return 0.0
+    return float(np.searchsorted(np.cumsum(ranked), _SUPPORT_SHARE * total) + 1) / rate_hz
 
 
 def _noise_floor(sim: FlightSeries) -> tuple[dict[str, float], dict[str, float]]:
