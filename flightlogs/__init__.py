@@ -14,7 +14,7 @@ read_log``): :mod:`flightlogs.readers`, :mod:`flightlogs.writers`,
 """
 
 import importlib as _importlib
-from types import ModuleType as _ModuleType
+from typing import TYPE_CHECKING as _TYPE_CHECKING
 
 from flightlogs.errors import (
     CollectedWarnings,
@@ -30,9 +30,6 @@ from flightlogs.errors import (
     SysidWarning,
     collected_warnings,
 )
-from flightlogs.flightlog import Autopilot, FlightLog, LogFormat, Signal, SystemIdRun
-from flightlogs.frames import air_velocity_body, earth_to_body, quaternion_to_euler, wind_to_body_axes
-from flightlogs.record import Record
 from flightlogs.signals import (
     CANONICAL_SIGNALS,
     ESTIMATOR_SIGNALS,
@@ -42,7 +39,25 @@ from flightlogs.signals import (
     is_canonical,
 )
 
+if _TYPE_CHECKING:
+    from flightlogs.flightlog import Autopilot, FlightLog, LogFormat, Signal, SystemIdRun
+    from flightlogs.frames import air_velocity_body, earth_to_body, quaternion_to_euler, wind_to_body_axes
+    from flightlogs.record import Record
+
 _SUBPACKAGES = ("conditioning", "maneuvers", "readers", "store", "writers")
+#: Core names that load their module (numpy, pandas) on first use: ``import flightlogs.errors`` stays light.
+_LAZY = {
+    "Signal": "flightlog",
+    "SystemIdRun": "flightlog",
+    "FlightLog": "flightlog",
+    "Autopilot": "flightlog",
+    "LogFormat": "flightlog",
+    "Record": "record",
+    "quaternion_to_euler": "frames",
+    "earth_to_body": "frames",
+    "air_velocity_body": "frames",
+    "wind_to_body_axes": "frames",
+}
 __all__ = [
     "SysidError",
     "LogFormatError",
@@ -76,11 +91,13 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> _ModuleType:
+def __getattr__(name: str) -> object:
     if name in _SUBPACKAGES:  # scipy's pattern: subpackages load on first use, not with the package
         return _importlib.import_module(f"{__name__}.{name}")
+    if name in _LAZY:
+        return getattr(_importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_SUBPACKAGES))
+    return sorted(set(globals()) | set(_SUBPACKAGES) | set(_LAZY))

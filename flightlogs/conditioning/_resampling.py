@@ -10,7 +10,6 @@ from typing import cast
 
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
-from scipy.signal import fftconvolve, firwin, kaiserord
 
 from flightlogs.errors import DataError
 
@@ -70,6 +69,8 @@ def lowpass(t: np.ndarray, v: np.ndarray, dt_src: float, target_rate_hz: float) 
         grid, values = t, v
     else:
         values = interpolate(t, v, grid, "spline")
+    from scipy.signal import fftconvolve  # here, not at import: scipy.signal takes longer to load than a log to read
+
     fs = (n_fine - 1) / (grid[-1] - grid[0])
     taps = _kaiser_lowpass(fs, target_rate_hz)
     half = taps.size // 2
@@ -79,6 +80,8 @@ def lowpass(t: np.ndarray, v: np.ndarray, dt_src: float, target_rate_hz: float) 
 
 def _kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
     """Odd-length, unit-DC-gain Kaiser FIR: pass to 0.4, stop from 0.6 × the target rate."""
+    from scipy.signal import firwin, kaiserord
+
     nyquist = fs_hz / 2.0
     width = (_STOP_EDGE - _PASS_EDGE) * target_rate_hz / nyquist
     numtaps, beta = kaiserord(_STOPBAND_DB, min(width, 1.0))

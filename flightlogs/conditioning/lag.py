@@ -6,7 +6,6 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy import signal as sps
 
 from flightlogs.errors import DataError
 
@@ -87,6 +86,8 @@ def estimate_lag(
     max_lag = int(round(max_lag_s * rate_hz))
     if reference.size < 2 * max_lag + 8:
         raise DataError(f"{reference.size} samples are too few to search lags of ±{max_lag_s:g} s at {rate_hz:g} Hz")
+    from scipy import signal as sps  # here, not at import: scipy.signal takes longer to load than a log to read
+
     a, b = (np.diff(reference), np.diff(delayed)) if prewhiten else (reference, delayed)
     a = sps.detrend(a)
     b = sps.detrend(b)

@@ -16,8 +16,8 @@ from typing import Literal, NamedTuple, cast
 import numpy as np
 from scipy.fft import irfft, next_fast_len, rfft
 from scipy.ndimage import binary_dilation, median_filter, uniform_filter1d
-from scipy.stats import spearmanr
 
+from flightlogs.maneuvers._rank import spearman
 from flightlogs.masks import true_runs
 
 __all__: list[str] = []
@@ -432,7 +432,7 @@ def _oscillation(lobes: list[_Lobe]) -> _Shape:
     mid = np.array([0.5 * (lobe.begin_s + lobe.end_s) for lobe in lobes[:-1]])
     smooth = np.array([np.median(freq[max(0, i - 1) : i + 2]) for i in range(freq.size)])
     f_min, f_max = float(min(freq[0], smooth.min())), float(smooth.max())
-    if (abs(spearmanr(mid, freq).statistic) > 0.6 and f_max > 2 * f_min) or f_max < 1.5 * f_min:
+    if (abs(spearman(mid, freq)) > 0.6 and f_max > 2 * f_min) or f_max < 1.5 * f_min:
         return _Shape("sweep", f_min, f_max)
     return _Shape("multisine", f_min, f_max)
 

@@ -25,9 +25,9 @@ from typing import Literal
 
 import numpy as np
 from scipy.ndimage import median_filter
-from scipy.stats import spearmanr
 
 from flightlogs.maneuvers._detection import _activity, _bursts, _edges
+from flightlogs.maneuvers._rank import spearman
 from flightlogs.maneuvers._scalogram import band_envelopes, band_frequencies
 from flightlogs.masks import true_runs
 
@@ -203,7 +203,7 @@ def _sweeping(ridge: _Ridge, a: int, b: int, frame_s: float) -> bool:
     lo_hz, hi_hz = np.exp(np.quantile(log_f, [0.1, 0.9]))
     if hi_hz < _MIN_RATIO * lo_hz:
         return False
-    return abs(float(spearmanr(np.arange(a, b), log_f).statistic)) >= _MIN_RHO
+    return abs(spearman(np.arange(a, b), log_f)) >= _MIN_RHO
 
 
 def _runs(pieces: list[tuple[int, int]], frame_s: float) -> list[list[tuple[int, int]]]:
@@ -275,7 +275,7 @@ def _periodic(ridge: _Ridge, swept: list[tuple[int, int]], frame_s: float) -> bo
 
 def _direction(ridge: _Ridge, a: int, b: int) -> int:
     """+1 where the ridge frequency rises over frames [a, b), -1 where it falls."""
-    return 1 if spearmanr(np.arange(a, b), np.log(ridge.freq_hz[a:b])).statistic > 0 else -1
+    return 1 if spearman(np.arange(a, b), np.log(ridge.freq_hz[a:b])) > 0 else -1
 
 
 def _found(
@@ -289,7 +289,7 @@ def _found(
 ) -> FoundSweep:
     a, b = chain[0][0], chain[-1][1]
     frames = np.concatenate([np.arange(lo, hi) for lo, hi in chain])
-    rho = float(spearmanr(frames, np.log(ridge.freq_hz[frames])).statistic)
+    rho = spearman(frames, np.log(ridge.freq_hz[frames]))
     n = next(iter(named.values())).size
     first, last = _time_edges(named, a * step, min((b - 1) * step, n - 1), dt)
     counts = np.bincount(ridge.trace[frames], minlength=len(ridge.names))

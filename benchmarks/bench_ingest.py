@@ -1,0 +1,102 @@
+"""Benchmark: ``sysid ingest`` as a whole process against pymavlink and pyulog reading the same files.
+
+Usage::
+
+    python benchmarks/bench_ingest.py [FILE ...] [--seconds 1000] [--repeat 3]
+
+Without files it writes a synthetic ArduCopter System ID log of about 113 MB (``--seconds`` of
+flight at 400 Hz, :func:`bench_dataflash.synthetic_log`) into a temporary folder and takes the real
+ULogs of ``../shared/data/real``. For each file:
+
+* ``baseline``: DataFlash, pymavlink's ``DFReader_binary`` walk reading every field of every
+  message (in this process, once; its values are compared with ours field by field, bitwise);
+  ULog, pyulog's own ``ULog(path)`` parse (best of ``--repeat``);
+* ``ingest``: ``sysid ingest FILE -q`` in a fresh process, start to exit (best of ``--repeat``);
+* ``ingest -o``: the same writing the HDF5 dataset;
+* the ratios of the baseline to each, and the peak resident memory of the ``-o`` process over the
+  file's size.
+
+The exit status is 1 if any DataFlash value differs from pymavlink's. Run on an idle machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from bench_dataflash import REAL, check_identical, synthetic_log
+
+from flightlogs.readers.dataflash import read_messages
+
+_SYSID = [str(Path(sys.executable).with_name("sysid"))]  # the installed command, as a user runs it
+
+
+def run_ingest(path: Path, out: Path | None) -> tuple[float, float]:
+    """Wall seconds and peak resident MB of one ``sysid ingest`` process."""
+    command = [*_SYSID, "ingest", str(path), "-q", *(["-o", str(out)] if out is not None else [])]
+    start = time.perf_counter()
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, status, usage = os.wait4(process.pid, 0)
+    seconds = time.perf_counter() - start
+    process.returncode = os.waitstatus_to_exitcode(status)
+    if process.returncode != 0:
+        raise RuntimeError(f"sysid ingest {path} exited {process.returncode}")
+    if out is not None:
+        out.unlink()
+    return seconds, usage.ru_maxrss / 1024.0
+
+
+def pyulog_seconds(path: Path, repeat: int) -> float:
+    """Best of `repeat` pyulog parses of the whole file, s."""
+    from pyulog import ULog
+
+    best = float("inf")
+    for _ in range(repeat):
+        start = time.perf_counter()
+        ULog(str(path))
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("files", nargs="*", type=Path)
+    parser.add_argument("--seconds", type=float, default=1000.0, help="length of the synthetic DataFlash log, s")
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args(argv)
+    ok = True
+    with tempfile.TemporaryDirectory() as tmp:
+        files = list(args.files)
+        if not files:
+            files = [synthetic_log(Path(tmp) / "synthetic_sysid.bin", args.seconds)]
+            files += sorted(p for p in (REAL / "px4-ulog-rs").glob("*.ulg") if "corrupt" not in p.name)
+            files += sorted((REAL / "kd0aij-impulse-response").glob("*.ulg"))
+        print(
+            f"{'file':28s} {'MB':>6s} {'baseline':>9s} {'ingest':>8s} {'ratio':>6s} {'-o':>8s} {'ratio':>6s} "
+            f"{'peak MB':>8s} {'xfile':>6s} identical"
+        )
+        for path in files:
+            size_mb = path.stat().st_size / 1e6
+            if path.suffix.lower() == ".ulg":
+                baseline, same = pyulog_seconds(path, args.repeat), "-"
+            else:
+                equal, baseline, _ = check_identical(path, read_messages(path))
+                ok &= equal
+                same = "yes" if equal else "NO"
+            plain = min(run_ingest(path, None)[0] for _ in range(args.repeat))
+            written = [run_ingest(path, Path(tmp) / "out.h5") for _ in range(args.repeat)]
+            seconds, peak = min(s for s, _ in written), max(m for _, m in written)
+            print(
+                f"{path.name[:28]:28s} {size_mb:6.1f} {baseline:8.3f}s {plain:7.3f}s {baseline / plain:5.1f}x "
+                f"{seconds:7.3f}s {baseline / seconds:5.1f}x {peak:8.0f} {peak / size_mb:5.1f}x {same}"
+            )
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
