@@ -62,7 +62,7 @@ def piece_bounds(t: np.ndarray, dt: float, max_gap_samples: float) -> list[tuple
 
 
 def lowpass(t: np.ndarray, v: np.ndarray, dt_src: float, target_rate_hz: float) -> tuple[np.ndarray, np.ndarray]:
-    """Anti-alias one contiguous piece: uniform grid at the source rate, then a zero-phase FIR."""
+    """Anti-alias one contiguous piece (`v` shape (n,) or (n, k)): uniform grid at the source rate, then a zero-phase FIR."""
     n_fine = max(int(round((t[-1] - t[0]) / dt_src)) + 1, 2)
     grid = np.linspace(t[0], t[-1], n_fine)
     if grid.size == t.size and np.allclose(grid, t, rtol=0.0, atol=TIME_TOL_S):
@@ -74,8 +74,10 @@ def lowpass(t: np.ndarray, v: np.ndarray, dt_src: float, target_rate_hz: float) 
     fs = (n_fine - 1) / (grid[-1] - grid[0])
     taps = _kaiser_lowpass(fs, target_rate_hz)
     half = taps.size // 2
-    padded = np.pad(values, half, mode="reflect", reflect_type="odd")
-    return grid, fftconvolve(padded, taps, mode="valid")
+    pad = [(half, half)] + [(0, 0)] * (values.ndim - 1)
+    padded = np.pad(values, pad, mode="reflect", reflect_type="odd")
+    kernel = taps.reshape((-1,) + (1,) * (values.ndim - 1))
+    return grid, fftconvolve(padded, kernel, mode="valid", axes=0)
 
 
 def _kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
@@ -91,9 +93,11 @@ def _kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
 
 
 def interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: str) -> np.ndarray:
-    """Evaluate the chosen interpolant through (t, v) at times `at` inside [t[0], t[-1]]."""
+    """Evaluate the chosen interpolant through (t, v) at times `at` inside [t[0], t[-1]]; `v` (n,) or (n, k)."""
     if method == "linear" or t.size < 3:
-        return cast(np.ndarray, np.interp(at, t, v))
+        if v.ndim == 1:
+            return cast(np.ndarray, np.interp(at, t, v))
+        return np.column_stack([np.interp(at, t, column) for column in v.T])
     if method == "spline":
         return cast(np.ndarray, CubicSpline(t, v, bc_type="not-a-knot")(at))
     if method == "pchip":

@@ -309,13 +309,30 @@ def resample_signal(
     True
     """
     name, t, v = _as_series(signal)
-    tb, dt_target = check_time_base(time_base)
     if outside not in ("nan", "raise"):
         raise DataError(f"{outside=} must be 'nan' or 'raise'")
+    out = _resample_columns(t, v[:, None], time_base, method, max_gap_samples, anti_alias)[:, 0]
+    if outside == "raise" and np.isnan(out).any():
+        first = float(time_base[np.isnan(out)][0])
+        raise DataError(
+            f"{name}: no data to interpolate at {first:.3f} s "
+            f"(samples span {t[0]:.3f}-{t[-1]:.3f} s, gaps over {max_gap_samples} intervals excluded)"
+        )
+    return out
+
+
+def _resample_columns(
+    t: np.ndarray, v: np.ndarray, time_base: np.ndarray, method: str, max_gap_samples: float, anti_alias: bool
+) -> np.ndarray:
+    """Columns sampled at the same times `t` (s, shape (n,)), `v` shape (n, k), onto `time_base`: shape (n_base, k).
+
+    One spline (or filter) for all columns: signals of one message share their times.
+    """
+    tb, dt_target = check_time_base(time_base)
     if method not in ("spline", "pchip", "linear"):
         raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
     dt_src = nominal_interval(t)
-    out = np.full(tb.shape, np.nan)
+    out = np.full((tb.size, v.shape[1]), np.nan)
     filter_needed = anti_alias and dt_target > _DOWNSAMPLE_MARGIN * dt_src
     for i0, i1 in piece_bounds(t, dt_src, max_gap_samples):
         pt, pv = t[i0:i1], v[i0:i1]
@@ -328,12 +345,6 @@ def resample_signal(
         if filter_needed:
             pt, pv = lowpass(pt, pv, dt_src, 1.0 / dt_target)
         out[inside] = interpolate(pt, pv, np.clip(tb[inside], pt[0], pt[-1]), method)
-    if outside == "raise" and np.isnan(out).any():
-        first = float(tb[np.isnan(out)][0])
-        raise DataError(
-            f"{name}: no data to interpolate at {first:.3f} s "
-            f"(samples span {t[0]:.3f}-{t[-1]:.3f} s, gaps over {max_gap_samples} intervals excluded)"
-        )
     return out
 
 
@@ -372,13 +383,24 @@ def resample_signals(
     DataError
         If a signal or the time base is malformed.
     """
-    out = {}
-    for name, signal in signals.items():
+    groups: dict[tuple[str, int, float, float], list[tuple[np.ndarray, list[tuple[str, np.ndarray]]]]] = {}
+    for name, signal in signals.items():  # signals of one method on equal times: resampled together
         chosen = method.get(name, "spline") if isinstance(method, Mapping) else method
-        out[name] = resample_signal(
-            signal, time_base, method=chosen, max_gap_samples=max_gap_samples, anti_alias=anti_alias
-        )
-    return out
+        _, t, v = _as_series(signal, name)
+        same = groups.setdefault((chosen, t.size, float(t[0]), float(t[-1])), [])
+        for times, members in same:
+            if times is t or np.array_equal(times, t):
+                members.append((name, v))
+                break
+        else:
+            same.append((t, [(name, v)]))
+    out: dict[str, np.ndarray] = {}
+    for (kind, *_), same in groups.items():
+        for t, members in same:
+            columns = np.column_stack([v for _, v in members])
+            values = _resample_columns(t, columns, time_base, kind, max_gap_samples, anti_alias)
+            out |= {name: values[:, k] for k, (name, _) in enumerate(members)}
+    return {name: out[name] for name in signals}
 
 
 def contiguous_spans(

@@ -253,3 +253,25 @@ def test_a_cubic_is_reproduced_by_the_spline() -> None:
     cubic = lambda t: 0.3 * t**3 - 2.0 * t**2 + t - 4.0
     time_base = uniform_time_base([(t_src, t_src)], rate_hz=100.0)
     assert np.allclose(resample_signal((t_src, cubic(t_src)), time_base), cubic(time_base), rtol=1e-9, atol=1e-8)
+
+
+@pytest.mark.parametrize("method", ["spline", "pchip", "linear"])
+@pytest.mark.parametrize("rate_hz", [50.0, 400.0])  # downsampled through the anti-alias filter, and not
+def test_signals_on_shared_times_resample_as_each_alone(method: str, rate_hz: float) -> None:
+    """One spline (and one filter) for the columns of a message equals one per signal, gaps included."""
+    rng = np.random.default_rng(5)
+    t = np.cumsum(rng.uniform(0.0024, 0.0026, 4000))  # a jittery 400 Hz message
+    t[2000:] += 0.5  # a gap
+    signals = {
+        name: Signal(name=name, time_s=t, values=rng.normal(0.0, 1.0, t.size), unit="-", source=name)
+        for name in ("p", "q", "r")
+    }
+    signals["ax"] = Signal(name="ax", time_s=t.copy(), values=np.sin(t), unit="-", source="ax")  # equal times
+    signals["ay"] = Signal(name="ay", time_s=t[::2], values=np.cos(t[::2]), unit="-", source="ay")  # other times
+    base = uniform_time_base([(t, t)], rate_hz=rate_hz)
+    together = resample_signals(signals, base, method=method)  # type: ignore[arg-type]
+    assert list(together) == list(signals)
+    for name, signal in signals.items():
+        alone = resample_signal(signal, base, method=method)  # type: ignore[arg-type]
+        np.testing.assert_allclose(together[name], alone, rtol=0.0, atol=1e-12, equal_nan=True)
+        assert np.isnan(alone).any()  # the gap is left out in both
