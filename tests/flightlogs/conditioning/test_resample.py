@@ -275,3 +275,22 @@ def test_signals_on_shared_times_resample_as_each_alone(method: str, rate_hz: fl
         alone = resample_signal(signal, base, method=method)  # type: ignore[arg-type]
         np.testing.assert_allclose(together[name], alone, rtol=0.0, atol=1e-12, equal_nan=True)
         assert np.isnan(alone).any()  # the gap is left out in both
+
+
+@pytest.mark.parametrize(("fs_hz", "target_hz"), [(1000.0, 100.0), (400.0, 50.0), (250.0, 200.0), (100.0, 99.0)])
+def test_the_anti_alias_filter_is_scipys_kaiser_design_and_convolution(fs_hz: float, target_hz: float) -> None:
+    """The numpy Kaiser FIR and FFT convolution (no scipy.signal on the ingest path) equal scipy.signal's."""
+    from scipy.signal import fftconvolve, firwin, kaiserord
+
+    from flightlogs.conditioning._resampling import convolve_valid, kaiser_lowpass
+
+    nyquist = fs_hz / 2.0
+    numtaps, beta = kaiserord(60.0, min(0.2 * target_hz / nyquist, 1.0))
+    cutoff = min(0.5 * target_hz, 0.999 * nyquist)
+    expected = firwin(numtaps | 1, cutoff, window=("kaiser", beta), fs=fs_hz)
+    taps = kaiser_lowpass(fs_hz, target_hz)
+    assert taps.size == expected.size and taps.size % 2 == 1
+    np.testing.assert_allclose(taps, expected, rtol=0.0, atol=1e-14)
+    x = np.random.default_rng(1).normal(size=(3000, 3))
+    np.testing.assert_allclose(convolve_valid(x, taps), fftconvolve(x, taps[:, None], mode="valid"), atol=1e-12)
+    np.testing.assert_allclose(convolve_valid(x[:, 0], taps), fftconvolve(x[:, 0], taps, mode="valid"), atol=1e-12)
