@@ -28,7 +28,7 @@ from flightlogs.errors import SysidWarning
 from flightlogs.readers import read_log
 from flightlogs.record import Record
 from simulator.vehicle.identified import CALM_HOVER
-from sysid.discrepancy import FlightSeries, flight_series
+from sysid.discrepancy import DiscrepancyResult, FlightSeries, discover, flight_series
 from sysid.fit import CostSummary, IdentifiedModel, ParameterEstimate, Provenance, ReductionStep, synthetic_responses
 from sysid.model import parse_structure
 from sysid.model.discrete import discretize, simulate
@@ -330,3 +330,22 @@ def discrepancy_series(path: Path) -> FlightSeries:
     """A log's flown samples as the discrepancy search reads them (no maneuver detection: it needs none)."""
     flight = condition_flight(read_log(path), options=ConditioningOptions(segments=()))
     return flight_series(path.name, flight.records)
+
+
+def discover_independent_pairs(
+    folder: Path, sim_seed: int, real_seed: int, changes: Mapping[str, tuple[tuple[str, float], ...]]
+) -> dict[str, DiscrepancyResult]:
+    """The search on ``independent_sim`` pairs: one SIM flight, a REAL one per entry of `changes` (its plant changes).
+
+    REAL flight k has noise seed ``real_seed + k``; every log is a PX4 ULog written into `folder`.
+    """
+    from independent_sim.corpus import write_case
+    from independent_sim.pairs import pair_case
+
+    sim = discrepancy_series(write_case(pair_case("sim", sim_seed, ()), folder).log)
+    return {
+        name: discover(
+            [sim], [discrepancy_series(write_case(pair_case(f"real-{k}", real_seed + k, plant), folder).log)]
+        )
+        for k, (name, plant) in enumerate(changes.items())
+    }

@@ -12,12 +12,11 @@ damping X_u and Y_v). The search's thresholds and terms were set on our simulato
 from __future__ import annotations
 
 import pytest
-from independent_sim.corpus import write_case
-from independent_sim.pairs import PLANT, Changes, delayed, pair_case, scaled
+from independent_sim.pairs import PLANT, Changes, delayed, scaled
 
-from sysid.discrepancy import DiscrepancyResult, discover
+from sysid.discrepancy import DiscrepancyResult
 
-from builders import discrepancy_series
+from builders import discover_independent_pairs
 
 pytestmark = [
     pytest.mark.slow,
@@ -39,12 +38,8 @@ PAIRS: dict[str, tuple[str, Changes]] = {
 
 @pytest.fixture(scope="module", name="results")
 def results_fixture(tmp_path_factory: pytest.TempPathFactory) -> dict[str, DiscrepancyResult]:
-    folder = tmp_path_factory.mktemp("independent-pairs")
-    sim = discrepancy_series(write_case(pair_case("sim", 501, ()), folder).log)
-    return {
-        name: discover([sim], [discrepancy_series(write_case(pair_case(f"real-{k}", 601 + k, changes), folder).log)])
-        for k, (name, (_, changes)) in enumerate(PAIRS.items())
-    }
+    plants = {name: entry[1] for name, entry in PAIRS.items()}
+    return discover_independent_pairs(tmp_path_factory.mktemp("independent-pairs"), 501, 601, plants)
 
 
 @pytest.mark.parametrize("name", list(PAIRS))

@@ -11,12 +11,11 @@ asserted on 901.
 from __future__ import annotations
 
 import pytest
-from independent_sim.corpus import write_case
-from independent_sim.pairs import PLANT, Changes, delayed, pair_case, scaled
+from independent_sim.pairs import PLANT, Changes, delayed, scaled
 
-from sysid.discrepancy import DiscrepancyResult, discover
+from sysid.discrepancy import DiscrepancyResult
 
-from builders import discrepancy_series
+from builders import discover_independent_pairs
 
 pytestmark = [
     pytest.mark.slow,
@@ -36,12 +35,8 @@ PAIRS: dict[str, tuple[str, Changes, float]] = {
 
 @pytest.fixture(scope="module", name="results")
 def results_fixture(tmp_path_factory: pytest.TempPathFactory) -> dict[str, DiscrepancyResult]:
-    folder = tmp_path_factory.mktemp("independent-weak-pairs")
-    sim = discrepancy_series(write_case(pair_case("sim", 901, ()), folder).log)
-    return {
-        name: discover([sim], [discrepancy_series(write_case(pair_case(f"real-{k}", 1001 + k, changes), folder).log)])
-        for k, (name, (_, changes, _)) in enumerate(PAIRS.items())
-    }
+    plants = {name: entry[1] for name, entry in PAIRS.items()}
+    return discover_independent_pairs(tmp_path_factory.mktemp("independent-weak-pairs"), 901, 1001, plants)
 
 
 def _value(result: DiscrepancyResult, name: str) -> float:
