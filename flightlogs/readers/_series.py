@@ -35,4 +35,6 @@ def make_signal(name: str, time_s: np.ndarray, values: np.ndarray, unit: str, so
         warnings.warn(DataQualityWarning(message), stacklevel=2)
     if not keep.any():
         return None
-    return Signal(name=name, time_s=time_s[keep], values=values[keep], unit=unit, source=source)
+    if dropped:
+        time_s, values = time_s[keep], values[keep]
+    return Signal(name=name, time_s=time_s, values=values, unit=unit, source=source)  # a message's times: shared

@@ -199,6 +199,8 @@ def _flightlog(messages: DataFlashMessages) -> FlightLog:
         warnings.warn(DataQualityWarning(message), stacklevel=2)
     parameters = _parameters(messages)
     signals: dict[str, Signal] = {}
+    times: dict[int, tuple[MessageTable, np.ndarray | None]] = {}  # a table's times, shared by its signals (the
+    # table is kept with them: an id is unique only while its object lives)
 
     def add(
         name: str,
@@ -208,7 +210,9 @@ def _flightlog(messages: DataFlashMessages) -> FlightLog:
         source: str,
         convert: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> None:
-        time_s, values = table.time_s, table[column].astype(np.float64)
+        if id(table) not in times:
+            times[id(table)] = (table, table.time_s)
+        time_s, values = times[id(table)][1], table[column].astype(np.float64)
         if time_s is None:
             return
         signal = make_signal(name, time_s, convert(values) if convert else values, unit, source)

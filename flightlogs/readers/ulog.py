@@ -377,6 +377,7 @@ def _read_source(
     if not all(field in data for field in source.fields):
         return {}
     stamps = np.asarray(data["timestamp"])
+    every = stamps / 1e6  # the topic's times, shared by its signals where none drops a sample
     columns, in_range = _convert(source, data)
     label = f"{source.topic}[{instance}]"
     signals: dict[str, Signal] = {}
@@ -393,7 +394,9 @@ def _read_source(
                 dropped = stamps.size - int(keep.sum())
                 message = f"{text}: dropped {dropped} of {stamps.size} samples ({why})"
                 _warnings.warn(DataQualityWarning(message), stacklevel=2)
-            signal = make_signal(name, stamps[keep] / 1e6, columns[k][keep], group.unit, text)
+            whole = bool(keep.all())
+            time_s, values = (every, columns[k]) if whole else (every[keep], columns[k][keep])
+            signal = make_signal(name, time_s, values, group.unit, text)
             if signal is not None and signal.samples >= 2:
                 signals[name] = signal
         if not signals:
