@@ -673,12 +673,15 @@ def _record(
         else:
             message = f"{name}: not logged through {label} ({span[0]:.2f}-{span[1]:.2f} s); left out of it"
             warnings.warn(DataQualityWarning(message), stacklevel=2)
-    table = pd.DataFrame(columns, index=pd.Index(time_base[inside], name="time_s"))
-    quiet = np.zeros(table.shape[0], dtype=bool)
-    t = table.index.to_numpy()
+    t = time_base[inside]
+    quiet = np.zeros(t.size, dtype=bool)
     for segment in segments:
         if segment.kind == "hover":
             quiet |= (t >= segment.start_s) & (t <= segment.end_s)
-    reference = table[quiet] if quiet.sum() >= 10 else table
-    trim = {str(name): float(value) for name, value in reference.mean().items()}
-    return Record(table=table - pd.Series(trim), units=units, trim=trim, source=log.path, label=label)
+    rows = quiet if quiet.sum() >= 10 else slice(None)
+    trim = {}
+    for name, piece in columns.items():  # each piece is this record's own copy: the trim comes off in place
+        trim[name] = float(np.mean(piece[rows]))
+        piece -= trim[name]
+    table = pd.DataFrame(columns, index=pd.Index(t, name="time_s"), copy=False)
+    return Record(table=table, units=units, trim=trim, source=log.path, label=label)
