@@ -22,6 +22,7 @@ from typing import Literal
 
 import numpy as np
 
+from flightlogs._arrays import ByContents
 from flightlogs.conditioning._resampling import (
     TIME_TOL_S,
     check_time_base,
@@ -383,23 +384,23 @@ def resample_signals(
     DataError
         If a signal or the time base is malformed.
     """
-    groups: dict[tuple[str, int, float, float], list[tuple[np.ndarray, list[tuple[str, np.ndarray]]]]] = {}
+    groups: dict[str, ByContents[list[tuple[str, np.ndarray]]]] = {}
+    shared: list[tuple[str, np.ndarray, list[tuple[str, np.ndarray]]]] = []
     for name, signal in signals.items():  # signals of one method on equal times: resampled together
         chosen = method.get(name, "spline") if isinstance(method, Mapping) else method
         _, t, v = _as_series(signal, name)
-        same = groups.setdefault((chosen, t.size, float(t[0]), float(t[-1])), [])
-        for times, members in same:
-            if times is t or np.array_equal(times, t):
-                members.append((name, v))
-                break
-        else:
-            same.append((t, [(name, v)]))
+        same = groups.setdefault(chosen, ByContents())
+        members = same.get(t)
+        if members is None:
+            members = []
+            same.put(t, members)
+            shared.append((chosen, t, members))
+        members.append((name, v))
     out: dict[str, np.ndarray] = {}
-    for (kind, *_), same in groups.items():
-        for t, members in same:
-            columns = np.column_stack([v for _, v in members])
-            values = _resample_columns(t, columns, time_base, kind, max_gap_samples, anti_alias)
-            out |= {name: values[:, k] for k, (name, _) in enumerate(members)}
+    for kind, t, members in shared:
+        columns = np.column_stack([v for _, v in members])
+        values = _resample_columns(t, columns, time_base, kind, max_gap_samples, anti_alias)
+        out |= {name: values[:, k] for k, (name, _) in enumerate(members)}
     return {name: out[name] for name in signals}
 
 

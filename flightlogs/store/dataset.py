@@ -38,6 +38,7 @@ from typing import Any, cast
 import h5py
 import numpy as np
 
+from flightlogs._arrays import ByContents
 from flightlogs.flightlog import FlightLog, Signal, SystemIdRun
 from flightlogs.store.schema import open_schema, stamp_schema
 from flightlogs.writers.atomic import atomic_output
@@ -165,18 +166,15 @@ class _SharedTimes:
 
     def __init__(self, group: h5py.Group) -> None:
         self._group = group.create_group("times")
-        self._stored: dict[tuple[int, float, float], list[tuple[np.ndarray, h5py.Dataset]]] = {}
+        self._stored: ByContents[h5py.Dataset] = ByContents()
 
     def dataset(self, time_s: np.ndarray) -> h5py.Dataset:
         """The dataset holding `time_s` (s, shape (n,)): one written before with equal values, or a new one."""
-        key = (time_s.size, float(time_s[0]), float(time_s[-1])) if time_s.size else (0, 0.0, 0.0)
-        candidates = self._stored.setdefault(key, [])
-        for values, stored in candidates:
-            if values is time_s or np.array_equal(values, time_s):
-                return stored
-        made = self._group.create_dataset(str(len(self._group)), data=time_s, **_COMPRESSION)
-        candidates.append((time_s, made))
-        return made
+        stored = self._stored.get(time_s)
+        if stored is None:
+            stored = self._group.create_dataset(str(len(self._group)), data=time_s, **_COMPRESSION)
+            self._stored.put(time_s, stored)
+        return stored
 
 
 def _source_hash(path: Path) -> str:

@@ -279,7 +279,9 @@ def test_a_fitted_model_as_sim_through_the_command(
     assert result.exit_code == 0, result.output
     assert json.loads(out.read_text())["verdict"] == "time_delay"
     page = report.read_text()
-    assert "Real against simulated frequency responses" in page and "p/delta_lat" in page and "model" in page
+    assert "Real against simulated frequency responses" in page and "p/delta_lat" in page
+    assert ">model</text>" in page  # the Bode legend names the model, not a simulated flight
+    assert "exact.json</span>, a fitted model evaluated along each real flight" in page
     mixed = CliRunner().invoke(cli, ["discrepancy", str(models["exact"]), str(pairs["octo"][0]), "--real", str(out)])
     assert mixed.exit_code == 1 and "a fitted model is the whole simulation" in mixed.output
 
