@@ -9,8 +9,9 @@ from __future__ import annotations
 from typing import cast
 
 import numpy as np
-from scipy.interpolate import CubicSpline, PchipInterpolator
 
+from flightlogs._moving import fast_fft_length
+from flightlogs.conditioning._splines import hermite, pchip_slopes, spline_slopes
 from flightlogs.errors import DataError
 
 __all__: list[str] = []  # private to flightlogs.conditioning
@@ -97,14 +98,12 @@ def kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
 def convolve_valid(x: np.ndarray, taps: np.ndarray) -> np.ndarray:
     """``x`` (shape (n,) or (n, k)) convolved with ``taps`` along axis 0, the fully overlapped part: (n - len + 1, ...).
 
-    By FFT, as ``scipy.signal.fftconvolve(x, taps, mode="valid")`` (to rounding) without importing scipy.signal.
+    By FFT, as ``scipy.signal.fftconvolve(x, taps, mode="valid")`` (to rounding) without importing SciPy.
     """
-    from scipy.fft import irfft, next_fast_len, rfft
-
     n, m = x.shape[0], taps.size
-    size = next_fast_len(n + m - 1, real=True)
-    kernel = rfft(taps, size).reshape((-1,) + (1,) * (x.ndim - 1))
-    full = irfft(rfft(x, size, axis=0) * kernel, size, axis=0)
+    size = fast_fft_length(n + m - 1)
+    kernel = np.fft.rfft(taps, size).reshape((-1,) + (1,) * (x.ndim - 1))
+    full = np.fft.irfft(np.fft.rfft(x, size, axis=0) * kernel, size, axis=0)
     return cast(np.ndarray, full[m - 1 : n])
 
 
@@ -114,11 +113,11 @@ def interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: str) -> np
         if v.ndim == 1:
             return cast(np.ndarray, np.interp(at, t, v))
         return np.column_stack([np.interp(at, t, column) for column in v.T])
-    if method == "spline":
-        return cast(np.ndarray, CubicSpline(t, v, bc_type="not-a-knot")(at))
-    if method == "pchip":
-        with np.errstate(over="ignore"):  # SciPy divides by slopes that underflow for subnormal data
-            return cast(np.ndarray, PchipInterpolator(t, v)(at))
+    if method in ("spline", "pchip"):
+        columns = v if v.ndim == 2 else v[:, None]
+        slopes = spline_slopes(t, columns) if method == "spline" else pchip_slopes(t, columns)
+        out = hermite(t, columns, slopes, at)
+        return out if v.ndim == 2 else out[:, 0]
     raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
 
 

@@ -26,8 +26,8 @@ from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
-from scipy.ndimage import binary_erosion
 
+from flightlogs._moving import erode
 from flightlogs.conditioning.align import WindAlignment, estimate_residual_offset, wind_log_time
 from flightlogs.conditioning.lag import TransportDelay, transport_delay
 from flightlogs.conditioning.resample import contiguous_spans, resample_signals, uniform_time_base
@@ -579,7 +579,7 @@ def _flight_state(time_base: np.ndarray, values: dict[str, np.ndarray]) -> tuple
     if thrust is not None and np.isfinite(thrust).any():
         level_on = _THRUST_ON * float(np.nanpercentile(thrust, 95))
         on = np.nan_to_num(thrust, nan=-np.inf) > level_on if level_on > 0 else np.zeros(time_base.size, dtype=bool)
-        flying = binary_erosion(on, iterations=width, border_value=1) if on.any() else on
+        flying = erode(on, width) if on.any() else on
     vd = values.get("vd")
     climb = vd if vd is not None and np.isfinite(vd).all() else np.zeros(time_base.size)
     return flying, climb

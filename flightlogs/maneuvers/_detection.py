@@ -14,15 +14,16 @@ from dataclasses import dataclass
 from typing import Literal, NamedTuple, cast
 
 import numpy as np
-from scipy.fft import irfft, next_fast_len, rfft
-from scipy.ndimage import binary_dilation, median_filter, uniform_filter1d
+from numpy.lib.stride_tricks import sliding_window_view
 
+from flightlogs._moving import dilate, moving_mean
 from flightlogs.maneuvers._rank import spearman
 from flightlogs.masks import true_runs
 
 __all__: list[str] = []
 
 _SHORT_S = 0.2  # window of the short moving mean and RMS, s
+_TREND_KNOTS_PER_WINDOW = 8  # robust trend: fits per window length, joined by straight lines
 _GUARD_S, _BASELINE_S = 1.0, 10.0  # edge baseline: fitted from 11 s to 1 s before the burst
 _QUADRATIC_S = 3.0  # edge baseline: straight below this much quiet trace, quadratic above
 _LOOK_IN_S = 3.0  # edge baseline: trusted this far into a burst, s
@@ -163,14 +164,14 @@ def _activity(x: np.ndarray, dt: float, threshold: float, trend_window_s: float)
     """Detrend one axis and normalise its short envelopes by noise floors of quiet stretches."""
     xd = x - _trend(x, max(3, int(round(trend_window_s / dt)) | 1))
     width = max(1, int(round(_SHORT_S / dt)))
-    mean = np.abs(uniform_filter1d(xd, width, mode="nearest"))
-    rms = np.sqrt(np.maximum(uniform_filter1d(xd * xd, width, mode="nearest"), 0.0))  # rounding can dip below 0
+    mean = np.abs(moving_mean(xd, width))
+    rms = np.sqrt(np.maximum(moving_mean(xd * xd, width), 0.0))  # rounding can dip below 0
     tiny = 1e-12 * max(1.0, float(np.max(np.abs(xd))))
     quiet = np.ones(xd.size, dtype=bool)
     for quantile in (0.25, 0.5, 0.5, 0.5):  # the first pass may see more maneuver than quiet
         sigma = max(_robust_std(xd[quiet], quantile), tiny)
         sigma_mean = max(_robust_std(mean[quiet], quantile, centred=True), tiny)
-        calm = ~binary_dilation(np.maximum(mean / sigma_mean, rms / sigma) > threshold, iterations=int(1 / dt))
+        calm = ~dilate(np.maximum(mean / sigma_mean, rms / sigma) > threshold, int(1 / dt))
         if calm.sum() < 10:
             break
         quiet = calm
@@ -184,22 +185,26 @@ def _trend(x: np.ndarray, width: int) -> np.ndarray:
 
     A maneuver's lobes lose their weight, so the trend runs through the quiet
     samples and the zero crossings and follows a curving drift without lag.
+    The fits are made every eighth of a window (`_TREND_KNOTS_PER_WINDOW`)
+    and joined by straight lines: a trend varies over a window, not a sample,
+    and the cost stays linear in the trace's length.
     """
-    trend = median_filter(x, size=width, mode="reflect")
     half = width // 2
-    n_fft = next_fast_len(x.size + 2 * half, real=True)
-    kernels = rfft((-np.arange(-half, half + 1) / half) ** np.arange(5)[:, None], n_fft)  # moving moments 0-4
-
-    def moving(signal: np.ndarray, k: int) -> list[np.ndarray]:  # its first k moving moments, as fftconvolve "same"
-        return list(irfft(rfft(signal, n_fft) * kernels[:k], n_fft)[:, half : half + x.size])
-
     idx = np.arange(x.size)
+    centres = np.unique(np.r_[idx[:: max(1, width // _TREND_KNOTS_PER_WINDOW)], x.size - 1])
+    mirrored = np.pad(x, (half, half), mode="symmetric")
+    trend = np.interp(idx, centres, np.median(sliding_window_view(mirrored, width)[centres], axis=1))
+    powers = (np.arange(-half, half + 1) / half)[:, None] ** np.arange(5)  # (width, 5): local time^0..4
+
+    def moments(signal: np.ndarray, k: int) -> np.ndarray:  # sum over each window of signal × (local time)^0..k-1
+        return cast(np.ndarray, sliding_window_view(np.pad(signal, half), width)[centres] @ powers[:, :k])
+
     for _ in range(3):
         resid = x - trend
         r = resid / (4.685 * max(_robust_std(resid, 0.25), 1e-12 * (1.0 + float(np.max(np.abs(x))))))
         w = np.where(np.abs(r) < 1, (1 - r * r) ** 2, 0.0)
-        m0, m1, m2, m3, m4 = moving(w, 5)
-        b0, b1, b2 = moving(w * x, 3)
+        m0, m1, m2, m3, m4 = moments(w, 5).T
+        b0, b1, b2 = moments(w * x, 3).T
         # normal equations [[m0 m1 m2] [m1 m2 m3] [m2 m3 m4]] c = b; the trend is c0 (Cramer's rule)
         minor = m2 * m4 - m3 * m3
         det = m0 * minor - m1 * (m1 * m4 - m3 * m2) + m2 * (m1 * m3 - m2 * m2)
@@ -207,7 +212,7 @@ def _trend(x: np.ndarray, width: int) -> np.ndarray:
         if good.sum() < 2:
             break
         c0 = (b0 * minor - m1 * (b1 * m4 - m3 * b2) + m2 * (b1 * m3 - m2 * b2))[good] / det[good]
-        trend = np.interp(idx, idx[good], c0)
+        trend = np.interp(idx, centres[good], c0)
     return cast(np.ndarray, trend)
 
 
@@ -293,8 +298,8 @@ def _onset(act: _Activity, core: int, dt: float, limits: tuple[int, int], peak: 
     else:
         d = act.detrended[lo : hi + 1]
     width = max(1, int(round(_SHORT_S / dt)))
-    mean = np.abs(uniform_filter1d(d, width, mode="nearest"))
-    rms = np.sqrt(uniform_filter1d(d * d, width, mode="nearest"))
+    mean = np.abs(moving_mean(d, width))
+    rms = np.sqrt(np.maximum(moving_mean(d * d, width), 0.0))
     floor = _RELATIVE_FLOOR * peak
     loud = (mean > max(threshold * act.sigma_mean, 2 * floor)) | (rms > max(threshold * act.sigma, 2 * floor))
     calm = (mean < max(_CALM * act.sigma_mean, floor)) & (rms < max(_CALM * act.sigma, floor))

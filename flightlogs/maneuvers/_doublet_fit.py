@@ -31,7 +31,6 @@ from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 __all__: list[str] = []
 
@@ -178,10 +177,34 @@ def _nuisance(states: np.ndarray, n: int, dt: float) -> np.ndarray:
     intervals = max(1, int(np.ceil(t[-1] / _KNOT_S)))
     inner = np.linspace(0.0, t[-1], intervals + 1)
     knots = np.r_[[0.0] * 3, inner, [t[-1]] * 3]
-    splines = BSpline.design_matrix(t, knots, 3).toarray()
+    splines = _cubic_bsplines(t, knots)
     integrals = np.cumsum(states, axis=0) * dt
     columns = np.column_stack([states - states.mean(axis=0), integrals - integrals.mean(axis=0), splines])
     return columns
+
+
+def _cubic_bsplines(t: np.ndarray, knots: np.ndarray) -> np.ndarray:
+    """Cubic B-splines on `knots` (clamped, shape (n_knots,)) at `t` (n,): shape (n, n_knots - 4).
+
+    ``scipy.interpolate.BSpline.design_matrix(t, knots, 3).toarray()`` by de Boor's recurrence for the
+    four splines alive in each interval (SciPy's import costs more than a log's reading).
+    """
+    span = np.clip(np.searchsorted(knots, t, side="right") - 1, 3, knots.size - 5)
+    values = np.zeros((t.size, 4))
+    values[:, 0] = 1.0
+    left, right = np.zeros((t.size, 4)), np.zeros((t.size, 4))
+    for j in range(1, 4):
+        left[:, j] = t - knots[span + 1 - j]
+        right[:, j] = knots[span + j] - t
+        saved = np.zeros(t.size)
+        for r in range(j):
+            share = values[:, r] / (right[:, r + 1] + left[:, j - r])
+            values[:, r] = saved + right[:, r + 1] * share
+            saved = left[:, j - r] * share
+        values[:, j] = saved
+    design = np.zeros((t.size, knots.size - 4))
+    np.put_along_axis(design, span[:, None] - 3 + np.arange(4), values, axis=1)
+    return design
 
 
 def _orthonormal(columns: np.ndarray) -> np.ndarray:

@@ -12,7 +12,8 @@ over decades. Helpers of :mod:`flightlogs.maneuvers._sweeps`.
 from __future__ import annotations
 
 import numpy as np
-from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
+
+from flightlogs._moving import fast_fft_length
 
 __all__: list[str] = []
 
@@ -54,9 +55,9 @@ def band_envelopes(x: np.ndarray, dt: float, freqs_hz: np.ndarray, *, cycles: fl
     array([0., 1., 0.])
     """
     n = x.size
-    n_fft = next_fast_len(n + int(4 * cycles / (2 * np.pi * freqs_hz.min() * dt)), real=True)  # room for the tails
-    spectrum = rfft(x, n_fft)
-    f = rfftfreq(n_fft, dt)
+    n_fft = fast_fft_length(n + int(4 * cycles / (2 * np.pi * freqs_hz.min() * dt)))  # room for the tails
+    spectrum = np.fft.rfft(x, n_fft)
+    f = np.fft.rfftfreq(n_fft, dt)
     out = np.empty(((n + step - 1) // step, freqs_hz.size))
     for k, centre in enumerate(freqs_hz):
         gain = np.exp(-0.5 * ((f - centre) * cycles / centre) ** 2)
@@ -68,6 +69,6 @@ def band_envelopes(x: np.ndarray, dt: float, freqs_hz: np.ndarray, *, cycles: fl
 
 def _analytic_inverse(half_spectrum: np.ndarray, n_fft: int) -> np.ndarray:
     """Analytic signal whose positive-frequency spectrum is `half_spectrum` (real part: the band-passed trace)."""
-    real = irfft(half_spectrum, n_fft)
-    imag = irfft(-1j * half_spectrum, n_fft)  # Hilbert transform: -j on positive frequencies
+    real = np.fft.irfft(half_spectrum, n_fft)
+    imag = np.fft.irfft(-1j * half_spectrum, n_fft)  # Hilbert transform: -j on positive frequencies
     return np.asarray(real + 1j * imag)

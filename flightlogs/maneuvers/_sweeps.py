@@ -24,8 +24,8 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
-from scipy.ndimage import median_filter
 
+from flightlogs._moving import moving_rank
 from flightlogs.maneuvers._detection import _activity, _bursts, _edges
 from flightlogs.maneuvers._rank import spearman
 from flightlogs.maneuvers._scalogram import band_envelopes, band_frequencies
@@ -135,8 +135,8 @@ def _ridge(named: Mapping[str, np.ndarray], dt: float, freqs: np.ndarray, step: 
     frames = np.arange(band.size)
     width = max(1, int(round(_SMOOTH_S / (step * dt)))) | 1
     return _Ridge(
-        score=median_filter(combined[frames, band], size=width, mode="nearest"),
-        freq_hz=np.exp(median_filter(np.log(freqs[band]), size=width, mode="nearest")),
+        score=moving_rank(combined[frames, band], width, mode="nearest"),
+        freq_hz=np.exp(moving_rank(np.log(freqs[band]), width, mode="nearest")),
         trace=best_trace[frames, band],
         names=tuple(named),
     )

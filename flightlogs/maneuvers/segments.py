@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import csv
 import re
-import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
@@ -587,6 +586,8 @@ def _checked_run(run: SystemIdRun) -> SystemIdRun:
 
 
 def _toml_entries(path: Path, text: str) -> list[tuple[int, dict[str, Any]]]:
+    import tomllib  # here, not at import: only segment files need it
+
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:

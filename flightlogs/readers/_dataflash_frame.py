@@ -28,6 +28,7 @@ __all__ = ["MessageFormat"]
 
 HEAD1, HEAD2, FMT_TYPE = 0xA3, 0x95, 0x80
 LISTED = 8  # gaps or resets spelled out in warnings before summarising
+_SCAN_BLOCK = 1 << 22  # bytes compared at a time in the header scan
 _FMT = DFFormat(FMT_TYPE, "FMT", 89, "BBnNZ", "Type,Length,Name,Format,Columns")  # as DFReader
 _NUMPY_CODE = {
     "b": "i1",
@@ -100,8 +101,7 @@ def frame_messages(buf: np.ndarray, path: Path) -> tuple[list[tuple[str, Message
     The FMT messages on the chain of messages define the chain (types and
     lengths), so the walk is repeated until the two agree (once, in practice).
     """
-    heads = np.flatnonzero(buf[:-2] == HEAD1) if buf.size > 2 else np.empty(0, np.int64)
-    heads = heads[buf[heads + 1] == HEAD2].astype(np.int64)
+    heads = _header_candidates(buf)
     parsed = {
         d.offset: d for d in _parse_fmts(buf, heads[(buf[heads + 2] == FMT_TYPE) & (heads + _FMT.len <= buf.size)])
     }
@@ -118,6 +118,20 @@ def frame_messages(buf: np.ndarray, path: Path) -> tuple[list[tuple[str, Message
         raise LogFormatError(f"{path}: holds {kind} (searched {buf.size} bytes from byte offset 0).")
     offsets, skipped = _account(buf, starts, ends, decodes, path)
     return _layouts(buf, offsets, by_type, path), skipped
+
+
+def _header_candidates(buf: np.ndarray) -> np.ndarray:
+    """Offsets of every ``A3 95`` pair followed by a byte, shape (n_candidates,), scanned a block at a time.
+
+    One comparison over the whole file would take a temporary the size of the
+    file, and most of its time in faulting that memory in.
+    """
+    found = [np.empty(0, np.int64)]
+    for lo in range(0, max(buf.size - 2, 0), _SCAN_BLOCK):
+        block = buf[lo : min(lo + _SCAN_BLOCK, buf.size - 2) + 1]  # one byte more: the pair's second byte
+        first = np.flatnonzero(block[:-1] == HEAD1)
+        found.append(first[block[first + 1] == HEAD2] + lo)
+    return np.concatenate(found).astype(np.int64, copy=False)
 
 
 def _by_type(defs: list[_Definition]) -> dict[int, list[_Definition]]:

@@ -231,7 +231,7 @@ def read_messages(
     """
     path = Path(path)
     try:
-        data = np.fromfile(path, dtype=np.uint8)
+        data = np.memmap(path, dtype=np.uint8, mode="r") if path.stat().st_size else np.empty(0, np.uint8)
     except OSError as err:
         raise LogFormatError(f"{path}: cannot be read ({err.strerror or err}) at byte offset 0.") from err
     return decode_messages(data, path=path, types=types, progress=progress)

@@ -132,3 +132,15 @@ def test_a_bad_time_base_is_a_data_error(time_s: np.ndarray, fragment: str) -> N
     log = closed_loop_roll_hold(np.zeros(800), 0, GUST["calm"])
     with pytest.raises(DataError, match=fragment):
         _excitation(log, np.ones(800, dtype=bool), time_s)
+
+
+@pytest.mark.parametrize(("n", "dt", "knot_s"), [(50, 0.01, 0.2), (1000, 0.01, 2.0), (1001, 0.005, 1.0), (7, 0.1, 5.0)])
+def test_the_nuisance_splines_are_scipys_b_spline_design_matrix(n: int, dt: float, knot_s: float) -> None:
+    from scipy.interpolate import BSpline
+
+    from flightlogs.maneuvers._doublet_fit import _cubic_bsplines
+
+    t = np.arange(n) * dt
+    inner = np.linspace(0.0, t[-1], max(1, int(np.ceil(t[-1] / knot_s))) + 1)
+    knots = np.r_[[0.0] * 3, inner, [t[-1]] * 3]
+    np.testing.assert_allclose(_cubic_bsplines(t, knots), BSpline.design_matrix(t, knots, 3).toarray(), atol=1e-14)
