@@ -73,15 +73,15 @@ def campaign_axis(seed: int = 0) -> list[Record]:
         )
         / 100.0
     )
-    whole = Record(
-        table=table, units={c: "-" for c in table.columns}, trim={}, source=Path("simulated-campaign"), label="campaign"
+    whole = Record.from_table(
+        table, units={c: "-" for c in table.columns}, trim={}, source=Path("simulated-campaign"), label="campaign"
     )
     pieces = []
     for start in starts:
         first = int(round(start * RATE_HZ))
         pieces.append(
-            Record(
-                table=table.iloc[first : first + int(SWEEP_S * RATE_HZ)],
+            Record.from_table(
+                table.iloc[first : first + int(SWEEP_S * RATE_HZ)],
                 units=whole.units,
                 trim={},
                 source=whole.source,

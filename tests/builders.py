@@ -266,8 +266,8 @@ def sample_verification(*, seed: int = 0) -> Verification:
             "p": "rad/s",
         }
         records.append(
-            Record(
-                table=table,
+            Record.from_table(
+                table,
                 units=units,
                 trim={},
                 source=Path("doublets.ulg"),

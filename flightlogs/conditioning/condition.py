@@ -25,7 +25,6 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import pandas as pd
 
 from flightlogs._moving import erode
 from flightlogs.conditioning.align import WindAlignment, estimate_residual_offset, wind_log_time
@@ -683,5 +682,4 @@ def _record(
     for name, piece in columns.items():  # each piece is this record's own copy: the trim comes off in place
         trim[name] = float(np.mean(piece[rows]))
         piece -= trim[name]
-    table = pd.DataFrame(columns, index=pd.Index(t, name="time_s"), copy=False)
-    return Record(table=table, units=units, trim=trim, source=log.path, label=label)
+    return Record(time_s=t, columns=columns, units=units, trim=trim, source=log.path, label=label)

@@ -37,7 +37,7 @@ Values equal those of pymavlink's ``DFReader_binary`` read with
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
@@ -92,9 +92,11 @@ class MessageTable:
     offsets: np.ndarray
 
     def __post_init__(self) -> None:
-        for array in (*self.columns.values(), self.offsets):
-            array.flags.writeable = False
-        object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
+        self.offsets.flags.writeable = False
+        if not isinstance(self.columns, _LazyColumns):  # those decode (read-only) when read
+            for array in self.columns.values():
+                array.flags.writeable = False
+            object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
 
     def __len__(self) -> int:
         return int(self.offsets.size)
@@ -123,6 +125,8 @@ class MessageTable:
 
     def select(self, rows: np.ndarray) -> MessageTable:
         """Return the messages picked by a boolean mask or index array."""
+        if isinstance(self.columns, _LazyColumns):
+            return MessageTable(format=self.format, columns=self.columns.select(rows), offsets=self.offsets[rows])
         return MessageTable(
             format=self.format, columns={k: v[rows] for k, v in self.columns.items()}, offsets=self.offsets[rows]
         )
@@ -192,7 +196,7 @@ class DataFlashMessages:
             return {}
         column = self.instance_field(name)
         if column is not None:
-            values = self.tables[name][column]
+            values = _peek(self.tables[name], column)
             return {int(i): self.tables[name].select(values == i) for i in np.unique(values)}
         found = {0: self.tables[name]}
         for k in range(2, 10):
@@ -351,8 +355,7 @@ def message_dtype(fmt: str) -> np.dtype:
 
 
 def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray) -> MessageTable:
-    dtype, chars = layout(fmt.format, fmt.length)
-    rec = gather(buf, offsets, fmt.length).view(dtype).ravel()
+    _, chars = layout(fmt.format, fmt.length)
     names = fmt.columns[: len(chars)]
     if len(set(names)) != len(names) or len(fmt.columns) != len(chars):
         message = (
@@ -360,8 +363,86 @@ def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray) -> M
             f"{fmt.columns}; as in DFReader, a repeated name keeps its last field."
         )
         warnings.warn(LogCorruptionWarning(message), stacklevel=2)
-    columns = {name: _column(rec[f"f{i}"], chars[i], fmt.name) for i, name in enumerate(names)}
-    return MessageTable(format=fmt, columns=columns, offsets=offsets)
+    return MessageTable(format=fmt, columns=_LazyColumns(buf, fmt, offsets), offsets=offsets)
+
+
+class _LazyColumns(Mapping[str, np.ndarray]):
+    """The columns of one layout, decoded from the log's bytes when first read (then kept, read-only).
+
+    A reader maps a few columns of a few types: the messages of a table are
+    copied out of the file at the first column read, and only the columns
+    read are converted. A column read before that (the instance number, to
+    split a table) is taken from the file alone. The file stays referenced
+    (its memory map open) until the table's messages are copied.
+    """
+
+    def __init__(
+        self, buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray, decoded: dict[str, np.ndarray] | None = None
+    ) -> None:
+        dtype, chars = layout(fmt.format, fmt.length)
+        self._buf: np.ndarray | None = buf
+        self._fmt, self._offsets, self._dtype, self._chars = fmt, offsets, dtype, chars
+        self._field = {name: i for i, name in enumerate(fmt.columns[: len(chars)])}  # a repeated name: its last
+        self._decoded = decoded if decoded is not None else {}
+        self._messages: np.ndarray | None = None
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        column = self._decoded.get(name)
+        if column is None:
+            i = self._field[name]
+            column = _column(self._raw(f"f{i}"), self._chars[i], self._fmt.name)
+            column.flags.writeable = False
+            self._decoded[name] = column
+        return column
+
+    def peek(self, name: str) -> np.ndarray:
+        """One column, read from the file alone while the messages are not copied yet (to split or check them)."""
+        column = self._decoded.get(name)
+        if column is not None or self._buf is None:
+            return self[name]
+        fields = self._dtype.fields
+        assert fields is not None  # a structured dtype
+        i = self._field[name]
+        base, at = fields[f"f{i}"][:2]
+        one = np.dtype({"names": ["v"], "formats": [base], "offsets": [0], "itemsize": base.itemsize})
+        raw = gather(self._buf, self._offsets + at, base.itemsize).view(one).ravel()["v"]
+        column = _column(raw, self._chars[i], self._fmt.name)
+        column.flags.writeable = False
+        self._decoded[name] = column
+        return column
+
+    def _raw(self, field: str) -> np.ndarray:
+        if self._messages is None:
+            assert self._buf is not None
+            self._messages = gather(self._buf, self._offsets, self._fmt.length).view(self._dtype).ravel()
+            self._buf = None  # the file is no longer needed by this table
+        return self._messages[field]
+
+    def __contains__(self, name: object) -> bool:  # Mapping's would decode the column to answer
+        return name in self._field
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._field)
+
+    def __len__(self) -> int:
+        return len(self._field)
+
+    def select(self, rows: np.ndarray) -> _LazyColumns:
+        """The same columns for the messages picked by `rows` (a mask or indices)."""
+        decoded = {name: column[rows] for name, column in self._decoded.items()}
+        for column in decoded.values():
+            column.flags.writeable = False
+        picked = _LazyColumns(
+            self._buf if self._buf is not None else np.empty(0, np.uint8), self._fmt, self._offsets[rows], decoded
+        )
+        if self._messages is not None:  # copied already: the picked ones from the copy
+            picked._messages, picked._buf = self._messages[rows], None
+        return picked
+
+
+def _peek(table: MessageTable, column: str) -> np.ndarray:
+    """One column of `table`, without copying its messages out of the file when they are not yet."""
+    return table.columns.peek(column) if isinstance(table.columns, _LazyColumns) else table[column]
 
 
 def _column(raw: np.ndarray, char: str, message: str) -> np.ndarray:
@@ -433,7 +514,7 @@ def _time_resets(tables: dict[str, MessageTable]) -> list[str]:
         column = next((c for c in ("TimeUS", "TimeMS") if c in table.columns), None)
         if column is None or not len(table) or key.startswith("GPS"):
             continue
-        name, stamp = key.split("@")[0], table[column].astype(np.int64)
+        name, stamp = key.split("@")[0], _peek(table, column).astype(np.int64)
         drops = np.flatnonzero(np.diff(stamp) < -(10**6 if column == "TimeUS" else 10**3))
         if not drops.size and name not in last_time:
             last_time[name] = stamp[-1] / (1e6 if column == "TimeUS" else 1e3)

@@ -345,8 +345,6 @@ def _write_conditioned(group: h5py.Group, flight: Any) -> None:
 
 
 def _read_conditioned(group: h5py.Group) -> Any:
-    import pandas as pd
-
     from flightlogs.conditioning.align import WindAlignment
     from flightlogs.conditioning.condition import ConditionedFlight
     from flightlogs.conditioning.lag import LagEstimate, TransportDelay
@@ -371,10 +369,10 @@ def _read_conditioned(group: h5py.Group) -> Any:
     for key in sorted(group["records"], key=int):
         sub = group["records"][key]
         units = json.loads(sub.attrs["units"])
-        table = pd.DataFrame({name: sub[name][()] for name in units}, index=pd.Index(sub["time_s"][()], name="time_s"))
         records.append(
             Record(
-                table=table,
+                time_s=sub["time_s"][()],
+                columns={name: sub[name][()] for name in units},
                 units=units,
                 trim=json.loads(sub.attrs["trim"]),
                 source=source,

@@ -101,12 +101,12 @@ def frequency_responses(
 
     Examples
     --------
-    >>> import numpy as np, pandas as pd
+    >>> import numpy as np
     >>> from pathlib import Path
     >>> t = np.arange(6000) / 100.0
     >>> x = np.random.default_rng(0).normal(size=t.size)
-    >>> table = pd.DataFrame({"delta_lon": x, "q": 2.0 * x}, index=t)
-    >>> record = Record(table=table, units={"delta_lon": "%", "q": "rad/s"}, trim={}, source=Path("sim"))
+    >>> columns = {"delta_lon": x, "q": 2.0 * x}
+    >>> record = Record(time_s=t, columns=columns, units={"delta_lon": "%", "q": "rad/s"}, trim={}, source=Path("sim"))
     >>> (h,) = frequency_responses([record], ["delta_lon"], ["q"])
     >>> h.pair, bool(np.allclose(h.response, 2.0)), bool(np.all(h.coherence > 0.999))
     ('q/delta_lon', True, True)

@@ -91,7 +91,7 @@ def maneuver_records(
             last = min(segment.end_s + margin_s, after)
             for record in flight.records:
                 start, end = max(first, record.start_s), min(last, record.end_s)
-                if end <= start or record.table.loc[start:end].shape[0] < _MIN_PIECE_SAMPLES:
+                if end <= start or record.samples_between(start, end) < _MIN_PIECE_SAMPLES:
                     continue
                 label = f"{flight.source.name} {axis} {kind} {segment.start_s:.2f}-{segment.end_s:.2f} s"
                 pieces.append(record.between(start, end, label=label))
@@ -152,7 +152,7 @@ def quiet_records(
             for first, last in _without((start, end), excited):
                 for record in flight.records:
                     a, b = max(first, record.start_s), min(last, record.end_s)
-                    if b - a >= min_s and record.table.loc[a:b].shape[0] >= _MIN_PIECE_SAMPLES:
+                    if b - a >= min_s and record.samples_between(a, b) >= _MIN_PIECE_SAMPLES:
                         pieces.append(record.between(a, b, label=f"{flight.source.name} no {axis} {a:.2f}-{b:.2f} s"))
     return pieces
 

@@ -252,14 +252,14 @@ def verify_record(
     --------
     A first-order lag verified against its own response, offset by a bias:
 
-    >>> import pandas as pd
     >>> from pathlib import Path
     >>> model = DelayedStateSpace(a=np.array([[-2.0]]), b=np.array([[2.0]]), c=np.array([[1.0]]), d=np.zeros((1, 1)),
     ...                           states=("q",), inputs=("delta_lon",), outputs=("q",), input_delays_s=np.array([0.0]))
     >>> t = np.arange(200) * 0.01
     >>> step = (t >= 0.5).astype(float)
-    >>> table = pd.DataFrame({"delta_lon": step, "q": 0.1 + step * (1 - np.exp(-2 * (t - 0.5)))}, index=t)
-    >>> result = verify_record(model, Record(table=table, units={"delta_lon": "%", "q": "rad/s"}, trim={}, source=Path("demo.ulg")),
+    >>> columns = {"delta_lon": step, "q": 0.1 + step * (1 - np.exp(-2 * (t - 0.5)))}
+    >>> record = Record(time_s=t, columns=columns, units={"delta_lon": "%", "q": "rad/s"}, trim={}, source=Path("demo.ulg"))
+    >>> result = verify_record(model, record,
     ...                        options=VerificationOptions(initial_state="zero", fit_reference_shift=False))
     >>> round(result.output("q").bias, 3), result.output("q").tic < 0.01
     (0.1, True)

@@ -35,7 +35,7 @@ def _flight(name: str, *segments: tuple[str, str]) -> ConditionedFlight:
 
 def _record() -> Record:
     table = pd.DataFrame({"delta_lon": np.zeros(20), "q": np.zeros(20)}, index=np.arange(20) * 0.01)
-    return Record(table=table, units={"delta_lon": "%", "q": "rad/s"}, trim={}, source=Path("a.bin"))
+    return Record.from_table(table, units={"delta_lon": "%", "q": "rad/s"}, trim={}, source=Path("a.bin"))
 
 
 FLIGHTS = [_flight("a.bin", ("lat", "sweep"), ("lon", "doublet")), _flight("b.bin"), _flight("c.bin")]

@@ -62,8 +62,8 @@ def _record(axis: str, seed: int) -> Record:
         index=flight.time_s,
     )
     trim = table.mean()
-    return Record(
-        table=table - trim, units=UNITS, trim=trim.to_dict(), source=Path(f"{axis}.bin"), label=f"{axis} sweep"
+    return Record.from_table(
+        table - trim, units=UNITS, trim=trim.to_dict(), source=Path(f"{axis}.bin"), label=f"{axis} sweep"
     )
 
 
@@ -102,7 +102,8 @@ def test_unresolved_wind_delays_are_dropped_to_zero(records: list[Record]) -> No
 def test_records_without_wind_are_refused(records: list[Record]) -> None:
     structure = load_structure("hover-wind")
     bare = [
-        Record(table=r.table.drop(columns="wind_lon"), units=r.units, trim=r.trim, source=r.source) for r in records
+        Record.from_table(r.table.drop(columns="wind_lon"), units=r.units, trim=r.trim, source=r.source)
+        for r in records
     ]
     with pytest.raises(FitError, match="wind_lon"):
         fit_wind(structure, structure.values(), structure.default_constants(), bare)

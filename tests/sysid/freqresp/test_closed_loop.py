@@ -73,7 +73,7 @@ def _fly(excitation: bool, disturbance: np.ndarray) -> Record:
     _, y, _ = sps.lsim(closed, np.column_stack([e, disturbance]), t)
     step = int(FINE_HZ / RATE_HZ)
     table = pd.DataFrame({"delta_lon": y[::step, 1], "q": y[::step, 0]}, index=t[::step])
-    return Record(table=table, units={"delta_lon": "-", "q": "rad/s"}, trim={}, source=Path("closed-loop"))
+    return Record.from_table(table, units={"delta_lon": "-", "q": "rad/s"}, trim={}, source=Path("closed-loop"))
 
 
 def _errors(response: np.ndarray, omega: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -171,8 +171,8 @@ def test_an_uncorrelated_noise_input_leaves_the_response_on_the_airframe(
     rng = np.random.default_rng(4)
     units = {**base.units, "wind_lon": "m/s"}
     records = [
-        Record(
-            table=base.table.assign(wind_lon=rng.normal(size=base.time_s.size)),
+        Record.from_table(
+            base.table.assign(wind_lon=rng.normal(size=base.time_s.size)),
             units=units,
             trim={},
             source=base.source,
@@ -189,8 +189,8 @@ def test_an_uncorrelated_noise_input_leaves_the_response_on_the_airframe(
 def test_a_second_input_that_never_varies_is_an_error() -> None:
     """Not a silent singular spectral matrix: the message names the input."""
     record = _fly(True, np.zeros(38_000))
-    silent = Record(
-        table=record.table.assign(wind_lon=0.0),
+    silent = Record.from_table(
+        record.table.assign(wind_lon=0.0),
         units={**record.units, "wind_lon": "m/s"},
         trim={},
         source=record.source,
@@ -202,7 +202,7 @@ def test_a_second_input_that_never_varies_is_an_error() -> None:
 def _flight(segments: list[Segment]) -> ConditionedFlight:
     t = np.arange(0.0, 200.0, 0.01)
     table = pd.DataFrame({"delta_lon": np.sin(t), "q": np.cos(t)}, index=t)
-    record = Record(table=table, units={"delta_lon": "-", "q": "rad/s"}, trim={}, source=Path("f.ulg"))
+    record = Record.from_table(table, units={"delta_lon": "-", "q": "rad/s"}, trim={}, source=Path("f.ulg"))
     return ConditionedFlight(source=Path("f.ulg"), records=(record,), segments=tuple(segments), rate_hz=100.0)
 
 
@@ -238,6 +238,6 @@ def test_coupled_inputs_are_those_that_move_with_the_maneuver() -> None:
         delta_yaw=0.0,
     )
     units = {**record.units, "delta_thr": "-", "delta_lat": "-", "delta_yaw": "-"}
-    flown = Record(table=table, units=units, trim={}, source=record.source)
+    flown = Record.from_table(table, units=units, trim={}, source=record.source)
     found = coupled_inputs([flown], "delta_lon", ["delta_lat", "delta_yaw", "delta_thr"], OPTIONS)
     assert found == ("delta_thr",)

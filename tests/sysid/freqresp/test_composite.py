@@ -40,8 +40,8 @@ def _truth(filt: tuple[np.ndarray, np.ndarray], omega: np.ndarray) -> np.ndarray
 
 def _record(columns: dict[str, np.ndarray]) -> Record:
     time_s = np.arange(next(iter(columns.values())).size) * DT
-    return Record(
-        table=pd.DataFrame(columns, index=time_s),
+    return Record.from_table(
+        pd.DataFrame(columns, index=time_s),
         units={name: "-" for name in columns},
         trim={},
         source=Path("simulated"),

@@ -67,8 +67,8 @@ def _sweep(amplitude: float = 1.0, f_stop_hz: float = 12.0) -> Maneuver:
 
 
 def _record(columns: dict[str, np.ndarray], time_s: np.ndarray) -> Record:
-    return Record(
-        table=pd.DataFrame(columns, index=time_s),
+    return Record.from_table(
+        pd.DataFrame(columns, index=time_s),
         units={name: "-" for name in columns},
         trim={},
         source=Path("simulated"),
@@ -353,7 +353,7 @@ def octocopter_sweeps() -> list[Record]:
     time_s = flight.time_s
     table = pd.DataFrame({name: flight.signals[name] for name in ("delta_lon", "q", "ax", "theta", "u")}, index=time_s)
     table["excitation"] = excitation_signal(time_s, maneuvers, "lon") / 100.0
-    record = Record(table=table, units={c: "-" for c in table.columns}, trim={}, source=Path("octocopter"))
+    record = Record.from_table(table, units={c: "-" for c in table.columns}, trim={}, source=Path("octocopter"))
     return [record.between(s - 1.0, s + 36.0) for s in starts]
 
 

@@ -207,7 +207,7 @@ def _flight(*, gap: tuple[float, float] | None = None, seed: int = 0, excitation
         )
     table = pd.DataFrame(columns, index=t)
     units = {name: "-" for name in columns}
-    whole = Record(table=table, units=units, trim={}, source=Path("f.bin"), label="piece 1 of 1")
+    whole = Record.from_table(table, units=units, trim={}, source=Path("f.bin"), label="piece 1 of 1")
     records = (whole,) if gap is None else (whole.between(0.0, gap[0]), whole.between(gap[1], 99.99))
     segments = (
         Segment(axis="lon", kind="sweep", start_s=10.0, end_s=50.0, source="detected"),
@@ -363,8 +363,8 @@ def test_window_lengths_are_sorted_and_unique() -> None:
 
 def _simple(columns: dict[str, np.ndarray], rate_hz: float = RATE_HZ) -> Record:
     t = np.arange(next(iter(columns.values())).size) / rate_hz
-    return Record(
-        table=pd.DataFrame(columns, index=t),
+    return Record.from_table(
+        pd.DataFrame(columns, index=t),
         units={name: "-" for name in columns},
         trim={},
         source=Path("x.ulg"),

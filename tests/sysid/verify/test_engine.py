@@ -193,7 +193,9 @@ def conditioned(flight: SimulatedFlight, name: str) -> ConditionedFlight:
     table = pd.DataFrame(columns, index=pd.Index(flight.time_s, name="time_s"))
     trim = table[hover_mask(flight.time_s, flight.maneuvers)].mean()  # over the whole hover, as conditioning does
     trim_values = {str(k): float(v) for k, v in trim.items()}
-    record = Record(table=table - trim, units=UNITS, trim=trim_values, source=Path(f"{name}.ulg"), label="piece 1 of 1")
+    record = Record.from_table(
+        table - trim, units=UNITS, trim=trim_values, source=Path(f"{name}.ulg"), label="piece 1 of 1"
+    )
     segments = tuple(
         Segment(axis=m.axis, kind="doublet", start_s=m.start_s, end_s=m.end_s, source="user") for m in flight.maneuvers
     )
@@ -238,8 +240,8 @@ def _block(models: Mapping[str, DelayedStateSpace]) -> DelayedStateSpace:
 def _record(columns: dict[str, np.ndarray], rate_hz: float = 100.0, units: Mapping[str, str] = UNITS) -> Record:
     n = len(next(iter(columns.values())))
     table = pd.DataFrame(columns, index=pd.Index(np.arange(n) / rate_hz, name="time_s"))
-    return Record(
-        table=table, units={c: units.get(c, "1") for c in columns}, trim={}, source=Path("test.ulg"), label="test"
+    return Record.from_table(
+        table, units={c: units.get(c, "1") for c in columns}, trim={}, source=Path("test.ulg"), label="test"
     )
 
 
