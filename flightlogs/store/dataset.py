@@ -44,7 +44,10 @@ from flightlogs.store.schema import open_schema, stamp_schema
 from flightlogs.writers.atomic import atomic_output
 from flightlogs.writers.jsonio import jsonable
 
-#: Every array's filter: LZF (in every h5py build) after byte shuffling; gzip took 2 s a 100 MB log.
+#: Time arrays' filter: LZF (in every h5py build) after byte shuffling; steady steps shrink well. Signal
+#: values are stored plain: measured on a 113 MB log's signals and records, LZF took 1.2 s of a 1.5 s
+#: write to save 38 % of the file, and most of that saving is had by storing in float32 the values the
+#: log held as float32 (:func:`_narrowed`), at no cost in time.
 _COMPRESSION: dict[str, Any] = {"compression": "lzf", "shuffle": True}
 
 __all__ = ["Dataset", "write_dataset", "read_dataset", "file_sha256", "SCHEMA_VERSION"]
@@ -204,7 +207,15 @@ def _write_log(group: h5py.Group, log: FlightLog) -> None:
         sub.attrs["unit"] = signal.unit
         sub.attrs["source"] = signal.source
         sub["time_s"] = times.dataset(signal.time_s)
-        sub.create_dataset("values", data=signal.values, **_COMPRESSION)
+        sub.create_dataset("values", data=_narrowed(signal.values))
+
+
+def _narrowed(values: np.ndarray) -> np.ndarray:
+    """`values` in float32 when that holds every one of them exactly (a log's float32 fields), else as they are."""
+    if values.dtype != np.float64:
+        return values
+    single = values.astype(np.float32)
+    return single if np.array_equal(single, values, equal_nan=True) else values
 
 
 def _read_log(group: h5py.Group) -> FlightLog:
@@ -212,7 +223,7 @@ def _read_log(group: h5py.Group) -> FlightLog:
         name: Signal(
             name=name,
             time_s=sub["time_s"][()],
-            values=sub["values"][()],
+            values=sub["values"][()].astype(np.float64, copy=False),
             unit=str(sub.attrs["unit"]),
             source=str(sub.attrs["source"]),
         )
@@ -341,7 +352,7 @@ def _write_conditioned(group: h5py.Group, flight: Any) -> None:
         sub.attrs["trim"] = json.dumps(dict(record.trim))
         sub.create_dataset("time_s", data=record.time_s)
         for name in record.signals:
-            sub.create_dataset(name, data=record[name], **_COMPRESSION)
+            sub.create_dataset(name, data=record[name])
 
 
 def _read_conditioned(group: h5py.Group) -> Any:

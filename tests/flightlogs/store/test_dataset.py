@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 from pathlib import Path
 
@@ -58,6 +59,23 @@ def test_round_trip_keeps_every_value(tmp_path: Path) -> None:
     assert dataset.sha256[str(source)] == hashlib.sha256(b"raw bytes").hexdigest()
     with h5py.File(out) as h5:
         assert sorted(h5["logs"]) == ["flight", "flight_2"]
+
+
+def test_values_a_log_held_in_float32_are_stored_in_float32_and_read_back_in_float64(tmp_path: Path) -> None:
+    log = _log(tmp_path / "flight.ulg")
+    single = np.float32(np.random.default_rng(3).normal(size=250)).astype(np.float64)  # float32 values, in float64
+    signals = dict(log.signals) | {
+        "p": Signal(name="p", time_s=log["motor_1"].time_s, values=single, unit="rad/s", source="x")
+    }
+    out = tmp_path / "set.h5"
+    write_dataset(out, [dataclasses.replace(log, signals=signals)])
+    with h5py.File(out) as h5:
+        stored = {name: h5[f"logs/flight/signals/{name}/values"].dtype for name in ("p", "q", "motor_1")}
+    assert stored == {"p": np.float32, "q": np.float64, "motor_1": np.float64}  # q and motor_1 need float64
+    back = read_dataset(out).logs[0]
+    for name, signal in signals.items():
+        assert back[name].values.dtype == np.float64
+        np.testing.assert_array_equal(back[name].values, signal.values)
 
 
 def test_unknown_utc_round_trips_as_none(tmp_path: Path) -> None:
