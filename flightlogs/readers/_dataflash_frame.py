@@ -17,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 from pymavlink.DFReader import FORMAT_TO_STRUCT, DFFormat
@@ -102,13 +102,12 @@ def frame_messages(buf: np.ndarray, path: Path) -> tuple[list[tuple[str, Message
     lengths), so the walk is repeated until the two agree (once, in practice).
     """
     heads = _header_candidates(buf)
-    parsed = {
-        d.offset: d for d in _parse_fmts(buf, heads[(buf[heads + 2] == FMT_TYPE) & (heads + _FMT.len <= buf.size)])
-    }
+    types = buf[heads + 2]
+    parsed = {d.offset: d for d in _parse_fmts(buf, heads[(types == FMT_TYPE) & (heads <= buf.size - _FMT.len)])}
     on_chain = {o for o, d in parsed.items() if d.decodable and d.fmt.name.isprintable() and d.fmt.name}
     for _ in range(6):
         by_type = _by_type([parsed[o] for o in sorted(on_chain) if o in parsed])
-        starts, ends, decodes = _walk(buf, heads, by_type)
+        starts, ends, decodes = _walk(heads, types, by_type)
         found = set(starts[buf[starts + 2] == FMT_TYPE].tolist())
         if found == on_chain:
             break
@@ -131,7 +130,12 @@ def _header_candidates(buf: np.ndarray) -> np.ndarray:
         block = buf[lo : min(lo + _SCAN_BLOCK, buf.size - 2) + 1]  # one byte more: the pair's second byte
         first = np.flatnonzero(block[:-1] == HEAD1)
         found.append(first[block[first + 1] == HEAD2] + lo)
-    return np.concatenate(found).astype(np.int64, copy=False)
+    return np.concatenate(found).astype(offset_dtype(buf.size), copy=False)
+
+
+def offset_dtype(size: int) -> type[np.signedinteger[Any]]:
+    """Byte offsets into `size` bytes: int32 (half the memory) when they fit, with room for a message's length."""
+    return np.int32 if size < 2**31 - 2**16 else np.int64
 
 
 def _by_type(defs: list[_Definition]) -> dict[int, list[_Definition]]:
@@ -143,7 +147,7 @@ def _by_type(defs: list[_Definition]) -> dict[int, list[_Definition]]:
 
 
 def _walk(
-    buf: np.ndarray, heads: np.ndarray, by_type: dict[int, list[_Definition]]
+    heads: np.ndarray, types: np.ndarray, by_type: dict[int, list[_Definition]]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Start, end and decodability of each message, stepping as DFReader does.
 
@@ -151,8 +155,7 @@ def _walk(
     type>`` at or after its end. The Python loop turns once per
     discontinuity (garbage, a header inside a payload), not per message.
     """
-    types = buf[heads + 2]
-    lenmap, okmap = np.zeros(256, np.int64), np.zeros(256, bool)
+    lenmap, okmap = np.zeros(256, heads.dtype), np.zeros(256, bool)
     for type_id, defs in by_type.items():
         lenmap[type_id], okmap[type_id] = defs[-1].fmt.length if defs[-1].decodable else 3, defs[-1].decodable
     lengths, decodes = lenmap[types], okmap[types]
@@ -163,23 +166,20 @@ def _walk(
             lengths[sel] = np.array([d.fmt.length if d.decodable else 3 for d in defs])[which]
             decodes[sel] = np.array([d.decodable for d in defs])[which]
     known = lengths > 0
-    cand, ends, decodes = heads[known], heads[known] + lengths[known], decodes[known]
-    nxt = np.arange(1, cand.size + 1)
+    cand, ends, decodes = heads[known], heads[known], decodes[known]
+    ends += lengths[known]
+    del lengths, known
     jump = np.flatnonzero(ends[:-1] != cand[1:])  # usually a message ends where the next begins
-    nxt[jump] = np.searchsorted(cand, ends[jump])
+    resume = np.searchsorted(cand, ends[jump])  # where the walk goes on after each jump
     breaks = jump.tolist()
-    starts, stops, i = [], [], 0
-    while i < cand.size:
+    on_chain = np.zeros(cand.size, bool)
+    i = 0
+    while i < cand.size:  # a run of contiguous messages from i to the next break, then a jump
         k = bisect.bisect_left(breaks, i)
         j = breaks[k] if k < len(breaks) else cand.size - 1
-        starts.append(i)
-        stops.append(j)
-        i = int(nxt[j]) if k < len(breaks) else cand.size
-    mark = np.zeros(cand.size + 1, np.int64)
-    np.add.at(mark, np.array(starts, np.int64), 1)
-    np.add.at(mark, np.array(stops, np.int64) + 1, -1)
-    chain = np.flatnonzero(np.cumsum(mark[:-1]) > 0)
-    return cand[chain], ends[chain], decodes[chain]
+        on_chain[i : j + 1] = True
+        i = int(resume[k]) if k < len(breaks) else cand.size
+    return cand[on_chain], ends[on_chain], decodes[on_chain]
 
 
 def _account(
@@ -218,12 +218,10 @@ def _layouts(
 ) -> list[tuple[str, MessageFormat, np.ndarray]]:
     """Group message offsets by layout (name, format, columns) under their table key."""
     types = buf[offsets + 2]
-    order = np.argsort(types, kind="stable")
-    present, first = np.unique(types[order], return_index=True)
     layouts: dict[tuple[str, str, tuple[str, ...]], list[np.ndarray]] = {}
     formats: dict[tuple[str, str, tuple[str, ...]], MessageFormat] = {}
-    for type_id, lo, hi in zip(present.tolist(), first.tolist(), [*first[1:].tolist(), order.size]):
-        sel, defs = offsets[order[lo:hi]], by_type[type_id]
+    for type_id in np.flatnonzero(np.bincount(types, minlength=256)).tolist():
+        sel, defs = offsets[types == type_id], by_type[type_id]
         pieces = [(defs[0], sel)]
         if len(defs) > 1:  # the FMT in force for each message (the last one before any FMT)
             which = np.searchsorted([d.offset for d in defs], sel) - 1

@@ -83,7 +83,7 @@ class MessageTable:
     columns : Mapping[str, ndarray]
         Values by column name, shape ``(n,)`` (``(n, 32)`` for ``a``), with
         multipliers applied as DFReader applies them.
-    offsets : ndarray of int64, shape (n,)
+    offsets : ndarray of int32 (int64 in files over 2 GB), shape (n,)
         Byte offset of each message in the file, increasing.
     """
 
