@@ -13,9 +13,9 @@ read_log``): :mod:`flightlogs.readers`, :mod:`flightlogs.writers`,
 :mod:`flightlogs.store`; ``flightlogs.readers`` loads one on first use.
 """
 
-import importlib as _importlib
 from typing import TYPE_CHECKING as _TYPE_CHECKING
 
+from flightlogs._lazy import lazy_names as _lazy_names
 from flightlogs.errors import (
     CollectedWarnings,
     DataError,
@@ -91,13 +91,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> object:
-    if name in _SUBPACKAGES:  # scipy's pattern: subpackages load on first use, not with the package
-        return _importlib.import_module(f"{__name__}.{name}")
-    if name in _LAZY:
-        return getattr(_importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_SUBPACKAGES) | set(_LAZY))
+__getattr__, __dir__ = _lazy_names(__name__, _LAZY, _SUBPACKAGES)

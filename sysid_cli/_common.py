@@ -93,6 +93,9 @@ def progress_bar(
     whole steps (trials, stages, files). The bar appears only on a terminal
     and only once work has lasted about a second.
     """
+    if quiet or not sys.stderr.isatty():  # no bar to draw: tqdm is not even loaded
+        yield lambda _done, _total: None
+        return
     from tqdm import tqdm
 
     bytes_ = unit == "bytes"

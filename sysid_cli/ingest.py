@@ -127,7 +127,6 @@ def ingest(
     canonical signal with its rate, unit and source, align the anemometer wind, and find the maneuvers."""
     from flightlogs.conditioning.condition import ConditioningOptions
     from flightlogs.store.campaign import ingest_campaign
-    from flightlogs.store.dataset import write_dataset
 
     if estimate_wind_offset and estimate_transport_delay:
         raise click.UsageError("--estimate-wind-offset and --estimate-transport-delay shift the wind alike; pick one")
@@ -151,6 +150,8 @@ def ingest(
             progress=lambda _name, done, total: bar(done, total),
         )
     if out is not None:
+        from flightlogs.store.dataset import write_dataset  # h5py: loaded only to write
+
         campaign.require_flights()  # no dataset without a flight in it; some not conditioned: warned below
         write_dataset(out, campaign.logs, campaign.winds, list(campaign.flights))
     summary = _summary(campaign, out)

@@ -32,6 +32,8 @@ from typing import cast
 
 import numpy as np
 
+from flightlogs.maneuvers._rank import median
+
 __all__: list[str] = []
 
 _KNOT_S = 1.0  # nuisance B-spline knot spacing, s: slower than any doublet edge, faster than the outer loops
@@ -146,7 +148,7 @@ def _candidate(
         return None
     amplitudes = inverse @ (projected.T @ resid)
     left = resid - projected @ amplitudes
-    sigma = max(1.4826 * float(np.median(np.abs(left - np.median(left)))), 1e-12 * float(np.max(np.abs(u)) + 1.0))
+    sigma = max(1.4826 * median(np.abs(left - median(left))), 1e-12 * float(np.max(np.abs(u)) + 1.0))
     z = np.abs(amplitudes) / (sigma * np.sqrt(np.diag(inverse)))
     excitation = pulses @ amplitudes + left
     lo, hi = min(burst[0], first), max(burst[1], int(edges[-1]) - 1)

@@ -1,14 +1,17 @@
-"""Spearman's rank correlation without importing scipy.stats (which takes longer to load than a log to read).
+"""Rank statistics of 1-D samples: Spearman's correlation, the median and quantiles.
 
-Equal to ``scipy.stats.spearmanr(x, y).statistic`` for 1-D finite data, ties given their average rank
-(tests/flightlogs/maneuvers/test_rank.py compares them).
+:func:`spearman` equals ``scipy.stats.spearmanr(x, y).statistic`` for 1-D finite data, ties given
+their average rank, without importing scipy.stats (which takes longer to load than a log to read).
+:func:`median` and :func:`quantile` equal ``np.median`` and ``np.quantile`` (linear) bit for bit on
+1-D finite data, at a tenth of their cost on the short traces the edge search takes them of
+hundreds of times (numpy's generic machinery costs more than the partition). The tests compare them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["spearman"]
+__all__ = ["median", "quantile", "spearman"]
 
 
 def spearman(x: np.ndarray, y: np.ndarray) -> float:
@@ -38,3 +41,39 @@ def _ranks(values: np.ndarray) -> np.ndarray:
     ranks = np.empty(values.size)
     ranks[order] = average[group]
     return ranks
+
+
+def median(x: np.ndarray) -> float:
+    """``float(np.median(x))`` of a 1-D finite sample (n >= 1).
+
+    Parameters
+    ----------
+    x : ndarray, shape (n,)
+        Finite values.
+    """
+    n = x.size
+    if n % 2:
+        return float(np.partition(x, n // 2)[n // 2])
+    low, high = np.partition(x, [n // 2 - 1, n // 2])[n // 2 - 1 : n // 2 + 1]
+    return float((low + high) / 2)
+
+
+def quantile(x: np.ndarray, q: float) -> float:
+    """``float(np.quantile(x, q))`` (linear interpolation) of a 1-D finite sample (n >= 1).
+
+    Parameters
+    ----------
+    x : ndarray, shape (n,)
+        Finite values.
+    q : float
+        Quantile, 0 to 1.
+    """
+    n = x.size
+    virtual = (n - 1) * q  # numpy's virtual index of the linear method
+    if virtual >= n - 1:
+        return float(np.max(x))
+    below = int(np.floor(virtual))
+    gamma = virtual - below
+    low, high = np.partition(x, [below, below + 1])[below : below + 2]
+    step = high - low
+    return float(high - step * (1 - gamma) if gamma >= 0.5 else low + step * gamma)  # numpy's _lerp

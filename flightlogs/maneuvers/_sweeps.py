@@ -119,11 +119,29 @@ def find_sweeps(t: np.ndarray, dt: float, traces: Mapping[str, Mapping[str, np.n
     found: list[FoundSweep] = []
     for axis, named in traces.items():
         ridge = ridges[axis]
-        for run in _runs(_pieces(ridge, step * dt), step * dt):
-            found += [
-                _found(axis, ridge, kind, chain, step, dt, named) for kind, chain in _tones(ridge, run, step * dt)
-            ]
+        tones = [tone for run in _runs(_pieces(ridge, step * dt), step * dt) for tone in _tones(ridge, run, step * dt)]
+        if tones:  # each trace's activity, once for all the axis's sweeps
+            activity = _Activities(named, dt)
+            found += [_found(axis, ridge, kind, chain, step, dt, activity) for kind, chain in tones]
     return sorted(_owned(found), key=lambda s: s.first)
+
+
+class _Activities:
+    """The activity and bursts of each trace of one axis, computed once for all its sweeps' edges.
+
+    A trace held exactly constant outside the maneuver (a setpoint before
+    take-off) has no noise to measure its edges against: the trend's tails
+    pass for activity there. Held traces are used only if every trace is held.
+    """
+
+    def __init__(self, named: Mapping[str, np.ndarray], dt: float) -> None:
+        activities = {name: _activity(x, dt, _THRESHOLD, _TREND_S) for name, x in named.items()}
+        noisy = {name: act for name, act in activities.items() if act.sigma > _HELD * np.max(np.abs(act.detrended))}
+        self.used = noisy or activities
+        self.bursts = {
+            name: _bursts(name, act, dt, _THRESHOLD, _BURST_MERGE_S, _MIN_ACTIVE_S) for name, act in self.used.items()
+        }
+        self.n = next(iter(named.values())).size
 
 
 def _ridge(named: Mapping[str, np.ndarray], dt: float, freqs: np.ndarray, step: int) -> _Ridge:
@@ -285,13 +303,12 @@ def _found(
     chain: list[tuple[int, int]],
     step: int,
     dt: float,
-    named: Mapping[str, np.ndarray],
+    activity: _Activities,
 ) -> FoundSweep:
     a, b = chain[0][0], chain[-1][1]
     frames = np.concatenate([np.arange(lo, hi) for lo, hi in chain])
     rho = spearman(frames, np.log(ridge.freq_hz[frames]))
-    n = next(iter(named.values())).size
-    first, last = _time_edges(named, a * step, min((b - 1) * step, n - 1), dt)
+    first, last = _time_edges(activity, a * step, min((b - 1) * step, activity.n - 1), dt)
     counts = np.bincount(ridge.trace[frames], minlength=len(ridge.names))
     return FoundSweep(
         axis=axis,
@@ -306,24 +323,12 @@ def _found(
     )
 
 
-def _time_edges(named: Mapping[str, np.ndarray], i0: int, i1: int, dt: float) -> tuple[int, int]:
-    """Earliest start and latest end, over the traces, of the activity overlapping samples [i0, i1].
-
-    A trace held exactly constant outside the maneuver (a setpoint before
-    take-off) has no noise to measure its edges against: the trend's tails
-    pass for activity there. It is used only if every trace is held.
-    """
-    n = next(iter(named.values())).size
-    window = (max(0, i0 - int(_EDGE_WINDOW_S / dt)), min(n - 1, i1 + int(_EDGE_WINDOW_S / dt)))
+def _time_edges(activity: _Activities, i0: int, i1: int, dt: float) -> tuple[int, int]:
+    """Earliest start and latest end, over the traces, of the activity overlapping samples [i0, i1]."""
+    window = (max(0, i0 - int(_EDGE_WINDOW_S / dt)), min(activity.n - 1, i1 + int(_EDGE_WINDOW_S / dt)))
     starts, ends = [], []
-    activities = {name: _activity(x, dt, _THRESHOLD, _TREND_S) for name, x in named.items()}
-    noisy = {name: act for name, act in activities.items() if act.sigma > _HELD * np.max(np.abs(act.detrended))}
-    for name, act in (noisy or activities).items():
-        bursts = [
-            burst
-            for burst in _bursts(name, act, dt, _THRESHOLD, _BURST_MERGE_S, _MIN_ACTIVE_S)
-            if burst.last >= i0 and burst.first <= i1
-        ]
+    for name, act in activity.used.items():
+        bursts = [burst for burst in activity.bursts[name] if burst.last >= i0 and burst.first <= i1]
         if bursts:
             lo, hi = _edges(act, min(b.first for b in bursts), max(b.last for b in bursts), dt, window, _THRESHOLD)
             starts.append(lo)

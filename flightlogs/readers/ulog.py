@@ -43,6 +43,10 @@ __all__ = ["read_ulog"]
 _ULOG_MAGIC = b"ULog\x01\x12\x35"
 _HEADER_BYTES = 16
 _MAX_PAYLOAD = 65535  # a ULog message payload is at most this long (16-bit size)
+_WHOLE_FILE_LIMIT = 1 << 30  # files up to this size are read into memory when their messages chain cleanly
+_MESSAGE_TYPES = frozenset(
+    getattr(ULog, name) for name in dir(ULog) if name.startswith("MSG_TYPE_") and isinstance(getattr(ULog, name), int)
+)
 _STALL_READS = 400_000  # reads with nothing new: pyulog loops (walking garbage re-reads < 2 * 65535)
 _MIN_UTC_US = 946_684_800_000_000  # 2000-01-01: GPS time before this is a receiver default
 _DOWNWARD = 25  # distance_sensor.orientation ROTATION_DOWNWARD_FACING
@@ -176,6 +180,47 @@ def _check_header(path: Path) -> int:
     return size
 
 
+class _WholeFile(io.BytesIO):
+    """A file read into memory whose messages chain cleanly to its end: pyulog reads it at C speed.
+
+    It answers what :class:`_TrackedFile` answers with nothing to report: no
+    zero tail, no cut, no stall.
+    """
+
+    def __init__(self, data: bytes) -> None:
+        super().__init__(data)
+        self.size = self.zero_start = self.end = self.furthest = len(data)
+        self.zero_tail = self.last_read_at = 0
+        self.searching = False
+        self.cut_at: int | None = None
+        self.stalled_at: int | None = None
+
+
+def _whole_if_clean(path: Path, size: int, progress: Callable[[int, int], None] | None) -> _WholeFile | None:
+    """The file in memory if every message, from the header on, is of a ULog type and the last ends at the end.
+
+    Such a file needs none of :class:`_TrackedFile`'s watching: no message is
+    cut, no zeros pad it, and pyulog never has to search for a sync marker.
+    Anything else (and files too large to hold twice) is read through the
+    tracked file.
+    """
+    if size > _WHOLE_FILE_LIMIT:
+        return None
+    data = path.read_bytes()
+    header = struct.Struct("<HB")
+    position, step = _HEADER_BYTES, max(size // 50, 1 << 16)
+    next_report = step
+    while position + 3 <= len(data):
+        length, kind = header.unpack_from(data, position)
+        if kind not in _MESSAGE_TYPES:
+            return None
+        position += 3 + length
+        if position >= next_report and progress is not None:
+            progress(min(position, size), size)
+            next_report = position + step
+    return _WholeFile(data) if position == len(data) else None
+
+
 class _TrackedFile:
     """A read-only file for pyulog: reports progress, notices a cut-off last message, and
     ends before a long zero-filled tail (which pyulog would walk one byte at a time)."""
@@ -248,7 +293,17 @@ def _zero_tail(stream: Any, size: int) -> int:
     return run
 
 
-class _CountingULog(ULog):  # type: ignore[misc]
+class _PlainULog(ULog):  # type: ignore[misc]
+    """pyulog's reader as it is, with the damage counters of :class:`_CountingULog` at zero (a clean file)."""
+
+    def __init__(self, log_file: _TrackedFile | _WholeFile) -> None:
+        self.skipped: dict[str | int, int] = {}  # topic name (wrong size) or unknown msg id
+        self.skipped_bytes = 0
+        self.resyncs = 0
+        super().__init__(log_file, disable_str_exceptions=True)
+
+
+class _CountingULog(_PlainULog):
     """pyulog's reader, counting the messages and bytes it skips (pyulog only sets a flag)."""
 
     class _MessageData(ULog._MessageData):  # type: ignore[misc]
@@ -261,12 +316,9 @@ class _CountingULog(ULog):  # type: ignore[misc]
                 ulog_object.skipped[key] = ulog_object.skipped.get(key, 0) + 1
             return corrupt
 
-    def __init__(self, log_file: _TrackedFile) -> None:
-        self.skipped: dict[str | int, int] = {}  # topic name (wrong size) or unknown msg id
-        self.skipped_bytes = 0
-        self.resyncs = 0
+    def __init__(self, log_file: _TrackedFile | _WholeFile) -> None:
         self._last_skip = -1
-        super().__init__(log_file, disable_str_exceptions=True)
+        super().__init__(log_file)
 
     def _find_sync(self, last_n_bytes: int = -1) -> bool:
         start = self._file_handle.tell()
@@ -291,35 +343,57 @@ class _CountingULog(ULog):  # type: ignore[misc]
 
 
 def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None) -> ULog:
-    """Run pyulog with its prints and warnings captured as our warnings; turn its errors into LogFormatError."""
+    """Run pyulog with its prints and warnings captured as our warnings; turn its errors into LogFormatError.
+
+    A file whose messages chain cleanly is parsed in memory by pyulog as it is;
+    one that pyulog then finds corrupt, or whose chain is not clean, is parsed
+    again through :class:`_TrackedFile` with the damage counted.
+    """
+    whole = _whole_if_clean(path, size, progress)
+    if whole is not None:
+        ulog, tracked, said = _run_pyulog(path, _PlainULog, whole)
+        if not ulog.file_corruption:
+            return _reported(ulog, tracked, said, size, path)
     tracked = _TrackedFile(path, size, progress)
+    return _reported(*_run_pyulog(path, _CountingULog, tracked), size, path)
+
+
+def _run_pyulog(
+    path: Path, kind: type[_PlainULog], source: _TrackedFile | _WholeFile
+) -> tuple[_PlainULog, _TrackedFile | _WholeFile, list[str]]:
+    """pyulog's parse of `source`, and what it printed or warned."""
     printed = io.StringIO()
     try:
         with contextlib.redirect_stdout(printed), _warnings.catch_warnings(record=True) as caught:
             _warnings.simplefilter("always")
-            ulog = _CountingULog(tracked)
+            ulog = kind(source)
     except ULogIncompatibleFlagException as err:
         raise LogFormatError(f"{path}: uses a ULog extension pyulog cannot read ({err}).") from err
     except _PYULOG_ERRORS as err:
         raise LogFormatError(
-            f"{path}: damaged beyond reading near byte {tracked.furthest} ({type(err).__name__}: {err})."
+            f"{path}: damaged beyond reading near byte {source.furthest} ({type(err).__name__}: {err})."
         ) from err
     finally:
-        tracked.close()
+        source.close()
+    said = [line.strip() for line in printed.getvalue().splitlines() if line.strip()]
+    said += [str(w.message) for w in caught if not issubclass(w.category, DeprecationWarning)]
+    return ulog, source, said
+
+
+def _reported(ulog: _PlainULog, tracked: _TrackedFile | _WholeFile, said: list[str], size: int, path: Path) -> ULog:
+    """`ulog`, after warning of the damage read past, the dropouts and pyulog's own complaints."""
     for note in _damage_notes(ulog, tracked, size, path.name):
         _warnings.warn(LogCorruptionWarning(note), stacklevel=2)
     if ulog.dropouts:
         lost_ms = sum(int(dropout.duration) for dropout in ulog.dropouts)
         message = f"{len(ulog.dropouts)} logging dropout(s): the logger lost {lost_ms} ms of data"
         _warnings.warn(DataQualityWarning(message), stacklevel=2)
-    said = [line.strip() for line in printed.getvalue().splitlines() if line.strip()]
-    said += [str(w.message) for w in caught if not issubclass(w.category, DeprecationWarning)]
     for text in said:
         _warnings.warn(LogCorruptionWarning(f"pyulog: {text}"), stacklevel=2)
     return ulog
 
 
-def _damage_notes(ulog: _CountingULog, tracked: _TrackedFile, size: int, name: str) -> list[str]:
+def _damage_notes(ulog: _PlainULog, tracked: _TrackedFile | _WholeFile, size: int, name: str) -> list[str]:
     """Sentences saying what pyulog skipped, from our counters and its flag."""
     notes = []
     if tracked.stalled_at is not None:

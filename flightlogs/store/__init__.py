@@ -2,13 +2,19 @@
 
 The public names of :mod:`~flightlogs.store.campaign`, :mod:`~flightlogs.store.dataset`,
 :mod:`~flightlogs.store.schema` and :mod:`~flightlogs.store.summary` are re-exported here: write
-``from flightlogs.store import name``. Modules with a leading underscore are private.
+``from flightlogs.store import name``. Modules with a leading underscore are private. Each name loads
+its module on first use (the dataset loads h5py).
 """
 
-from flightlogs.store.campaign import Campaign, expand_wind_paths, ingest_campaign
-from flightlogs.store.dataset import SCHEMA_VERSION, Dataset, file_sha256, read_dataset, write_dataset
-from flightlogs.store.schema import open_schema, software_version, stamp_schema
-from flightlogs.store.summary import conditioned_summary, log_summary, wind_summary
+from typing import TYPE_CHECKING
+
+from flightlogs._lazy import lazy_names
+
+if TYPE_CHECKING:
+    from flightlogs.store.campaign import Campaign, expand_wind_paths, ingest_campaign
+    from flightlogs.store.dataset import SCHEMA_VERSION, Dataset, file_sha256, read_dataset, write_dataset
+    from flightlogs.store.schema import open_schema, software_version, stamp_schema
+    from flightlogs.store.summary import conditioned_summary, log_summary, wind_summary
 
 __all__ = [
     "Campaign",
@@ -26,3 +32,11 @@ __all__ = [
     "wind_summary",
     "conditioned_summary",
 ]
+
+_HOMES = {
+    **dict.fromkeys(("Campaign", "expand_wind_paths", "ingest_campaign"), "campaign"),
+    **dict.fromkeys(("SCHEMA_VERSION", "Dataset", "file_sha256", "read_dataset", "write_dataset"), "dataset"),
+    **dict.fromkeys(("open_schema", "software_version", "stamp_schema"), "schema"),
+    **dict.fromkeys(("conditioned_summary", "log_summary", "wind_summary"), "summary"),
+}
+__getattr__, __dir__ = lazy_names(__name__, _HOMES)

@@ -8,6 +8,8 @@ writer imports pymavlink's tables): ``import flightlogs.writers.jsonio`` stays l
 
 from typing import TYPE_CHECKING
 
+from flightlogs._lazy import lazy_names
+
 if TYPE_CHECKING:
     from flightlogs.writers.atomic import atomic_output
     from flightlogs.writers.dataflash import (
@@ -56,13 +58,4 @@ _HOMES = {
 }
 
 
-def __getattr__(name: str) -> object:
-    if name in _HOMES:
-        import importlib
-
-        return getattr(importlib.import_module(f"{__name__}.{_HOMES[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_HOMES))
+__getattr__, __dir__ = lazy_names(__name__, _HOMES)

@@ -602,3 +602,21 @@ def test_the_estimator_position_wins_over_the_receiver(tmp_path: Path) -> None:
     log = read_ulog(_synthetic(tmp_path / "both.ulg", topics, {}))
     assert log["longitude"].source == "vehicle_global_position[0].lon (deg→rad)"  # no lat_lon_valid: all valid
     np.testing.assert_array_equal(log["longitude"].values, np.deg2rad(20.5))
+
+
+@pytest.mark.parametrize("name", [QUAD, OLD])
+def test_a_clean_file_read_in_memory_equals_the_tracked_read(
+    real_data: Path, name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import flightlogs.readers.ulog as ulog_module
+
+    path = real_data / name
+    assert ulog_module._whole_if_clean(path, path.stat().st_size, None) is not None  # the fast path is taken
+    fast = read_warned(read_ulog, path)
+    monkeypatch.setattr(ulog_module, "_whole_if_clean", lambda *_: None)
+    tracked = read_warned(read_ulog, path)
+    assert fast.warnings == tracked.warnings and fast.vehicle == tracked.vehicle
+    assert dict(fast.parameters) == dict(tracked.parameters) and list(fast.signals) == list(tracked.signals)
+    for signal_name, signal in tracked.signals.items():
+        np.testing.assert_array_equal(fast.signals[signal_name].time_s, signal.time_s)
+        np.testing.assert_array_equal(fast.signals[signal_name].values, signal.values)
