@@ -107,17 +107,25 @@ def convolve_valid(x: np.ndarray, taps: np.ndarray) -> np.ndarray:
     return cast(np.ndarray, full[m - 1 : n])
 
 
-def interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: str) -> np.ndarray:
-    """Evaluate the chosen interpolant through (t, v) at times `at` inside [t[0], t[-1]]; `v` (n,) or (n, k)."""
+def interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: str, out: np.ndarray | None = None) -> np.ndarray:
+    """Evaluate the chosen interpolant through (t, v) at times `at` inside [t[0], t[-1]]; `v` (n,) or (n, k).
+
+    Into `out` (shaped as the result) when given.
+    """
     if method == "linear" or t.size < 3:
         if v.ndim == 1:
-            return cast(np.ndarray, np.interp(at, t, v))
-        return np.column_stack([np.interp(at, t, column) for column in v.T])
+            result = np.interp(at, t, v)
+        else:
+            result = np.column_stack([np.interp(at, t, column) for column in v.T])
+        if out is None:
+            return cast(np.ndarray, result)
+        out[...] = result
+        return out
     if method in ("spline", "pchip"):
         columns = v if v.ndim == 2 else v[:, None]
         slopes = spline_slopes(t, columns) if method == "spline" else pchip_slopes(t, columns)
-        out = hermite(t, columns, slopes, at)
-        return out if v.ndim == 2 else out[:, 0]
+        values = hermite(t, columns, slopes, at, None if out is None else out if out.ndim == 2 else out[:, None])
+        return values if v.ndim == 2 else values[:, 0]
     raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
 
 

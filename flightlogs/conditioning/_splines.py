@@ -14,6 +14,8 @@ import numpy as np
 
 __all__: list[str] = []  # private to flightlogs.conditioning
 
+_CHUNK = 1 << 15  # points evaluated at a time
+
 
 def spline_slopes(t: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Slopes of the not-a-knot cubic spline through (t, v) at the knots: ``CubicSpline(t, v).derivative()(t)``.
@@ -80,25 +82,35 @@ def pchip_slopes(t: np.ndarray, v: np.ndarray) -> np.ndarray:
     return d
 
 
-def hermite(t: np.ndarray, v: np.ndarray, slopes: np.ndarray, at: np.ndarray) -> np.ndarray:
+def hermite(
+    t: np.ndarray, v: np.ndarray, slopes: np.ndarray, at: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
     """The cubic Hermite interpolant of values `v` and `slopes` (shape (n, k)) on knots `t` (n,), at `at` (m,): (m, k).
 
-    Points outside [t[0], t[-1]] extend the end pieces.
+    Points outside [t[0], t[-1]] extend the end pieces. Evaluated `_CHUNK`
+    points at a time (the temporaries stay small), into `out` when given.
     """
+    out = np.empty((at.size, v.shape[1])) if out is None else out
+    for lo in range(0, at.size, _CHUNK):
+        _hermite_into(t, v, slopes, at[lo : lo + _CHUNK], out[lo : lo + _CHUNK])
+    return out
+
+
+def _hermite_into(t: np.ndarray, v: np.ndarray, slopes: np.ndarray, at: np.ndarray, out: np.ndarray) -> None:
     j = np.clip(np.searchsorted(t, at, side="right") - 1, 0, t.size - 2)
     h = (t[j + 1] - t[j])[:, None]
     s = (at - t[j])[:, None] / h
     y0 = v.take(j, axis=0)
     rise = v.take(j + 1, axis=0) - y0
     d0 = slopes.take(j, axis=0) * h
-    out = slopes.take(j + 1, axis=0) * h  # in Horner form: y0 + s (d0 + s (c2 + s c3))
-    out += d0
-    out -= 2 * rise  # c3 = d0 + d1 - 2 (y1 - y0)
-    c2 = rise - d0 - out  # = 3 (y1 - y0) - 2 d0 - d1
+    c3 = slopes.take(j + 1, axis=0) * h  # in Horner form: y0 + s (d0 + s (c2 + s c3))
+    c3 += d0
+    c3 -= 2 * rise  # c3 = d0 + d1 - 2 (y1 - y0)
+    c2 = rise - d0 - c3  # = 3 (y1 - y0) - 2 d0 - d1
+    out[...] = c3
     for term in (c2, d0, y0):
         out *= s
         out += term
-    return cast(np.ndarray, out)
 
 
 def _pchip_end(h0: np.ndarray, h1: np.ndarray, m0: np.ndarray, m1: np.ndarray) -> np.ndarray:

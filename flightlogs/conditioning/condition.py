@@ -663,23 +663,26 @@ def _record(
     segments: Sequence[Segment],
     label: str,
 ) -> Record:
-    inside = (time_base >= span[0] - 1e-9) & (time_base <= span[1] + 1e-9)
-    columns = {}
+    first = int(np.searchsorted(time_base, span[0] - 1e-9, side="left"))
+    stop = int(np.searchsorted(time_base, span[1] + 1e-9, side="right"))
+    columns, taken = {}, set()
     for name, column in values.items():
-        piece = column[inside]
+        # the record takes its piece of the conditioned values, not a copy: they are not used after it
+        piece = column[first:stop] if id(column) not in taken else column[first:stop].copy()
+        taken.add(id(column))
         if np.all(np.isfinite(piece)):
             columns[name] = piece
         else:
             message = f"{name}: not logged through {label} ({span[0]:.2f}-{span[1]:.2f} s); left out of it"
             warnings.warn(DataQualityWarning(message), stacklevel=2)
-    t = time_base[inside]
+    t = time_base[first:stop]
     quiet = np.zeros(t.size, dtype=bool)
     for segment in segments:
         if segment.kind == "hover":
             quiet |= (t >= segment.start_s) & (t <= segment.end_s)
     rows = quiet if quiet.sum() >= 10 else slice(None)
     trim = {}
-    for name, piece in columns.items():  # each piece is this record's own copy: the trim comes off in place
+    for name, piece in columns.items():  # each piece is this record's alone: the trim comes off in place
         trim[name] = float(np.mean(piece[rows]))
         piece -= trim[name]
     return Record(time_s=t, columns=columns, units=units, trim=trim, source=log.path, label=label)

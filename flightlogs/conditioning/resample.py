@@ -333,19 +333,20 @@ def _resample_columns(
     if method not in ("spline", "pchip", "linear"):
         raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
     dt_src = nominal_interval(t)
-    out = np.full((tb.size, v.shape[1]), np.nan)
+    out = np.full((v.shape[1], tb.size), np.nan).T  # (n_base, k), each column contiguous: the signals to come
     filter_needed = anti_alias and dt_target > _DOWNSAMPLE_MARGIN * dt_src
     for i0, i1 in piece_bounds(t, dt_src, max_gap_samples):
         pt, pv = t[i0:i1], v[i0:i1]
-        inside = (tb >= pt[0] - TIME_TOL_S) & (tb <= pt[-1] + TIME_TOL_S)
-        if not inside.any():
+        first = int(np.searchsorted(tb, pt[0] - TIME_TOL_S, side="left"))  # the base's samples inside the piece
+        stop = int(np.searchsorted(tb, pt[-1] + TIME_TOL_S, side="right"))
+        if stop <= first:
             continue
         if pt.size == 1:
-            out[inside] = pv[0]
+            out[first:stop] = pv[0]
             continue
         if filter_needed:
             pt, pv = lowpass(pt, pv, dt_src, 1.0 / dt_target)
-        out[inside] = interpolate(pt, pv, np.clip(tb[inside], pt[0], pt[-1]), method)
+        interpolate(pt, pv, np.clip(tb[first:stop], pt[0], pt[-1]), method, out[first:stop])
     return out
 
 

@@ -11,6 +11,7 @@ re-exported by :mod:`flightlogs.readers.dataflash`.
 from __future__ import annotations
 
 import bisect
+import mmap
 import struct
 import warnings
 from collections.abc import Callable
@@ -29,6 +30,7 @@ __all__ = ["MessageFormat"]
 HEAD1, HEAD2, FMT_TYPE = 0xA3, 0x95, 0x80
 LISTED = 8  # gaps or resets spelled out in warnings before summarising
 _SCAN_BLOCK = 1 << 22  # bytes compared at a time in the header scan
+_GATHER_BLOCK = 1 << 16  # messages copied at a time when the pages read are given back
 _FMT = DFFormat(FMT_TYPE, "FMT", 89, "BBnNZ", "Type,Length,Name,Format,Columns")  # as DFReader
 _NUMPY_CODE = {
     "b": "i1",
@@ -95,42 +97,74 @@ _FMT_DEF = _Definition(
 )
 
 
-def frame_messages(buf: np.ndarray, path: Path) -> tuple[list[tuple[str, MessageFormat, np.ndarray]], int]:
+Release = Callable[[int, int], None]
+"""Gives the pages of bytes ``[lo, hi)`` of a memory-mapped log back to the page cache, once read."""
+
+
+def mapped_log(path: Path) -> tuple[np.ndarray, Release]:
+    """The bytes of the file at `path`, memory-mapped read-only, and their :data:`Release`.
+
+    A page read is in the process's memory until it is released; the page
+    cache keeps it, so reading it again costs a minor fault, not a disk read.
+    """
+    with path.open("rb") as stream:
+        mapping = mmap.mmap(stream.fileno(), 0, access=mmap.ACCESS_READ)
+    advice = getattr(mmap, "MADV_DONTNEED", None)
+
+    def release(lo: int, hi: int) -> None:
+        first = -(-max(lo, 0) // mmap.PAGESIZE) * mmap.PAGESIZE  # whole pages inside [lo, hi) only
+        last = min(hi, len(mapping)) // mmap.PAGESIZE * mmap.PAGESIZE
+        if advice is not None and last > first and not mapping.closed:
+            mapping.madvise(advice, first, last - first)
+
+    return np.frombuffer(mapping, dtype=np.uint8), release
+
+
+def frame_messages(
+    buf: np.ndarray, path: Path, release: Release | None = None
+) -> tuple[list[tuple[str, MessageFormat, np.ndarray]], int]:
     """``(table key, format, offsets)`` of the messages DFReader would decode, per layout; bytes skipped.
 
     The FMT messages on the chain of messages define the chain (types and
     lengths), so the walk is repeated until the two agree (once, in practice).
     """
-    heads = _header_candidates(buf)
-    types = buf[heads + 2]
+    heads, types = _header_candidates(buf, release)
     parsed = {d.offset: d for d in _parse_fmts(buf, heads[(types == FMT_TYPE) & (heads <= buf.size - _FMT.len)])}
     on_chain = {o for o, d in parsed.items() if d.decodable and d.fmt.name.isprintable() and d.fmt.name}
     for _ in range(6):
         by_type = _by_type([parsed[o] for o in sorted(on_chain) if o in parsed])
-        starts, ends, decodes = _walk(heads, types, by_type)
-        found = set(starts[buf[starts + 2] == FMT_TYPE].tolist())
+        starts, ends, decodes, kinds = _walk(heads, types, by_type)
+        found = set(starts[kinds == FMT_TYPE].tolist())
         if found == on_chain:
             break
         on_chain = found
     if len(by_type) == 1:
         kind = "a text DataFlash log" if buf[:4].tobytes() == b"FMT," else "no DataFlash FMT message"
         raise LogFormatError(f"{path}: holds {kind} (searched {buf.size} bytes from byte offset 0).")
-    offsets, skipped = _account(buf, starts, ends, decodes, path)
-    return _layouts(buf, offsets, by_type, path), skipped
+    kept, skipped = _account(buf, starts, ends, decodes, path)
+    if release is not None:
+        release(0, buf.size)  # the FMT messages and the damage read: the pages go back
+    return _layouts(starts[kept], kinds[kept], by_type, path), skipped
 
 
-def _header_candidates(buf: np.ndarray) -> np.ndarray:
-    """Offsets of every ``A3 95`` pair followed by a byte, shape (n_candidates,), scanned a block at a time.
+def _header_candidates(buf: np.ndarray, release: Release | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Offset and type byte of every ``A3 95 <byte>``, shapes (n_candidates,), scanned a block at a time.
 
     One comparison over the whole file would take a temporary the size of the
-    file, and most of its time in faulting that memory in.
+    file, and most of its time in faulting that memory in. Each block's pages
+    are released once scanned.
     """
-    found = [np.empty(0, np.int64)]
+    found, kinds = [np.empty(0, np.int64)], [np.empty(0, np.uint8)]
     for lo in range(0, max(buf.size - 2, 0), _SCAN_BLOCK):
-        block = buf[lo : min(lo + _SCAN_BLOCK, buf.size - 2) + 1]  # one byte more: the pair's second byte
-        first = np.flatnonzero(block[:-1] == HEAD1)
-        found.append(first[block[first + 1] == HEAD2] + lo)
-    return np.concatenate(found).astype(offset_dtype(buf.size), copy=False)
+        end = min(lo + _SCAN_BLOCK, buf.size - 2)
+        block = buf[lo : end + 2]  # two bytes more: a last candidate's second byte and type
+        first = np.flatnonzero(block[: end - lo] == HEAD1)
+        first = first[block[first + 1] == HEAD2]
+        found.append(first + lo)
+        kinds.append(block[first + 2])
+        if release is not None:
+            release(lo, end)
+    return np.concatenate(found).astype(offset_dtype(buf.size), copy=False), np.concatenate(kinds)
 
 
 def offset_dtype(size: int) -> type[np.signedinteger[Any]]:
@@ -148,8 +182,8 @@ def _by_type(defs: list[_Definition]) -> dict[int, list[_Definition]]:
 
 def _walk(
     heads: np.ndarray, types: np.ndarray, by_type: dict[int, list[_Definition]]
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Start, end and decodability of each message, stepping as DFReader does.
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Start, end, decodability and type of each message, stepping as DFReader does.
 
     After a message, the next one is the first candidate ``A3 95 <known
     type>`` at or after its end. The Python loop turns once per
@@ -166,7 +200,7 @@ def _walk(
             lengths[sel] = np.array([d.fmt.length if d.decodable else 3 for d in defs])[which]
             decodes[sel] = np.array([d.decodable for d in defs])[which]
     known = lengths > 0
-    cand, ends, decodes = heads[known], heads[known], decodes[known]
+    cand, ends, decodes, kinds = heads[known], heads[known], decodes[known], types[known]
     ends += lengths[known]
     del lengths, known
     jump = np.flatnonzero(ends[:-1] != cand[1:])  # usually a message ends where the next begins
@@ -179,13 +213,13 @@ def _walk(
         j = breaks[k] if k < len(breaks) else cand.size - 1
         on_chain[i : j + 1] = True
         i = int(resume[k]) if k < len(breaks) else cand.size
-    return cand[on_chain], ends[on_chain], decodes[on_chain]
+    return cand[on_chain], ends[on_chain], decodes[on_chain], kinds[on_chain]
 
 
 def _account(
     buf: np.ndarray, starts: np.ndarray, ends: np.ndarray, decodes: np.ndarray, path: Path
 ) -> tuple[np.ndarray, int]:
-    """Offsets of the decodable, complete messages; the rest warned about (:class:`LogCorruptionWarning`)."""
+    """Which messages are decodable and complete (a mask over `starts`); the rest warned about (:class:`LogCorruptionWarning`)."""
     size, name = buf.size, path.name
     found = []
     if not decodes.all():
@@ -210,14 +244,13 @@ def _account(
     for message in found:
         warnings.warn(LogCorruptionWarning(message), stacklevel=2)
     skipped = int(gap_len.sum() + 3 * (~decodes).sum() + (size - starts[truncated]).sum())
-    return starts[decodes & ~truncated], skipped
+    return decodes & ~truncated, skipped
 
 
 def _layouts(
-    buf: np.ndarray, offsets: np.ndarray, by_type: dict[int, list[_Definition]], path: Path
+    offsets: np.ndarray, types: np.ndarray, by_type: dict[int, list[_Definition]], path: Path
 ) -> list[tuple[str, MessageFormat, np.ndarray]]:
-    """Group message offsets by layout (name, format, columns) under their table key."""
-    types = buf[offsets + 2]
+    """Group message offsets (with their type bytes) by layout (name, format, columns) under their table key."""
     layouts: dict[tuple[str, str, tuple[str, ...]], list[np.ndarray]] = {}
     formats: dict[tuple[str, str, tuple[str, ...]], MessageFormat] = {}
     for type_id in np.flatnonzero(np.bincount(types, minlength=256)).tolist():
@@ -280,12 +313,26 @@ def layout(fmt: str, length: int | None) -> tuple[np.dtype, tuple[str, ...]]:
     return np.dtype(spec), tuple(fmt)  # type: ignore[call-overload]
 
 
-def gather(buf: np.ndarray, offsets: np.ndarray, length: int) -> np.ndarray:
-    """Copy the `length` bytes at each offset into a contiguous ``(n, length)`` array."""
+def gather(buf: np.ndarray, offsets: np.ndarray, length: int, release: Release | None = None) -> np.ndarray:
+    """Copy the `length` bytes at each offset (increasing) into a contiguous ``(n, length)`` array.
+
+    With `release`, a block of offsets at a time, giving back the pages the
+    next block starts past.
+    """
     if offsets.size == 0 or buf.size < length:
         return np.empty((0, length), np.uint8)
     windows = np.ndarray((buf.size - length + 1, length), np.uint8, buffer=buf, strides=(1, 1))
-    return cast(np.ndarray, windows[offsets])
+    if release is None:
+        return cast(np.ndarray, windows[offsets])
+    out = np.empty((offsets.size, length), np.uint8)
+    done = 0
+    for lo in range(0, offsets.size, _GATHER_BLOCK):
+        part = offsets[lo : lo + _GATHER_BLOCK]
+        out[lo : lo + part.size] = windows[part]
+        reached = int(offsets[lo + part.size]) if lo + part.size < offsets.size else buf.size
+        release(done, reached)
+        done = reached
+    return out
 
 
 def strings(raw: np.ndarray, decode: Callable[[bytes], str]) -> np.ndarray:

@@ -53,9 +53,11 @@ from flightlogs.readers._dataflash_frame import (  # noqa: F401  (kept importabl
     HEAD2,
     LISTED,
     MessageFormat,
+    Release,
     frame_messages,
     gather,
     layout,
+    mapped_log,
     strings,
 )
 
@@ -235,10 +237,12 @@ def read_messages(
     """
     path = Path(path)
     try:
-        data = np.memmap(path, dtype=np.uint8, mode="r") if path.stat().st_size else np.empty(0, np.uint8)
-    except OSError as err:
-        raise LogFormatError(f"{path}: cannot be read ({err.strerror or err}) at byte offset 0.") from err
-    return decode_messages(data, path=path, types=types, progress=progress)
+        data, release = mapped_log(path) if path.stat().st_size else (np.empty(0, np.uint8), None)
+    except (OSError, ValueError) as err:
+        raise LogFormatError(
+            f"{path}: cannot be read ({getattr(err, 'strerror', None) or err}) at byte offset 0."
+        ) from err
+    return _decode(data, path, types, progress, release)
 
 
 def decode_messages(
@@ -288,12 +292,22 @@ def decode_messages(
     >>> decode_messages(encode_dataflash([block]))["ATT"]["Roll"]
     array([ 1.5 , -2.25])
     """
-    path = Path(path)
     buf = np.ascontiguousarray(
         np.frombuffer(data, dtype=np.uint8)
         if isinstance(data, (bytes, bytearray, memoryview))
         else np.asarray(data, dtype=np.uint8).ravel()
     )
+    return _decode(buf, Path(path), types, progress, None)
+
+
+def _decode(
+    buf: np.ndarray,
+    path: Path,
+    types: Collection[str] | None,
+    progress: Callable[[int, int], None] | None,
+    release: Release | None,
+) -> DataFlashMessages:
+    """:func:`decode_messages` of bytes in memory or (with `release`) memory-mapped from `path`."""
     size = int(buf.size)
     if size == 0:
         raise LogFormatError(f"{path}: the file is empty (no DataFlash message at byte offset 0).")
@@ -302,11 +316,11 @@ def decode_messages(
             f"{path}: is a PX4 ULog file, not an ArduPilot DataFlash log (ULog magic at byte offset 0)."
         )
     with collected_warnings() as caught:
-        groups, skipped = frame_messages(buf, path)
+        groups, skipped = frame_messages(buf, path, release)
         done = 0
         if progress is not None:
             progress(0, size)
-        meta = {k: _decode_table(buf, f, o) for k, f, o in groups if k in ("FMTU", "UNIT", "MULT")}
+        meta = {k: _decode_table(buf, f, o, release) for k, f, o in groups if k in ("FMTU", "UNIT", "MULT")}
         units = _unit_context(meta)
         tables: dict[str, MessageTable] = {}
         counts: dict[str, int] = {}
@@ -317,7 +331,7 @@ def decode_messages(
                 tables[key] = (
                     MessageTable(format=fmt, columns=meta[key].columns, offsets=offsets)
                     if key in meta
-                    else _decode_table(buf, fmt, offsets)
+                    else _decode_table(buf, fmt, offsets, release)
                 )
                 done += offsets.size * fmt.length
                 if progress is not None:
@@ -354,7 +368,7 @@ def message_dtype(fmt: str) -> np.dtype:
     return layout(fmt, None)[0]
 
 
-def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray) -> MessageTable:
+def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray, release: Release | None) -> MessageTable:
     _, chars = layout(fmt.format, fmt.length)
     names = fmt.columns[: len(chars)]
     if len(set(names)) != len(names) or len(fmt.columns) != len(chars):
@@ -363,7 +377,7 @@ def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray) -> M
             f"{fmt.columns}; as in DFReader, a repeated name keeps its last field."
         )
         warnings.warn(LogCorruptionWarning(message), stacklevel=2)
-    return MessageTable(format=fmt, columns=_LazyColumns(buf, fmt, offsets), offsets=offsets)
+    return MessageTable(format=fmt, columns=_LazyColumns(buf, fmt, offsets, release), offsets=offsets)
 
 
 class _LazyColumns(Mapping[str, np.ndarray]):
@@ -377,10 +391,16 @@ class _LazyColumns(Mapping[str, np.ndarray]):
     """
 
     def __init__(
-        self, buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray, decoded: dict[str, np.ndarray] | None = None
+        self,
+        buf: np.ndarray,
+        fmt: MessageFormat,
+        offsets: np.ndarray,
+        release: Release | None,
+        decoded: dict[str, np.ndarray] | None = None,
     ) -> None:
         dtype, chars = layout(fmt.format, fmt.length)
         self._buf: np.ndarray | None = buf
+        self._release = release
         self._fmt, self._offsets, self._dtype, self._chars = fmt, offsets, dtype, chars
         self._field = {name: i for i, name in enumerate(fmt.columns[: len(chars)])}  # a repeated name: its last
         self._decoded = decoded if decoded is not None else {}
@@ -390,7 +410,7 @@ class _LazyColumns(Mapping[str, np.ndarray]):
         column = self._decoded.get(name)
         if column is None:
             i = self._field[name]
-            column = _column(self._raw(f"f{i}"), self._chars[i], self._fmt.name)
+            column = _column(self._raw(f"f{i}"), self._chars[i], self._fmt.name, copy=False)  # numbers: views
             column.flags.writeable = False
             self._decoded[name] = column
         return column
@@ -405,7 +425,7 @@ class _LazyColumns(Mapping[str, np.ndarray]):
         i = self._field[name]
         base, at = fields[f"f{i}"][:2]
         one = np.dtype({"names": ["v"], "formats": [base], "offsets": [0], "itemsize": base.itemsize})
-        raw = gather(self._buf, self._offsets + at, base.itemsize).view(one).ravel()["v"]
+        raw = gather(self._buf, self._offsets + at, base.itemsize, self._release).view(one).ravel()["v"]
         column = _column(raw, self._chars[i], self._fmt.name)
         column.flags.writeable = False
         self._decoded[name] = column
@@ -414,7 +434,8 @@ class _LazyColumns(Mapping[str, np.ndarray]):
     def _raw(self, field: str) -> np.ndarray:
         if self._messages is None:
             assert self._buf is not None
-            self._messages = gather(self._buf, self._offsets, self._fmt.length).view(self._dtype).ravel()
+            messages = gather(self._buf, self._offsets, self._fmt.length, self._release)
+            self._messages = messages.view(self._dtype).ravel()
             self._buf = None  # the file is no longer needed by this table
         return self._messages[field]
 
@@ -432,9 +453,8 @@ class _LazyColumns(Mapping[str, np.ndarray]):
         decoded = {name: column[rows] for name, column in self._decoded.items()}
         for column in decoded.values():
             column.flags.writeable = False
-        picked = _LazyColumns(
-            self._buf if self._buf is not None else np.empty(0, np.uint8), self._fmt, self._offsets[rows], decoded
-        )
+        buf = self._buf if self._buf is not None else np.empty(0, np.uint8)
+        picked = _LazyColumns(buf, self._fmt, self._offsets[rows], self._release, decoded)
         if self._messages is not None:  # copied already: the picked ones from the copy
             picked._messages, picked._buf = self._messages[rows], None
         return picked
@@ -445,8 +465,8 @@ def _peek(table: MessageTable, column: str) -> np.ndarray:
     return table.columns.peek(column) if isinstance(table.columns, _LazyColumns) else table[column]
 
 
-def _column(raw: np.ndarray, char: str, message: str) -> np.ndarray:
-    """Convert one raw field to the values DFReader returns."""
+def _column(raw: np.ndarray, char: str, message: str, *, copy: bool = True) -> np.ndarray:
+    """Convert one raw field to the values DFReader returns; numbers kept as they are left a view unless `copy`."""
     mult = FORMAT_TO_STRUCT[char][1]
     if mult is not None:
         if 0.0 < mult < 1.0:  # DFReader divides by 1/mult for accuracy
@@ -456,7 +476,7 @@ def _column(raw: np.ndarray, char: str, message: str) -> np.ndarray:
         if message == "FILE" and char == "Z":
             return np.array([bytes(v).ljust(raw.dtype.itemsize, b"\0") for v in raw.tolist()], dtype=object)
         return strings(raw, _df_string)
-    return np.ascontiguousarray(raw)
+    return np.ascontiguousarray(raw) if copy else raw
 
 
 def _df_string(value: bytes) -> str:

@@ -80,6 +80,28 @@ def test_every_field_of_every_message_equals_dfreader(real_data: Path, where: tu
     assert_same_as_dfreader(ours, path)
 
 
+@pytest.mark.parametrize("where", [SAMPLE, LOG171], ids=lambda w: w[1])
+def test_a_mapped_file_giving_its_pages_back_decodes_as_the_bytes_in_memory(real_data: Path, where) -> None:
+    path = real_data.joinpath(*where)
+    mapped, in_memory = read_messages(path), decode_messages(path.read_bytes())
+    assert list(mapped.tables) == list(in_memory.tables) and mapped.counts == in_memory.counts
+    for name in mapped.tables:  # instances split first, then every column: the pages go and come back
+        assert mapped.instances(name).keys() == in_memory.instances(name).keys()
+    assert_tables_equal(mapped, in_memory)
+
+
+def test_gathering_a_block_at_a_time_with_release_copies_the_same_bytes() -> None:
+    from flightlogs.readers._dataflash_frame import gather
+
+    buf = np.random.default_rng(0).integers(0, 256, 1_000_003, dtype=np.uint8)
+    offsets = np.sort(np.random.default_rng(1).choice(buf.size - 40, 200_000, replace=False)).astype(np.int32)
+    released: list[tuple[int, int]] = []
+    blocks = gather(buf, offsets, 40, lambda lo, hi: released.append((lo, hi)))
+    np.testing.assert_array_equal(blocks, gather(buf, offsets, 40))
+    assert released[0][0] == 0 and released[-1][1] == buf.size  # every byte given back, in order, once
+    assert all(a[1] == b[0] for a, b in zip(released, released[1:])) and len(released) > 1
+
+
 def test_units_and_instance_fields_equal_dfreader(real_data: Path) -> None:
     path = real_data.joinpath(*SAMPLE)
     reader = DFReader_binary(str(path))
