@@ -42,11 +42,14 @@ REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "real"
 DEFAULT_FILES = (REAL / "ardupilot-log-diagnosis" / "sample.bin", REAL / "dronekit-la-testdata" / "log171.bin")
 
 
-def synthetic_log(path: Path, seconds: float, seed: int = 0) -> Path:
-    """A System ID flight at 400 Hz: two IMUs, ATT, RATE, RCOU, SIDD (≈100 kB per second)."""
+def synthetic_log(path: Path, seconds: float, seed: int = 0, *, rate_hz: float = 400.0, system_id: bool = True) -> Path:
+    """A System ID flight at `rate_hz`: two IMUs, ATT, RATE, RCOU, SIDD (≈100 kB per second at 400 Hz).
+
+    Without `system_id`, an ordinary flight: no SIDS/SIDD (the maneuvers are then searched for).
+    """
     rng = np.random.default_rng(seed)
-    t400 = 10_000_000 + np.arange(int(seconds * 400)) * 2500
-    n, t_gps = t400.size, t400[::40]
+    t400 = 10_000_000 + np.arange(int(seconds * rate_hz)) * int(round(1e6 / rate_hz))
+    n, t_gps = t400.size, t400[:: max(1, int(round(rate_hz / 10)))]
     chirp = np.sin(2 * np.pi * (0.5 + 0.03 * (t400 - t400[0]) / 1e6) * (t400 - t400[0]) / 1e6)
     imu = [
         standard_block(
@@ -82,17 +85,22 @@ def synthetic_log(path: Path, seconds: float, seed: int = 0) -> Path:
             AOut=np.full(n, 0.42),
         ),
         standard_block("RCOU", **{"TimeUS": t400 + 5, **{f"C{k}": rng.integers(1100, 1900, n) for k in range(1, 5)}}),
-        standard_block("SIDD", TimeUS=t400 + 6, Time=(t400 - t400[0]) / 1e6, Targ=chirp),
-        standard_block("SIDS", TimeUS=t400[:1], Ax=[10], Mag=[0.1], FSt=[0.5], FSp=[20.0], TR=[seconds]),
+    ]
+    if system_id:
+        blocks += [
+            standard_block("SIDD", TimeUS=t400 + 6, Time=(t400 - t400[0]) / 1e6, Targ=chirp),
+            standard_block("SIDS", TimeUS=t400[:1], Ax=[10], Mag=[0.1], FSt=[0.5], FSp=[20.0], TR=[seconds]),
+        ]
+    blocks.append(
         standard_block(
             "GPS",
             TimeUS=t_gps + 7,
             GWk=np.full(t_gps.size, 2300),
             GMS=300_000_000 + np.arange(t_gps.size) * 100,
             Status=np.full(t_gps.size, 3),
-        ),
-    ]
-    params = {"FRAME_CLASS": 1, "FRAME_TYPE": 1, "SID_AXIS": 10, "SID_MAGNITUDE": 0.1}
+        )
+    )
+    params = {"FRAME_CLASS": 1, "FRAME_TYPE": 1, "SID_AXIS": 10 if system_id else 0, "SID_MAGNITUDE": 0.1}
     path.write_bytes(encode_dataflash(blocks, parameters=params, firmware="ArduCopter V4.5.7 (synthetic)"))
     return path
 

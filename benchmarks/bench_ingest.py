@@ -2,15 +2,23 @@
 
 Usage::
 
-    python benchmarks/bench_ingest.py [FILE ...] [--seconds 1000] [--repeat 3]
+    python benchmarks/bench_ingest.py [FILE ...] [--seconds 1000] [--hours 2] [--repeat 3]
 
-Without files it writes a synthetic ArduCopter System ID log of about 113 MB (``--seconds`` of
-flight at 400 Hz, :func:`bench_dataflash.synthetic_log`) into a temporary folder and takes the real
-ULogs of ``../shared/data/real``. For each file:
+Without files it writes into a temporary folder, not timed:
+
+* a synthetic ArduCopter System ID log of about 113 MB (``--seconds`` of flight at 400 Hz,
+  :func:`bench_dataflash.synthetic_log`);
+* a continuous ``--hours`` ordinary ArduCopter flight at 100 Hz (no System ID messages: the
+  maneuvers are searched for over the whole log; about 200 MB for 2 hours);
+* a PX4 ULog of a 980 s System ID flight (24 sweeps, all four axes, 250 Hz, about 97 MB) flown by
+  the Table 3.3 linear model in closed loop and written by the simulator's PX4 writer;
+
+and takes the real ULogs of ``../shared/data/real``. For each file:
 
 * ``baseline``: DataFlash, pymavlink's ``DFReader_binary`` walk reading every field of every
   message (in this process, once; its values are compared with ours field by field, bitwise);
-  ULog, pyulog's own ``ULog(path)`` parse (best of ``--repeat``);
+  ULog, pyulog's own parse of the file as a whole process, ``python -c "from pyulog import ULog;
+  ULog(path)"`` (best of ``--repeat``): start-up and imports included on both sides;
 * ``ingest``: ``sysid ingest FILE -q`` in a fresh process, start to exit (best of ``--repeat``);
 * ``ingest -o``: the same writing the HDF5 dataset;
 * the ratios of the baseline to each, and the peak resident memory of the ``-o`` process over the
@@ -49,21 +57,41 @@ def run_ingest(path: Path, out: Path | None) -> tuple[float, float]:
 
 
 def pyulog_seconds(path: Path, repeat: int) -> float:
-    """Best of `repeat` pyulog parses of the whole file, s."""
-    from pyulog import ULog
-
+    """Best of `repeat` pyulog parses of the whole file, each a fresh process, s."""
+    command = [sys.executable, "-c", "import sys; from pyulog import ULog; ULog(sys.argv[1])", str(path)]
     best = float("inf")
     for _ in range(repeat):
         start = time.perf_counter()
-        ULog(str(path))
+        subprocess.run(command, check=True, capture_output=True)
         best = min(best, time.perf_counter() - start)
     return best
+
+
+def synthetic_ulog(path: Path, seconds: float = 980.0) -> Path:
+    """A PX4 System ID flight: a 34 s sweep every 40 s, the axes in turn, 250 Hz, the linear model's closed loop."""
+    from datetime import UTC, datetime
+
+    from simulator.autopilot.excitation import Maneuver
+    from simulator.flights.linear import simulate_hover
+    from simulator.output.px4 import write_px4_log
+
+    amplitude = {"lat": 8.0, "lon": 8.0, "yaw": 10.0, "thr": 4.0}
+    axes = tuple(amplitude)
+    sweeps = tuple(
+        Maneuver(
+            axis=axes[k % 4], kind="sweep", start_s=10.0 + 40.0 * k, amplitude=amplitude[axes[k % 4]], duration_s=34.0
+        )
+        for k in range(int((seconds - 10.0) // 40.0))
+    )
+    flight = simulate_hover(seconds, sweeps, rate_hz=250.0, substeps=2, seed=5)
+    return write_px4_log(flight, path, utc_start=datetime(2025, 5, 1, 10, tzinfo=UTC))
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("files", nargs="*", type=Path)
     parser.add_argument("--seconds", type=float, default=1000.0, help="length of the synthetic DataFlash log, s")
+    parser.add_argument("--hours", type=float, default=2.0, help="length of the continuous DataFlash log, h")
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args(argv)
     ok = True
@@ -71,6 +99,9 @@ def main(argv: list[str] | None = None) -> int:
         files = list(args.files)
         if not files:
             files = [synthetic_log(Path(tmp) / "synthetic_sysid.bin", args.seconds)]
+            continuous = Path(tmp) / f"continuous_{args.hours:g}h.bin"
+            files.append(synthetic_log(continuous, 3600.0 * args.hours, rate_hz=100.0, system_id=False))
+            files.append(synthetic_ulog(Path(tmp) / "synthetic_sysid.ulg"))
             files += sorted(p for p in (REAL / "px4-ulog-rs").glob("*.ulg") if "corrupt" not in p.name)
             files += sorted((REAL / "kd0aij-impulse-response").glob("*.ulg"))
         print(

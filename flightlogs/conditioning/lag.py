@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
+from flightlogs._moving import fast_fft_length
 from flightlogs.errors import DataError
 
 __all__ = [
@@ -86,18 +87,14 @@ def estimate_lag(
     max_lag = int(round(max_lag_s * rate_hz))
     if reference.size < 2 * max_lag + 8:
         raise DataError(f"{reference.size} samples are too few to search lags of ±{max_lag_s:g} s at {rate_hz:g} Hz")
-    from scipy import signal as sps  # here, not at import: scipy.signal takes longer to load than a log to read
-
     a, b = (np.diff(reference), np.diff(delayed)) if prewhiten else (reference, delayed)
-    a = sps.detrend(a)
-    b = sps.detrend(b)
+    a = _detrended(a)
+    b = _detrended(b)
     norm = np.sqrt(np.dot(a, a) * np.dot(b, b))
     if norm == 0.0:
         raise DataError("a stream to correlate is constant: no lag can be estimated")
-    full = sps.correlate(b, a, mode="full", method="fft") / norm
-    lags = sps.correlation_lags(b.size, a.size, mode="full")
-    window = np.abs(lags) <= max_lag
-    full, lags = full[window], lags[window]
+    full, lags = _correlation(b, a, max_lag)
+    full /= norm
     peak = int(np.argmax(np.abs(full)))
     shift = 0.0
     if 0 < peak < full.size - 1:
@@ -106,6 +103,28 @@ def estimate_lag(
         if curvature < 0.0:
             shift = 0.5 * (left - right) / curvature
     return LagEstimate(lag_s=float((lags[peak] + shift) / rate_hz), correlation=float(full[peak]))
+
+
+def _detrended(x: np.ndarray) -> np.ndarray:
+    """`x` less its least-squares straight line: ``scipy.signal.detrend(x)`` (to rounding)."""
+    t = np.arange(x.size, dtype=np.float64) / x.size
+    basis = np.column_stack([t, np.ones(x.size)])
+    coefficients, *_ = np.linalg.lstsq(basis, x, rcond=None)
+    return cast(np.ndarray, x - basis @ coefficients)
+
+
+def _correlation(b: np.ndarray, a: np.ndarray, max_lag: int) -> tuple[np.ndarray, np.ndarray]:
+    """``sum_n b[n + k] a[n]`` for lags ``k`` from ``-max_lag`` to ``max_lag``, and the lags, by FFT.
+
+    ``scipy.signal.correlate(b, a, "full", method="fft")`` at those lags (to rounding), without
+    importing scipy.signal, which takes longer to load than a log to read.
+    """
+    size = fast_fft_length(a.size + b.size - 1)
+    circular = np.fft.irfft(np.fft.rfft(b, size) * np.conj(np.fft.rfft(a, size)), size)
+    positive = circular[: min(max_lag, b.size - 1) + 1]
+    negative = circular[size - min(max_lag, a.size - 1) :]  # lags -max_lag..-1 wrap to the end
+    lags = np.arange(-negative.size, positive.size)
+    return np.concatenate([negative, positive]), lags
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

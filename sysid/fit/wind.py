@@ -44,8 +44,7 @@ from types import MappingProxyType
 from typing import Literal
 
 import numpy as np
-from scipy import optimize
-from scipy import signal as sps
+from scipy import linalg, optimize
 
 from flightlogs.errors import FitError, FitWarning
 from flightlogs.record import Record
@@ -158,6 +157,8 @@ def _simulate(a: np.ndarray, forcing: np.ndarray, t: np.ndarray, x0: np.ndarray)
     """``x' = a x + f(t)`` with f linear between samples, shape (n_samples, n); decoupled states by filtering."""
     n = a.shape[0]
     if not np.array_equal(a, np.diag(np.diag(a))) or np.any(np.diag(a) == 0):
+        from scipy import signal as sps  # coupled states only: scipy.signal takes 0.75 s to load
+
         _, x_sim, _ = sps.lsim((a, np.eye(n), np.eye(n), np.zeros((n, n))), forcing, t - t[0], X0=x0)
         return np.reshape(x_sim, (t.size, n))
     dt = float(np.mean(np.diff(t)))
@@ -166,10 +167,23 @@ def _simulate(a: np.ndarray, forcing: np.ndarray, t: np.ndarray, x0: np.ndarray)
         phi = np.exp(pole * dt)
         g0 = (phi - 1.0) / pole  # exact for a first-order hold on f, as lsim does
         g1 = (phi - 1.0 - pole * dt) / (pole**2 * dt)
-        b, den = np.array([g1, g0 - g1]), np.array([1.0, -phi])
-        zi = sps.lfiltic(b, den, y=[x0[k]], x=[forcing[0, k]])  # x0 and f[0] as the samples before f[1]
-        out[0, k] = x0[k]
-        out[1:, k] = sps.lfilter(b, den, forcing[1:, k], zi=zi)[0]
+        out[:, k] = _first_order(phi, g1, g0 - g1, forcing[:, k], x0[k])
+    return out
+
+
+def _first_order(phi: float, b0: float, b1: float, f: np.ndarray, x0: float) -> np.ndarray:
+    """``x[0] = x0``, ``x[n] = phi x[n-1] + b0 f[n] + b1 f[n-1]``, shape (n_samples,).
+
+    The recursion is a lower bidiagonal system, solved by LAPACK (``scipy.signal.lfilter`` with
+    its initial state gives the same to rounding, and costs scipy.signal's import).
+    """
+    out = np.empty(f.size)
+    out[0] = x0
+    if f.size > 1:
+        rhs = b0 * f[1:] + b1 * f[:-1]
+        rhs[0] += phi * x0
+        bands = np.vstack([np.ones(f.size - 1), np.full(f.size - 1, -phi)])  # diagonal, then below it
+        out[1:] = linalg.solve_banded((1, 0), bands, rhs)
     return out
 
 

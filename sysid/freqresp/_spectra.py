@@ -20,7 +20,8 @@ from typing import cast
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
-from scipy import signal as sps
+
+from sysid.freqresp._tapers import taper as taper_window
 
 __all__: list[str] = []
 
@@ -72,7 +73,7 @@ def window_spectra(
     Returns None when no record holds a whole window.
     """
     hop = max(1, int(round(n_window * (1.0 - overlap))))
-    taper_values = sps.get_window(taper, n_window)  # periodic: the spectral-analysis form
+    taper_values = taper_window(taper, n_window)  # periodic: the spectral-analysis form
     pieces = []
     n_effective = 0.0
     for channels in data:
@@ -122,6 +123,8 @@ def _czt(flat: np.ndarray, dt: float, taper: np.ndarray, omega: np.ndarray) -> n
     step = float(omega[1] - omega[0])
     if not np.allclose(np.diff(omega), step, rtol=1e-9, atol=0.0):
         raise ValueError("the chirp-z transform needs an evenly spaced grid")
+    from scipy import signal as sps  # here: scipy.signal takes 0.75 s to load, an even grid is rare
+
     transform = sps.CZT(flat.shape[1], m=omega.size, w=np.exp(-1j * step * dt), a=np.exp(1j * omega[0] * dt))
     tapered = (flat - flat.mean(axis=1, keepdims=True)) * taper
     return np.asarray(transform(tapered, axis=-1))

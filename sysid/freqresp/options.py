@@ -6,7 +6,8 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy import signal as sps
+
+from sysid.freqresp._tapers import taper
 
 __all__ = ["ResponseOptions"]
 
@@ -113,7 +114,7 @@ class ResponseOptions:
         if not 0.0 <= self.overlap < 0.95:
             raise ValueError(f"{self.overlap=} must lie in [0, 0.95)")
         try:
-            sps.get_window(self.taper, 16)
+            taper(self.taper, 16)
         except ValueError as err:
             raise ValueError(f"taper={self.taper!r} is not a window scipy.signal.get_window knows") from err
         if not 0.0 < self.min_coherence < 1.0:

@@ -104,3 +104,20 @@ def test_the_transport_delay_records_the_bearing_it_used() -> None:
     delay = transport_delay(wind, distance_m=5.0, bearing_rad=np.arctan2(4.0, 3.0))
     assert delay.bearing_rad == pytest.approx(np.arctan2(4.0, 3.0))
     assert delay.delay_s == pytest.approx(1.0)  # straight downwind at 5 m/s
+
+
+@pytest.mark.parametrize(("n_a", "n_b", "max_lag"), [(500, 500, 40), (300, 700, 250), (700, 300, 299), (64, 64, 63)])
+def test_the_detrend_and_correlation_are_scipys(n_a: int, n_b: int, max_lag: int) -> None:
+    from scipy import signal as sps
+
+    from flightlogs.conditioning.lag import _correlation, _detrended
+
+    rng = np.random.default_rng(n_a + n_b)
+    a, b = rng.standard_normal(n_a) + 0.01 * np.arange(n_a), rng.standard_normal(n_b)
+    np.testing.assert_allclose(_detrended(a), sps.detrend(a), rtol=0, atol=1e-12)
+    full = sps.correlate(b, a, mode="full", method="fft")
+    lags = sps.correlation_lags(b.size, a.size, mode="full")
+    window = np.abs(lags) <= max_lag
+    ours, our_lags = _correlation(b, a, max_lag)
+    np.testing.assert_array_equal(our_lags, lags[window])
+    np.testing.assert_allclose(ours, full[window], rtol=0, atol=1e-10)

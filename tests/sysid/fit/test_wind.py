@@ -164,3 +164,15 @@ def test_the_wind_step_of_a_partial_model_fits_the_identified_axes_outputs(recor
     assert np.isnan(result.values["X_w_lon"]) and result.fit is not None and result.fit.outputs == ("az",)
     assert result.status["Z_w_lon"] == "estimated"
     assert abs(result.values["Z_w_lon"] - STRONG_WIND_TERMS["Z_w_lon"]) <= 0.1 * STRONG_WIND_TERMS["Z_w_lon"]
+
+
+@pytest.mark.parametrize("phi", [0.5, 0.9, 0.999, -0.3])
+def test_the_first_order_recursion_is_lfilter_with_its_initial_state(phi: float) -> None:
+    from scipy import signal as sps
+
+    from sysid.fit.wind import _first_order
+
+    f = np.random.default_rng(4).standard_normal(4000)
+    b, den = np.array([0.3, -0.1]), np.array([1.0, -phi])
+    expected = sps.lfilter(b, den, f[1:], zi=sps.lfiltic(b, den, y=[0.7], x=[f[0]]))[0]
+    np.testing.assert_allclose(_first_order(phi, 0.3, -0.1, f, 0.7), np.r_[0.7, expected], rtol=0, atol=1e-12)
