@@ -26,6 +26,7 @@ __all__: list[str] = []
 _SHORT_S = 0.2  # window of the short moving mean and RMS, s
 _TREND_KNOTS_PER_WINDOW = 8  # robust trend: fits per window length, joined by straight lines
 _TREND_RATE_HZ = 100.0  # robust trend: fitted to at most this many samples a second
+_TREND_MEDIAN_SAMPLES = 256  # robust trend: its starting moving median takes at most this many samples a window
 _ROBUST_SAMPLES = 50_000  # noise floors: order statistics of at most this many evenly spaced samples
 _GUARD_S, _BASELINE_S = 1.0, 10.0  # edge baseline: fitted from 11 s to 1 s before the burst
 _QUADRATIC_S = 3.0  # edge baseline: straight below this much quiet trace, quadratic above
@@ -210,7 +211,8 @@ def _trend(x: np.ndarray, width: int) -> np.ndarray:
     idx = np.arange(x.size)
     centres = np.unique(np.r_[idx[:: max(1, width // _TREND_KNOTS_PER_WINDOW)], x.size - 1])
     mirrored = np.pad(x, (half, half), mode="symmetric")
-    trend = np.interp(idx, centres, np.median(sliding_window_view(mirrored, width)[centres], axis=1))
+    every = max(1, width // _TREND_MEDIAN_SAMPLES)  # the starting trend: each window's median of evenly spaced samples
+    trend = np.interp(idx, centres, np.median(sliding_window_view(mirrored, width)[centres, ::every], axis=1))
     powers = (np.arange(-half, half + 1) / half)[:, None] ** np.arange(5)  # (width, 5): local time^0..4
 
     def moments(signal: np.ndarray, k: int) -> np.ndarray:  # sum over each window of signal × (local time)^0..k-1

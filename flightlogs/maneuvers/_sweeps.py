@@ -36,6 +36,7 @@ __all__: list[str] = []
 _F_MIN_HZ, _F_MAX_HZ, _PER_OCTAVE, _CYCLES = 0.05, 15.0, 6, 4.0
 _FRAME_S = 0.1  # time step of the envelopes, s
 _FLOOR_QUANTILE = 0.2  # a band's noise floor: this quantile of its envelope over the quiet frames
+_FLOOR_FRAMES = 20_000  # noise floors: read from at most this many evenly spaced frames
 _SCORE = 6.0  # a frame is on the ridge when its best band (median over _SMOOTH_S) stands this many floors out
 _SMOOTH_S = 1.0  # running median of the ridge's score and log frequency, s
 _MAX_JUMP_OCTAVES = 0.5  # the ridge of one sweep moves less than this from one frame to the next
@@ -205,11 +206,12 @@ def _normalised(x: np.ndarray, dt: float, freqs: np.ndarray, step: int) -> np.nd
     """Band envelopes over each band's noise floor, taken where no band stands out (two passes)."""
     envelope = band_envelopes(x - np.median(x), dt, freqs, cycles=_CYCLES, step=step)
     tiny = 1e-12 * max(1.0, float(envelope.max()))
-    lowest = np.maximum(_DYNAMIC_RANGE * np.median(envelope, axis=0), tiny)
-    floor = np.maximum(np.quantile(envelope, _FLOOR_QUANTILE, axis=0), lowest)
-    quiet = (envelope / floor).max(axis=1) < _SCORE
+    sample = envelope[:: -(-envelope.shape[0] // _FLOOR_FRAMES)]  # floors from evenly spaced frames of a long log
+    lowest = np.maximum(_DYNAMIC_RANGE * np.median(sample, axis=0), tiny)
+    floor = np.maximum(np.quantile(sample, _FLOOR_QUANTILE, axis=0), lowest)
+    quiet = (sample / floor).max(axis=1) < _SCORE
     if quiet.sum() >= 0.1 * quiet.size:
-        floor = np.maximum(np.quantile(envelope[quiet], _FLOOR_QUANTILE, axis=0), lowest)
+        floor = np.maximum(np.quantile(sample[quiet], _FLOOR_QUANTILE, axis=0), lowest)
     return np.asarray(envelope / floor)
 
 
