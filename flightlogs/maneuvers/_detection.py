@@ -10,6 +10,7 @@ the uniform time base.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal, NamedTuple, cast
 
@@ -209,14 +210,14 @@ def _trend(x: np.ndarray, width: int) -> np.ndarray:
     """
     half = width // 2
     idx = np.arange(x.size)
-    centres = np.unique(np.r_[idx[:: max(1, width // _TREND_KNOTS_PER_WINDOW)], x.size - 1])
+    stride = max(1, width // _TREND_KNOTS_PER_WINDOW)
+    centres = np.unique(np.r_[idx[::stride], x.size - 1])
     mirrored = np.pad(x, (half, half), mode="symmetric")
     every = max(1, width // _TREND_MEDIAN_SAMPLES)  # the starting trend: each window's median of evenly spaced samples
     trend = np.interp(idx, centres, np.median(sliding_window_view(mirrored, width)[centres, ::every], axis=1))
-    powers = (np.arange(-half, half + 1) / half)[:, None] ** np.arange(5)  # (width, 5): local time^0..4
 
     def moments(signal: np.ndarray, k: int) -> np.ndarray:  # sum over each window of signal × (local time)^0..k-1
-        return cast(np.ndarray, sliding_window_view(np.pad(signal, half), width)[centres] @ powers[:, :k])
+        return _window_moments(signal, half, stride, k)
 
     for _ in range(3):
         resid = x - trend
@@ -233,6 +234,47 @@ def _trend(x: np.ndarray, width: int) -> np.ndarray:
         c0 = (b0 * minor - m1 * (b1 * m4 - m3 * b2) + m2 * (b1 * m3 - m2 * b2))[good] / det[good]
         trend = np.interp(idx, centres[good], c0)
     return cast(np.ndarray, trend)
+
+
+def _window_moments(signal: np.ndarray, half: int, stride: int, k: int) -> np.ndarray:
+    """``sum_u signal[c + u] (u / half)^p`` over ``u = -half..half`` (zero beyond the ends), ``p < k``.
+
+    At the centres ``c = 0, stride, 2 stride, ...`` and the last sample, as :func:`_trend`
+    places them; shape (n_centres, k). With ``8 stride <= 2 half + 1``, a window is eight
+    blocks of `stride` samples and a short tail: each block's own moments (one matrix
+    product over the trace) are moved to the window's centre by the binomial theorem, so
+    the cost is one pass over the trace, not one per window.
+    """
+    n = signal.size
+    tail = 2 * half + 1 - 8 * stride  # samples of a window after its eight blocks
+    if tail < 0:  # windows shorter than eight strides: each window directly
+        centres = np.unique(np.r_[np.arange(0, n, stride), n - 1])
+        powers_of_time = (np.arange(-half, half + 1) / half)[:, None] ** np.arange(k)
+        return cast(np.ndarray, sliding_window_view(np.pad(signal, half), 2 * half + 1)[centres] @ powers_of_time)
+    regular = np.arange(0, n, stride)
+    blocks_needed = regular.size + 8
+    length = max(blocks_needed * stride, int(regular[-1]) + 2 * half + 1)
+    padded = np.zeros(length + stride)
+    padded[half : half + n] = signal
+    local = np.arange(stride) / half
+    block = padded[: blocks_needed * stride].reshape(blocks_needed, stride) @ local[:, None] ** np.arange(k)
+    binomial = np.array([[math.comb(p, j) for p in range(k)] for j in range(k)], dtype=np.float64)
+    powers = np.arange(k)
+    out = np.zeros((regular.size, k))
+    for q in range(8):  # block q starts q stride - half samples from the centre
+        offset = (q * stride - half) / half
+        shift = np.where(
+            powers[None, :] >= powers[:, None], offset ** np.maximum(powers[None, :] - powers[:, None], 0), 0.0
+        )
+        out += block[q : q + regular.size] @ (binomial * shift)
+    if tail:
+        after = (8 * stride + np.arange(tail) - half) / half
+        out += padded[regular[:, None] + 8 * stride + np.arange(tail)] @ after[:, None] ** powers
+    if regular[-1] != n - 1:  # the last sample, off the stride: its window directly
+        window = padded[n - 1 : n - 1 + 2 * half + 1]
+        last = window @ (np.arange(-half, half + 1) / half)[:, None] ** powers
+        out = np.vstack([out, last])
+    return out
 
 
 def _robust_std(x: np.ndarray, quantile: float = 0.5, *, centred: bool = False) -> float:
