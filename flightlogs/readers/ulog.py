@@ -43,7 +43,7 @@ __all__ = ["read_ulog"]
 _ULOG_MAGIC = b"ULog\x01\x12\x35"
 _HEADER_BYTES = 16
 _MAX_PAYLOAD = 65535  # a ULog message payload is at most this long (16-bit size)
-_WHOLE_FILE_LIMIT = 1 << 30  # files up to this size are read into memory when their messages chain cleanly
+_WHOLE_FILE_LIMIT = 1 << 28  # files up to 256 MB are read into memory when their messages chain cleanly
 _MESSAGE_TYPES = frozenset(
     getattr(ULog, name) for name in dir(ULog) if name.startswith("MSG_TYPE_") and isinstance(getattr(ULog, name), int)
 )
