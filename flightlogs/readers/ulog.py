@@ -351,9 +351,13 @@ def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None) -
     """
     whole = _whole_if_clean(path, size, progress)
     if whole is not None:
-        ulog, tracked, said = _run_pyulog(path, _PlainULog, whole)
-        if not ulog.file_corruption:
-            return _reported(ulog, tracked, said, size, path)
+        try:
+            ulog, tracked, said = _run_pyulog(path, _PlainULog, whole)
+        except LogFormatError:
+            pass  # the tracked reader says where the damage lies
+        else:
+            if not ulog.file_corruption:
+                return _reported(ulog, tracked, said, size, path)
     tracked = _TrackedFile(path, size, progress)
     return _reported(*_run_pyulog(path, _CountingULog, tracked), size, path)
 
