@@ -87,13 +87,18 @@ def overlap_s(log: FlightLog, wind: Any, *, clock_offset_s: float = 0.0) -> floa
     clock_offset_s : float, optional
         Anemometer clock minus reference clock, s.
     """
-    if log.utc_offset_s is None:
-        start, end = log.time_range_s
-    else:
-        start, end = _log_span_utc(log)
+    return _overlap(_span(log), wind, clock_offset_s)
+
+
+def _span(log: FlightLog) -> tuple[float, float]:
+    """The log's first and last sample time, UTC s where it has GPS time, else on its own clock."""
+    return log.time_range_s if log.utc_offset_s is None else _log_span_utc(log)
+
+
+def _overlap(span: tuple[float, float], wind: Any, clock_offset_s: float) -> float:
     w_start = float(wind.utc_s[0]) - clock_offset_s
     w_end = float(wind.utc_s[-1]) - clock_offset_s
-    return max(0.0, min(end, w_end) - max(start, w_start))
+    return max(0.0, min(span[1], w_end) - max(span[0], w_start))
 
 
 def _iso(seconds: float) -> str:
@@ -134,8 +139,8 @@ def pair_winds(
                 f"{log.path}: the log has no GPS time, so the anemometer cannot be aligned by UTC; "
                 "give --wind-offset (anemometer time minus log time, s)"
             )
-        offset = clock_offset_s or 0.0
-        overlaps = [overlap_s(log, wind, clock_offset_s=offset) for wind in winds]
+        offset, span = clock_offset_s or 0.0, _span(log)  # the span once: every record is tried against it
+        overlaps = [_overlap(span, wind, offset) for wind in winds]
         best = int(np.argmax(overlaps))
         if overlaps[best] <= 0.0:
             raise DataError(_no_overlap_message(log, winds, offset))

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Literal, NamedTuple, cast
 
 import numpy as np
@@ -256,25 +257,35 @@ def _window_moments(signal: np.ndarray, half: int, stride: int, k: int) -> np.nd
     length = max(blocks_needed * stride, int(regular[-1]) + 2 * half + 1)
     padded = np.zeros(length + stride)
     padded[half : half + n] = signal
-    local = np.arange(stride) / half
-    block = padded[: blocks_needed * stride].reshape(blocks_needed, stride) @ local[:, None] ** np.arange(k)
-    binomial = np.array([[math.comb(p, j) for p in range(k)] for j in range(k)], dtype=np.float64)
+    local, shifts, after, whole = _moment_kernels(half, stride, k)
+    block = padded[: blocks_needed * stride].reshape(blocks_needed, stride) @ local  # (blocks, k)
+    eight = sliding_window_view(block[: regular.size + 7], 8, axis=0)  # (n_regular, k, 8): a window's blocks
+    out = np.einsum("ijq,qjp->ip", eight, shifts)
+    if tail:
+        out += padded[regular[:, None] + 8 * stride + np.arange(tail)] @ after
+    if regular[-1] != n - 1:  # the last sample, off the stride: its window directly
+        out = np.vstack([out, padded[n - 1 : n - 1 + 2 * half + 1] @ whole])
+    return cast(np.ndarray, out)
+
+
+@lru_cache(maxsize=64)
+def _moment_kernels(half: int, stride: int, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """For :func:`_window_moments`: a block's local powers (stride, k); the binomial shifts of the
+    eight blocks to the window's centre (8, k, k); the tail's powers (tail, k); a whole window's (width, k)."""
     powers = np.arange(k)
-    out = np.zeros((regular.size, k))
+    local = (np.arange(stride) / half)[:, None] ** powers
+    binomial = np.array([[math.comb(p, j) for p in powers] for j in powers], dtype=np.float64)
+    shifts = np.empty((8, k, k))
     for q in range(8):  # block q starts q stride - half samples from the centre
         offset = (q * stride - half) / half
-        shift = np.where(
-            powers[None, :] >= powers[:, None], offset ** np.maximum(powers[None, :] - powers[:, None], 0), 0.0
-        )
-        out += block[q : q + regular.size] @ (binomial * shift)
-    if tail:
-        after = (8 * stride + np.arange(tail) - half) / half
-        out += padded[regular[:, None] + 8 * stride + np.arange(tail)] @ after[:, None] ** powers
-    if regular[-1] != n - 1:  # the last sample, off the stride: its window directly
-        window = padded[n - 1 : n - 1 + 2 * half + 1]
-        last = window @ (np.arange(-half, half + 1) / half)[:, None] ** powers
-        out = np.vstack([out, last])
-    return out
+        lifted = np.maximum(powers[None, :] - powers[:, None], 0)
+        shifts[q] = binomial * np.where(powers[None, :] >= powers[:, None], offset**lifted, 0.0)
+    tail = 2 * half + 1 - 8 * stride
+    after = ((8 * stride + np.arange(tail) - half) / half)[:, None] ** powers
+    whole = (np.arange(-half, half + 1) / half)[:, None] ** powers
+    for kernel in (local, shifts, after, whole):
+        kernel.flags.writeable = False  # shared by every call with these sizes
+    return local, shifts, after, whole
 
 
 def _robust_std(x: np.ndarray, quantile: float = 0.5, *, centred: bool = False) -> float:

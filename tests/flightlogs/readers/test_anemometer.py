@@ -365,3 +365,28 @@ def test_round_trip_speed_direction_and_components(tmp_path, rows, unit, start):
     moving = polar.speed_m_s > 1e-6
     turn = np.angle(np.exp(1j * (cartesian.direction_from_rad - polar.direction_from_rad)))
     np.testing.assert_allclose(turn[moving], 0.0, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "texts",
+    [
+        ["2024-05-01T10:00:01.500Z", "2024-05-01T10:00:01.55Z", "2024-05-01T10:00:02Z"],
+        ["2024-05-01 10:00:01.123456789", "2024-05-01 10:00:01.2", "2024-05-01 10:00:59"],
+        ["1969-12-31T23:59:58.25Z", "1969-12-31T23:59:59.75Z"],
+    ],
+)
+def test_iso_times_parsed_at_once_equal_the_row_by_row_parse(texts: list[str]) -> None:
+    from flightlogs.readers._anemometer_text import _iso_at_once, _iso_to_unix
+
+    at_once = _iso_at_once(texts, 7200.0)
+    assert at_once is not None
+    np.testing.assert_array_equal(at_once, [_iso_to_unix(text, 7200.0) for text in texts])
+
+
+@pytest.mark.parametrize(
+    "texts", [["2024-05-01"], ["10:00:01"], ["2024-05-01T10:00:01+02:00"], ["2024-05-01T10:00:01,5"], ["NaT"]]
+)
+def test_texts_numpy_would_misread_go_row_by_row(texts: list[str]) -> None:
+    from flightlogs.readers._anemometer_text import _iso_at_once
+
+    assert _iso_at_once(texts, 0.0) is None
