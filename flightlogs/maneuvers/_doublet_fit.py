@@ -27,6 +27,7 @@ pulses and explains the burst clearly better, it is returned instead.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import cast
 
@@ -39,6 +40,7 @@ __all__: list[str] = []
 _KNOT_S = 1.0  # nuisance B-spline knot spacing, s: slower than any doublet edge, faster than the outer loops
 _MIN_PULSE_S, _MAX_PULSE_S = 0.1, 5.0  # pulse widths scanned, s
 _COARSE_S = 0.05  # scan step before refining to single samples, s
+_GRID_ELEMENTS = 1 << 20  # the (width, start, basis) arrays of one block of the scan stay under this many numbers
 _REACH_S = 1.0  # a doublet may start this long before its burst and end this long after it, s
 #: Each pulse must stand out of the residual noise by this many standard errors. Measured with the
 #: rules off on 8 s windows of simulated chapter 3 logs (nonlinear octocopter, calm and strong wind):
@@ -252,44 +254,92 @@ def _scan(
 def _best_on_grid(
     sums: np.ndarray, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
 ) -> tuple[float, int, int] | None:
-    """(gain, first, width) of the best doublet starting at earliest, earliest + step, ... and ending by `latest`."""
-    best: tuple[float, int, int] | None = None
-    for width in widths:
-        first = np.arange(earliest, latest - 2 * width + 1, step)
-        if first.size == 0:
-            continue
-        mid, end = first + width, first + 2 * width
-        q1, q2 = sums[mid] - sums[first], sums[end] - sums[mid]
-        v1, v2 = run[mid] - run[first], run[end] - run[mid]
-        g11 = width - np.einsum("ij,ij->i", q1, q1)
-        g22 = width - np.einsum("ij,ij->i", q2, q2)
-        g12 = -np.einsum("ij,ij->i", q1, q2)
-        det = g11 * g22 - g12 * g12
-        ok = det > 1e-9 * width * width
-        gain = np.where(ok, (g22 * v1 * v1 - 2 * g12 * v1 * v2 + g11 * v2 * v2) / np.where(ok, det, 1.0), -np.inf)
-        k = int(np.argmax(gain))
-        if best is None or gain[k] > best[0]:
-            best = (float(gain[k]), int(first[k]), width)
-    return best if best is not None and np.isfinite(best[0]) else None
+    """(gain, first, width) of the best doublet starting at earliest, earliest + step, ... and ending by `latest`.
+
+    A block of widths at a time, every start at once (the starts past the end masked).
+    """
+    return _best_by_blocks(_doublet_block, sums, run, widths, earliest, latest, step)
 
 
 def _best_template_on_grid(
     sums: np.ndarray, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
 ) -> tuple[float, int, int] | None:
     """(gain, first, width) of the best 3-2-1-1 (one amplitude, signs + - + -) on the grid, as :func:`_best_on_grid`."""
+    return _best_by_blocks(_template_block, sums, run, widths, earliest, latest, step)
+
+
+def _best_by_blocks(
+    block: Callable[[np.ndarray, np.ndarray, range, int, int, int], tuple[float, int, int] | None],
+    sums: np.ndarray,
+    run: np.ndarray,
+    widths: range,
+    earliest: int,
+    latest: int,
+    step: int,
+) -> tuple[float, int, int] | None:
+    """The best of `block` over `widths` taken a few at a time (the grid's arrays stay under `_GRID_ELEMENTS`)."""
+    starts = max(1, (latest - earliest) // step + 1)
+    per_block = max(1, _GRID_ELEMENTS // (starts * max(1, sums.shape[1])))
     best: tuple[float, int, int] | None = None
+    for lo in range(0, len(widths), per_block):
+        found = block(sums, run, widths[lo : lo + per_block], earliest, latest, step)
+        if found is not None and (best is None or found[0] > best[0]):  # equal gains: the narrower width
+            best = found
+    return best
+
+
+def _doublet_block(
+    sums: np.ndarray, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
+) -> tuple[float, int, int] | None:
+    grid = _grid(widths, earliest, latest, step, 2)
+    if grid is None:
+        return None
+    width, first, ok = grid
+    mid, end = first + width, first + 2 * width
+    q1, q2 = sums[mid] - sums[first], sums[end] - sums[mid]  # (n_widths, n_starts, n_basis)
+    v1, v2 = run[mid] - run[first], run[end] - run[mid]
+    g11 = width - np.einsum("wij,wij->wi", q1, q1)
+    g22 = width - np.einsum("wij,wij->wi", q2, q2)
+    g12 = -np.einsum("wij,wij->wi", q1, q2)
+    det = g11 * g22 - g12 * g12
+    ok &= det > 1e-9 * width * width
+    gain = np.where(ok, (g22 * v1 * v1 - 2 * g12 * v1 * v2 + g11 * v2 * v2) / np.where(ok, det, 1.0), -np.inf)
+    return _best_of(gain, width, first)
+
+
+def _template_block(
+    sums: np.ndarray, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
+) -> tuple[float, int, int] | None:
     offsets = np.cumsum((0, *_3211))
-    for width in widths:
-        first = np.arange(earliest, latest - offsets[-1] * width + 1, step)
-        if first.size == 0:
-            continue
-        edges = first[:, None] + width * offsets
-        q = sum(sign * (sums[edges[:, k + 1]] - sums[edges[:, k]]) for k, sign in enumerate(_SIGNS))
-        v = sum(sign * (run[edges[:, k + 1]] - run[edges[:, k]]) for k, sign in enumerate(_SIGNS))
-        g = offsets[-1] * width - np.einsum("ij,ij->i", q, q)
-        ok = g > 1e-9 * width
-        gain = np.where(ok, v * v / np.where(ok, g, 1.0), -np.inf)
-        k = int(np.argmax(gain))
-        if best is None or gain[k] > best[0]:
-            best = (float(gain[k]), int(first[k]), width)
-    return best if best is not None and np.isfinite(best[0]) else None
+    grid = _grid(widths, earliest, latest, step, int(offsets[-1]))
+    if grid is None:
+        return None
+    width, first, ok = grid
+    edges = [first + width * int(o) for o in offsets]
+    q = sum(sign * (sums[edges[k + 1]] - sums[edges[k]]) for k, sign in enumerate(_SIGNS))
+    v = sum(sign * (run[edges[k + 1]] - run[edges[k]]) for k, sign in enumerate(_SIGNS))
+    g = offsets[-1] * width - np.einsum("wij,wij->wi", q, q)
+    ok &= g > 1e-9 * width
+    gain = np.where(ok, v * v / np.where(ok, g, 1.0), -np.inf)
+    return _best_of(gain, width, first)
+
+
+def _grid(
+    widths: range, earliest: int, latest: int, step: int, span: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Widths (n_widths, 1), starts (n_widths, n_starts) and which fit (`span` widths ending by `latest`)."""
+    width = np.asarray(widths)
+    width = width[earliest <= latest - span * width][:, None]  # the widths that fit at the earliest start
+    if width.size == 0:
+        return None
+    starts = np.arange(earliest, latest - span * int(width[0, 0]) + 1, step)
+    ok = starts[None, :] <= latest - span * width
+    first = np.where(ok, starts[None, :], earliest)  # a start past the end reads the earliest; its gain is masked
+    return width, first, ok
+
+
+def _best_of(gain: np.ndarray, width: np.ndarray, first: np.ndarray) -> tuple[float, int, int] | None:
+    """The grid's best (gain, first, width): the first in width, then start, order among equals."""
+    w, i = np.unravel_index(int(np.argmax(gain)), gain.shape)
+    best = float(gain[w, i])
+    return (best, int(first[w, i]), int(width[w, 0])) if np.isfinite(best) else None
