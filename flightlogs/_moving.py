@@ -74,7 +74,7 @@ def dilate(mask: np.ndarray, reach: int) -> np.ndarray:
     reach : int
         Samples either side (>= 0).
     """
-    return _any_within(np.asarray(mask, dtype=bool), reach, outside=False)
+    return _any_within(np.asarray(mask, dtype=bool), reach)
 
 
 def erode(mask: np.ndarray, reach: int) -> np.ndarray:
@@ -86,7 +86,7 @@ def erode(mask: np.ndarray, reach: int) -> np.ndarray:
     reach : int
         Samples either side (>= 0).
     """
-    return ~_any_within(~np.asarray(mask, dtype=bool), reach, outside=False)
+    return ~_any_within(~np.asarray(mask, dtype=bool), reach)
 
 
 def fast_fft_length(n: int) -> int:
@@ -109,10 +109,10 @@ def fast_fft_length(n: int) -> int:
     return best
 
 
-def _any_within(mask: np.ndarray, reach: int, *, outside: bool) -> np.ndarray:
-    """True where a True sample lies within `reach` samples; beyond the ends every sample is `outside`."""
+def _any_within(mask: np.ndarray, reach: int) -> np.ndarray:
+    """True where a True sample lies within `reach` samples (none beyond the ends)."""
     if reach <= 0:
         return mask.copy()
-    padded = np.pad(mask, reach, constant_values=outside)
+    padded = np.pad(mask, reach)
     counts = np.concatenate(([0], np.cumsum(padded, dtype=np.int64)))
     return cast(np.ndarray, counts[2 * reach + 1 :] - counts[: -2 * reach - 1] > 0)

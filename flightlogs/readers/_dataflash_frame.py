@@ -164,10 +164,10 @@ def _header_candidates(buf: np.ndarray, release: Release | None = None) -> tuple
         kinds.append(block[first + 2])
         if release is not None:
             release(lo, end)
-    return np.concatenate(found).astype(offset_dtype(buf.size), copy=False), np.concatenate(kinds)
+    return np.concatenate(found).astype(_offset_dtype(buf.size), copy=False), np.concatenate(kinds)
 
 
-def offset_dtype(size: int) -> type[np.signedinteger[Any]]:
+def _offset_dtype(size: int) -> type[np.signedinteger[Any]]:
     """Byte offsets into `size` bytes: int32 (half the memory) when they fit, with room for a message's length."""
     return np.int32 if size < 2**31 - 2**16 else np.int64
 
