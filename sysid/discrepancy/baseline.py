@@ -6,6 +6,13 @@ the simulated delays and lags, whatever they are), their squares at four of
 those lags (differential rotor speeds change the total thrust: a yaw sweep
 pulls az down), the body velocities and rates, and a constant. Nothing about the vehicle is assumed. What REAL
 does that this model of SIM does not is the discrepancy.
+
+An input's square is left out when SIM flew it over too narrow a range for a curvature to show: when
+the part of ``x²`` that a constant and ``x`` do not explain is under 1 % of its spread (a thrust held
+at 0.45 ± 0.002 through a flight without height changes). Its coefficients would then be noise that
+cancels within SIM's range and extrapolates outside it: a REAL vehicle that needs 3 % more thrust (a
+sagging battery, a heavier one) would be predicted a roll and pitch moment from the thrust alone,
+which was first read as a CG offset (found on another generator's flights).
 """
 
 from __future__ import annotations
@@ -23,6 +30,7 @@ __all__ = ["BaselineModel", "fit_baseline", "Commands"]
 _LAG_S = 0.3  # longest input lag of the impulse responses, s
 _STATES = ("u", "v", "w", "p", "q", "r")
 _N_SQUARE_LAGS = 4  # the inputs' squares (a rotor's thrust grows with its speed squared) at this many lags
+_MIN_CURVATURE_SHARE = 0.01  # std of (x - mean)² over std of x²: below it, SIM cannot inform x²'s coefficient
 
 #: Mixer inputs to drive a prediction with (each shape (n,)); None: as logged.
 Commands = Mapping[str, np.ndarray] | None
@@ -42,12 +50,15 @@ class BaselineModel:
         State regressors used.
     rate_hz : float
         Sample rate it was fitted at, Hz.
+    squared : tuple of str
+        Mixer inputs whose squares are regressors (those SIM varied enough to inform them).
     """
 
     coefficients: Mapping[str, np.ndarray]
     lags: np.ndarray
     states: tuple[str, ...]
     rate_hz: float
+    squared: tuple[str, ...] = COMMANDS
 
     def predict(self, series: FlightSeries, commands: Commands = None) -> dict[str, np.ndarray]:
         """Each output as the simulation would have it on `series`, shape (n,) each.
@@ -64,12 +75,12 @@ class BaselineModel:
         n_lags, n_squares, n_in = self.lags.size, square_lags.size, len(COMMANDS)
         weights = np.column_stack(list(self.coefficients.values()))  # (n_regressors, n_outputs)
         fixed = np.column_stack([series[s] for s in self.states] + [np.ones(series.n)])
-        total = fixed @ weights[n_in * (n_lags + n_squares) :]
+        total = fixed @ weights[n_in * n_lags + len(self.squared) * n_squares :]
         for k, name in enumerate(COMMANDS):  # lagged inputs times all outputs' weights at once: no whole design
-            x = np.asarray(inputs[name])
-            total += _lagged(series, x, self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
+            total += _lagged(series, np.asarray(inputs[name]), self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
+        for k, name in enumerate(self.squared):
             first = n_in * n_lags + k * n_squares
-            total += _lagged(series, x**2, square_lags) @ weights[first : first + n_squares]
+            total += _lagged(series, np.asarray(inputs[name]) ** 2, square_lags) @ weights[first : first + n_squares]
         return {o: total[:, j] for j, o in enumerate(self.coefficients)}
 
 
@@ -89,16 +100,31 @@ def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> Baseli
     """
     lags = np.arange(int(round(_LAG_S * series.rate_hz)) + 1)
     states = tuple(s for s in _STATES if s in series)
-    design = _design(series, lags, states)
     use = slice(None) if rows is None else rows
+    squared = tuple(c for c in COMMANDS if _curvature_share(series[c][use]) >= _MIN_CURVATURE_SHARE)
+    design = _design(series, lags, states, squared)
     coefficients = {o: np.linalg.lstsq(design[use], series[o][use], rcond=None)[0] for o in OUTPUTS}
-    return BaselineModel(coefficients=coefficients, lags=lags, states=states, rate_hz=series.rate_hz)
+    return BaselineModel(coefficients=coefficients, lags=lags, states=states, rate_hz=series.rate_hz, squared=squared)
 
 
-def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...]) -> np.ndarray:
+def _curvature_share(x: np.ndarray) -> float:
+    """Spread of ``(x - mean)²`` over that of ``x²``: the part of the square a constant and `x` leave (0..1).
+
+    Examples
+    --------
+    >>> round(_curvature_share(np.array([-1.0, 0.0, 1.0])), 3)  # about zero: the square is all curvature
+    1.0
+    >>> _curvature_share(np.array([0.448, 0.45, 0.452])) < 0.01  # a narrow range far from zero
+    True
+    """
+    spread = float(np.std(x**2))
+    return float(np.std((x - x.mean()) ** 2)) / spread if spread > 0 else 0.0
+
+
+def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...], squared: tuple[str, ...]) -> np.ndarray:
     """The regressors of the fit, shape (n, n_regressors), in the order :meth:`BaselineModel.predict` reads them."""
     columns = [_lagged(series, series[c], lags) for c in COMMANDS]
-    columns += [_lagged(series, series[c] ** 2, _square_lags(lags)) for c in COMMANDS]
+    columns += [_lagged(series, series[c] ** 2, _square_lags(lags)) for c in squared]
     columns.append(np.column_stack([series[s] for s in states] + [np.ones(series.n)]))
     return np.column_stack(columns)
 

@@ -48,16 +48,17 @@ def parameters_of(
 ) -> tuple[FittedParameter, ...]:
     """The fitted parameters of a term, with standard deviations, in SI units.
 
-    `thrust_scale` is the real over the simulated thrust per input taken out before the term: the
-    battery's exponent is the log-derivative of thrust against voltage, its coefficient over the
-    thrust scale with the term's own gain change.
+    `thrust_scale` is the real over the simulated thrust per input apart from this term's own gain
+    change (the trim taken out before any term, and the other terms' gains: the gains of the terms on
+    az share one regressor, so only their sum is measured): the battery's exponent is the
+    log-derivative of thrust against voltage, its coefficient over the whole thrust level.
 
     Parameters
     ----------
     fit : TermFit
         The term fitted on all of REAL.
     thrust_scale : float, optional
-        Real over simulated thrust per input (the trim fitted before any term).
+        Real over simulated thrust per input (the trim fitted before any term and the other terms' gains).
     rotor_radius_m : float, optional
         Propeller radius, m: the ground effect's end is also given as the rotor plane's Z/R (chapter 2).
 
@@ -94,6 +95,17 @@ def parameters_of(
         level = thrust_scale + gain.value
         out[0] = FittedParameter(
             name="exponent", value=exponent.value / level, uncertainty=exponent.uncertainty / level, unit="1"
+        )
+    if candidate.effect == "mass_change" and len(out) > 1:
+        ratio = out[1]  # the specific force per thrust drops by dm / (m + dm): the mass grew by ratio / (1 - ratio)
+        out.insert(
+            2,
+            FittedParameter(
+                name="mass_change_fraction",
+                value=ratio.value / (1.0 - ratio.value),
+                uncertainty=ratio.uncertainty / (1.0 - ratio.value) ** 2,
+                unit="1",
+            ),
         )
     if candidate.effect == "ground_effect" and len(out) > 1:
         rotors_above, c = out[0], out[1]
@@ -151,10 +163,13 @@ def describe_finding(finding: Finding, candidate: Candidate) -> str:
             f"The real vehicle gains thrust near the ground, up to about {p.value:.2f} m{where}; "
             "the simulation has no ground effect"
         )
-    elif effect == "mass_change" and (p := _value(finding, "mass_ratio")) is not None:
+    elif effect == "mass_change" and (p := _value(finding, "mass_change_fraction")) is not None:
         t = _value(finding, "time_s")
         when = f" at t = {_pm(t.value, t.uncertainty)} s of flight" if t is not None else ""
-        what = f"The required thrust steps by {_pm(p.value, p.uncertainty, 100.0, sign=True)} %{when}: the mass changed"
+        what = (
+            f"The mass changes by {_pm(p.value, p.uncertainty, 100.0, sign=True)} %{when}, "
+            "and the thrust needed to hover with it"
+        )
     elif effect == "battery_sag" and (p := _value(finding, "exponent")) is not None:
         what = f"Thrust follows the battery voltage (thrust ∝ V^n, n = {_pm(p.value, p.uncertainty)}); the simulation keeps it constant"
     elif effect == "cg_offset":

@@ -117,6 +117,7 @@ def discover(
     thrust = -base["az"]
     gain = float(np.dot(thrust, base["az"] - y["az"]) / max(float(np.dot(thrust, thrust)), 1e-300))
     additions["az"] = -gain * thrust  # the real thrust per input may differ by a constant factor: a trim
+    trim = additions["az"]
     kept: list[tuple[TermFit, float, dict[str, np.ndarray], dict[str, np.ndarray]]] = []
     screened: dict[str, float] = {}
     held_out = combined(base, additions)  # the baseline is fitted on SIM: on REAL its prediction is held out already
@@ -127,7 +128,10 @@ def discover(
         linear = [fit for fit, *_ in kept if fit.candidate.kind == "linear"]
         without = _without(additions, linear)  # the kept linear terms refit with each linear newcomer
         current = combined(base, additions)
-        for candidate in candidate_terms(flown, baseline, current, exclude=exclude):
+        # every term reads one thrust, the model's with the trim: two terms' thrust gains are then one column, whose
+        # sum is measured, and not two near copies whose difference (the first term's contribution) a fit would use
+        trimmed = {**current, "az": base["az"] + trim}
+        for candidate in candidate_terms(flown, baseline, trimmed, exclude=exclude):
             together = candidate.kind == "linear" and bool(linear)
             trial, adds = (joined(candidate, linear), without) if together else (candidate, additions)
             reference = held_out if together else None  # judged against the kept terms' held-out prediction
@@ -163,9 +167,20 @@ def discover(
         built = fit.candidate.build(fit.value)
         for o, coefficients in fit.coefficients.items():
             additions[o] = additions[o] + built[o] @ coefficients
+    gains = {id(fit): _thrust_gain(fit) for fit, *_ in kept}
     findings = sorted(
-        (
-            _finding(fit, score, before, after, y, flown, scale, 1.0 + gain, options.rotor_radius_m)
+        (  # each term's thrust level: the trim and the other terms' gains (collinear: only their sum is known)
+            _finding(
+                fit,
+                score,
+                before,
+                after,
+                y,
+                flown,
+                scale,
+                1.0 + gain + sum(gains.values()) - gains[id(fit)],
+                options.rotor_radius_m,
+            )
             for fit, score, before, after in kept
         ),
         key=lambda f: -f.improvement_percent,
@@ -184,6 +199,13 @@ def discover(
         real=tuple(s.name for s in real),
         thrust_scale=round(1.0 + gain, 5),
     )
+
+
+def _thrust_gain(fit: TermFit) -> float:
+    """The change of thrust per input a term fitted beside its shape (its ``gain`` on az), 0 if it has none."""
+    if "gain" not in fit.candidate.coefficients or "az" not in fit.coefficients:
+        return 0.0
+    return float(fit.coefficients["az"][fit.candidate.coefficients.index("gain")])
 
 
 def _without(additions: Mapping[str, np.ndarray], linear: Sequence[TermFit]) -> dict[str, np.ndarray]:

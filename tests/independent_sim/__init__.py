@@ -23,6 +23,9 @@ pyulog and pymavlink):
   the rate controller and never logged;
 * wind (:mod:`.wind`): Dryden turbulence, frozen past an anemometer 4.6 m
   upstream (20 Hz, ±0.3 m/s, a CSV the workbench reads);
+* physics outside the linear plant (:mod:`.effects`), for discrepancy pairs
+  (:mod:`.pairs`): a ground cushion, battery fade, a payload picked up, a CG
+  off the thrust axis, and the calm airframe in a steady wind;
 * logs (:mod:`.px4_log`, :mod:`.ardupilot_log`): realistic topics and rates;
 * corpus (:mod:`.corpus`, :mod:`.catalogue`): :func:`write_case` and the
   named :data:`TUNING_CASES` / :data:`HELDOUT_CASES`;

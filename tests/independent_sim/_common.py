@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from independent_sim.effects import pack_current, pack_voltage
 from independent_sim.flight import Flight
 
 __all__ = [
@@ -94,10 +95,8 @@ def battery(flight: Flight, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Voltage, V, and current, A.
     """
     thrust = flight.truth["delta_thr"][index]
-    current = 0.8 + 95.0 * thrust**1.5
     used_s = np.cumsum(flight.airborne) * flight.step_us / 1e6
-    voltage = 25.1 - 0.006 * used_s[index] - 0.009 * current
-    return voltage, current
+    return pack_voltage(thrust, used_s[index]), pack_current(thrust)
 
 
 def geodetic(north_m: np.ndarray, east_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -82,6 +82,8 @@ def exogenous_inputs(
         ramp = _smoothstep((t - move.start_s) / move.duration_s)
         columns["sp_xn"] += move.north_m * ramp
         columns["sp_ye"] += move.east_m * ramp
+    for change in plan.height_changes:
+        columns["sp_zd"] += change.down_m * _smoothstep((t - change.start_s) / change.duration_s)
     maneuvers = []
     for m in case.maneuvers:
         signal = m.design.render(t, m.start_s, m.amplitude, rng)
@@ -130,6 +132,11 @@ def _external_inputs(
         along = gust[:, 0] * math.cos(psi0) + gust[:, 1] * math.sin(psi0)
         series["wind_lon_x"], series["wind_lon_z"] = along, along
         series["wind_n"], series["wind_e"] = gust[:, 0], gust[:, 1]
+        if not plant.has_wind_terms:
+            # no G_w: a gust changes the air-relative velocity at once, the ground velocity not (eq. 3.1)
+            across = -gust[:, 0] * math.sin(psi0) + gust[:, 1] * math.cos(psi0)
+            series["air_accel_lon"] = np.gradient(along, period)
+            series["air_accel_lat"] = np.gradient(across, period)
     noise = case.noise
     for axis in "uvwpqr":
         std = noise.force_disturbance_std if axis in "uvw" else noise.moment_disturbance_std

@@ -4,15 +4,20 @@ The plan: lon, lat and yaw log chirps (0.1-6 Hz, 40 s, 6-8 % of the mixer range)
 15 m reposition north and back; 200 s in all, as PX4 ULog. A pair's REAL flight has its own noise
 seed and some :class:`~independent_sim.plant.HoverPlant` fields set to other values (a longer delay,
 a slower actuator, more speed damping); nothing in the log says which.
+
+:func:`physics_pair_case` flies a longer plan (240 s) that adds a low hover (0.35 m for 20 s) after
+the repositions, for physics outside the plant (:mod:`independent_sim.effects`) or a wind.
 """
 
 from __future__ import annotations
 
+from independent_sim.effects import Effect
 from independent_sim.maneuvers import Chirp, Maneuver
 from independent_sim.plant import hover_plant
-from independent_sim.scenario import Case, FlightPlan, Reposition
+from independent_sim.scenario import Case, FlightPlan, HeightChange, Reposition
+from independent_sim.wind import WindModel
 
-__all__ = ["PLANT", "Changes", "delayed", "scaled", "pair_case"]
+__all__ = ["PLANT", "Changes", "delayed", "scaled", "pair_case", "physics_pair_case", "LOW_HOVER_M"]
 
 #: The plant both flights start from (Table 3.3, calm).
 PLANT = hover_plant("calm")
@@ -32,15 +37,43 @@ def scaled(factor: float, *fields: str) -> Changes:
     return tuple((f, factor * getattr(PLANT, f)) for f in fields)
 
 
-def pair_case(name: str, seed: int, changes: Changes) -> Case:
-    """One flight of the pair plan, with the plant `changes` (none for SIM)."""
+#: Height of the low hover of :func:`physics_pair_case`, m.
+LOW_HOVER_M = 0.35
+_REPOSITIONS = (Reposition(start_s=150.0, north_m=15.0), Reposition(start_s=170.0, north_m=-15.0))
+
+
+def _sweeps() -> tuple[Maneuver, ...]:
     sweep = Chirp(duration_s=40.0, f_min_hz=0.1, f_max_hz=6.0)
-    maneuvers = tuple(
+    return tuple(
         Maneuver(axis=axis, design=sweep, start_s=start, amplitude=amplitude)  # type: ignore[arg-type]
         for axis, start, amplitude in (("lon", 10.0, 0.06), ("lat", 56.0, 0.07), ("yaw", 102.0, 0.08))
     )
+
+
+def pair_case(name: str, seed: int, changes: Changes) -> Case:
+    """One flight of the pair plan, with the plant `changes` (none for SIM)."""
+    plan = FlightPlan(duration_s=200.0, repositions=_REPOSITIONS)
+    return Case(name=name, fmt="ulog", plan=plan, maneuvers=_sweeps(), seed=seed, plant_changes=changes)
+
+
+def physics_pair_case(name: str, seed: int, *, effects: tuple[Effect, ...] = (), wind: WindModel | None = None) -> Case:
+    """One flight of the longer plan with a low hover: sweeps, repositions, 20 s at 0.35 m, landing.
+
+    Parameters
+    ----------
+    name : str
+        Case name.
+    seed : int
+        Noise seed.
+    effects : tuple of Effect
+        Physics outside the plant acting on this vehicle (none for SIM).
+    wind : WindModel or None
+        A wind for the calm airframe (the anemometer's CSV is written with the log).
+    """
+    down = 4.6 - LOW_HOVER_M
     plan = FlightPlan(
-        duration_s=200.0,
-        repositions=(Reposition(start_s=150.0, north_m=15.0), Reposition(start_s=170.0, north_m=-15.0)),
+        duration_s=240.0,
+        repositions=_REPOSITIONS,
+        height_changes=(HeightChange(start_s=188.0, down_m=down), HeightChange(start_s=213.0, down_m=-down)),
     )
-    return Case(name=name, fmt="ulog", plan=plan, maneuvers=maneuvers, seed=seed, plant_changes=changes)
+    return Case(name=name, fmt="ulog", plan=plan, maneuvers=_sweeps(), seed=seed, wind=wind, effects=effects)

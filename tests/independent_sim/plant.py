@@ -36,7 +36,7 @@ ground velocity is its air velocity plus the wind.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Literal
 
 import numpy as np
@@ -47,10 +47,12 @@ __all__ = [
     "G",
     "STATES",
     "PLANT_INPUTS",
+    "AIR_INPUTS",
     "HoverPlant",
     "Trim",
     "LinearPlant",
     "hover_plant",
+    "in_wind",
     "linear_plant",
     "longitudinal_matrix",
 ]
@@ -81,8 +83,10 @@ STATES: tuple[str, ...] = (
 
 #: Plant inputs, each entering after its own delay: the four mixer inputs
 #: (as logged), the along-nose wind for G_w on u and on w (m/s, eq. 3.6),
-#: the NED wind moving the vehicle over the ground (m/s), and unmeasured
-#: disturbance accelerations (m/s², rad/s²).
+#: the NED wind moving the vehicle over the ground (m/s), unmeasured
+#: disturbance accelerations (m/s², rad/s²) and the acceleration of the air
+#: itself in heading axes (m/s²: a gust changes the air-relative velocity at
+#: once, the ground velocity not; used where G_w is zero).
 PLANT_INPUTS: tuple[str, ...] = (
     "delta_lat",
     "delta_lon",
@@ -98,7 +102,11 @@ PLANT_INPUTS: tuple[str, ...] = (
     "dist_p",
     "dist_q",
     "dist_r",
+    "air_accel_lon",
+    "air_accel_lat",
 )
+#: Inputs that change the air-relative velocity without a force (a gust arriving): no accelerometer feels them.
+AIR_INPUTS: tuple[str, ...] = ("air_accel_lon", "air_accel_lat")
 
 _CONTROL_DERIVATIVES = ("X_lon", "M_lon", "Y_lat", "L_lat", "N_yaw", "Z_thr")
 
@@ -285,6 +293,48 @@ def hover_plant(
     return HoverPlant(**table, Z_w=0.0, tau_yaw=tau_yaw, tau_thr=tau_thr, trim=trim, condition=condition)
 
 
+def in_wind(plant: HoverPlant, speed_m_s: float, psi0: float) -> HoverPlant:
+    """The same airframe holding position in a steady wind: its own derivatives, trimmed against it.
+
+    Parameters
+    ----------
+    plant : HoverPlant
+        A calm airframe (U0 = W0 = 0).
+    speed_m_s : float
+        Mean wind speed, m/s; the nose faces the wind.
+    psi0 : float
+        Heading, rad.
+
+    Returns
+    -------
+    HoverPlant
+        The pitch trim cancels the moment of the wind (``M_lon delta_lon0 = -M_u U0``) and the trim
+        pitch balances the specific force along the nose (``g sin(theta0) = X_u U0 + X_lon delta_lon0``);
+        the air flows level (U0 = M cos(theta0), W0 = M sin(theta0)). G_w stays zero: the wind acts
+        through the speed derivatives alone.
+
+    Examples
+    --------
+    >>> plant = in_wind(hover_plant("calm"), 5.4, 0.0)
+    >>> round(math.degrees(plant.trim.theta0), 2), round(plant.trim.delta_lon, 4)
+    (-5.44, -0.0787)
+    """
+    theta0 = 0.0
+    for _ in range(5):  # U0 depends on theta0 a little
+        u0 = speed_m_s * math.cos(theta0)
+        theta0 = math.asin(u0 * (plant.X_u - plant.X_lon * plant.M_u / plant.M_lon) / G)
+    u0, w0 = speed_m_s * math.cos(theta0), speed_m_s * math.sin(theta0)
+    trim = Trim(
+        U0=u0,
+        W0=w0,
+        theta0=theta0,
+        psi0=psi0,
+        delta_lon=-plant.M_u * u0 / plant.M_lon,
+        delta_thr=plant.trim.delta_thr / math.cos(theta0),
+    )
+    return replace(plant, trim=trim)
+
+
 @dataclass(frozen=True, slots=True)
 class LinearPlant:
     """Continuous-time plant ``x' = A x + sum_j B[:, j] u_j(t - delays[j])``.
@@ -436,6 +486,8 @@ def _state_and_input_matrices(plant: HoverPlant) -> tuple[np.ndarray, np.ndarray
         ("x_n", "wind_n"): 1.0,
         ("y_e", "wind_e"): 1.0,
         **{(state, f"dist_{state}"): 1.0 for state in "uvwpqr"},
+        ("u", "air_accel_lon"): -1.0,
+        ("v", "air_accel_lat"): -1.0,
     }
     B = np.zeros((len(STATES), len(PLANT_INPUTS)))
     for (row, col), value in inputs.items():

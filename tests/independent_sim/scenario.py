@@ -5,10 +5,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
+from independent_sim.effects import Effect
 from independent_sim.maneuvers import Maneuver
 from independent_sim.wind import WindModel
 
-__all__ = ["LogFormat", "NoiseModel", "Reposition", "FlightPlan", "Case"]
+__all__ = ["LogFormat", "NoiseModel", "Reposition", "HeightChange", "FlightPlan", "Case"]
 
 LogFormat = Literal["ulog", "dataflash"]
 
@@ -88,6 +89,25 @@ class Reposition:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class HeightChange:
+    """A pilot moving the height setpoint during the hover: a smooth step.
+
+    Parameters
+    ----------
+    start_s : float
+        Start, s after take-off.
+    duration_s : float
+        Time to reach the new setpoint, s.
+    down_m : float
+        Setpoint change, m (positive: lower).
+    """
+
+    start_s: float
+    down_m: float
+    duration_s: float = 5.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class FlightPlan:
     """Timing of a flight: ground, take-off, hover, landing, ground.
 
@@ -108,6 +128,8 @@ class FlightPlan:
         UTC of the first logged sample, UNIX s.
     repositions : tuple of Reposition
         Position setpoint moves during the hover.
+    height_changes : tuple of HeightChange
+        Height setpoint moves during the hover (a low hover near the ground).
     """
 
     duration_s: float
@@ -119,6 +141,7 @@ class FlightPlan:
     log_start_us: int = 41_250_000
     utc_at_log_start: float = 1_715_698_931.0  # 2024-05-14T15:02:11Z
     repositions: tuple[Reposition, ...] = ()
+    height_changes: tuple[HeightChange, ...] = ()
 
     def __post_init__(self) -> None:
         if self.takeoff_s + self.landing_s + 10.0 > self.duration_s:
@@ -149,7 +172,8 @@ class Case:
     maneuvers : tuple of Maneuver
         What is flown, in any order (they must not overlap on one axis).
     condition : {"calm", "light", "strong"}
-        Table 3.3 column of the airframe; "light"/"strong" need `wind`.
+        Table 3.3 column of the airframe; "light"/"strong" need `wind`. A calm airframe may fly in
+        `wind` too: then the wind acts only through the airframe's speed derivatives (no G_w).
     wind : WindModel or None
         Turbulent wind and the anemometer (then a CSV is written).
     noise : NoiseModel
@@ -166,6 +190,8 @@ class Case:
     plant_changes : tuple of (str, float)
         :class:`~independent_sim.plant.HoverPlant` fields set to other values (a vehicle that differs from
         the Table 3.3 one: a longer delay, a slower actuator, more drag).
+    effects : tuple of Effect
+        Physics outside the linear plant that acts on this vehicle (:mod:`independent_sim.effects`).
     """
 
     name: str
@@ -180,12 +206,13 @@ class Case:
     seed: int = 0
     description: str = ""
     plant_changes: tuple[tuple[str, float], ...] = ()
+    effects: tuple[Effect, ...] = ()
 
     def __post_init__(self) -> None:
         if self.fmt not in ("ulog", "dataflash"):
             raise ValueError(f"{self.fmt=} must be 'ulog' or 'dataflash'")
-        if (self.condition != "calm") != (self.wind is not None):
-            raise ValueError(f"{self.name}: a {self.condition} case needs wind exactly when not calm")
+        if self.condition != "calm" and self.wind is None:
+            raise ValueError(f"{self.name}: a {self.condition} case needs wind")
         low, high = self.plan.hover_span_s
         for m in self.maneuvers:
             if m.start_s < low or m.end_s > high:

@@ -28,8 +28,9 @@ from independent_sim.control import (
     closed_loop,
     px4_gains,
 )
+from independent_sim.effects import FORCED, EffectForcing, effect_forcing
 from independent_sim.flight import Flight, ManeuverTruth
-from independent_sim.plant import PLANT_INPUTS, STATES, G, HoverPlant, hover_plant
+from independent_sim.plant import AIR_INPUTS, PLANT_INPUTS, STATES, G, HoverPlant, hover_plant, in_wind
 from independent_sim.scenario import Case, LogFormat
 from independent_sim.wind import WindField, wind_field
 
@@ -60,6 +61,8 @@ def simulate(case: Case, fmt: LogFormat | None = None) -> Flight:
     plan, rng = case.plan, np.random.default_rng(case.seed)
     psi0 = math.radians(case.wind.from_deg if case.wind is not None else case.heading_deg)
     plant = replace(hover_plant(case.condition, psi0=psi0), **dict(case.plant_changes))
+    if case.wind is not None and not plant.has_wind_terms:  # the calm airframe flown in wind
+        plant = in_wind(plant, case.wind.mean_speed_m_s, psi0)
     gains = px4_gains(plant) if fmt == "ulog" else ardupilot_gains(plant)
     loop = closed_loop(plant, gains, n_sub=_SUB_STEPS[fmt])
     grid = _Grid.of(case, gains.rate_hz, loop.n_sub)
@@ -75,7 +78,22 @@ def simulate(case: Case, fmt: LogFormat | None = None) -> Flight:
     W, external, maneuvers = exogenous_inputs(
         case, loop, plant, control_t, grid.takeoff_s, noise, grid.n_before, field_, rng
     )
-    X = _run(loop, W, _initial_state(loop, plant, case))
+    forcing = effect_forcing(
+        case.effects,
+        gravity=G,
+        z_thr=plant.Z_thr,
+        l_lat=plant.L_lat,
+        m_lon=plant.M_lon,
+        trim_thrust=plant.trim.delta_thr,
+        hover_height_m=plan.hover_height_m,
+    )
+    if forcing is None:
+        X = _run(loop, W, _initial_state(loop, plant, case))
+    else:
+        X = _run_forced(loop, W, _initial_state(loop, plant, case), forcing)
+        for name in FORCED:  # what the effects added, for the fine grid
+            column = {c: k for k, c in enumerate(loop.inputs)}
+            external[name] = (W[:, column[f"{name}@prev"]], W[:, column[f"{name}@cur"]])
     Y = X[:-1] @ loop.C.T + W @ loop.D.T
     outputs = {name: Y[:, k] for k, name in enumerate(loop.outputs)}
     x_fine, xdot_fine = _lift(loop, X[:-1, : len(STATES)], outputs, external)
@@ -168,13 +186,42 @@ def _run(loop: ClosedLoop, W: np.ndarray, x0: np.ndarray) -> np.ndarray:
     return X
 
 
+def _run_forced(loop: ClosedLoop, W: np.ndarray, x0: np.ndarray, forcing: EffectForcing) -> np.ndarray:
+    """States X[0..n] with the effects' disturbances computed from each step's state (W updated in place).
+
+    A disturbance input without delay enters step k as ``name@cur`` and step k + 1 as ``name@prev``.
+    """
+    column = {name: k for k, name in enumerate(loop.inputs)}
+    state = {name: k for k, name in enumerate(loop.states)}
+    for name in FORCED:
+        if loop.maps[PLANT_INPUTS.index(name)].n_periods != 0:
+            raise ValueError(f"{name} must enter without delay")
+    cur = [column[f"{name}@cur"] for name in FORCED]
+    prev = [column[f"{name}@prev"] for name in FORCED]
+    thrust_row = loop.outputs.index("delta_thr")
+    trim_thrust = forcing.trim_thrust
+    A, B, C_thr, D_thr = loop.A, loop.B, loop.C[thrust_row], loop.D[thrust_row]
+    X = np.empty((W.shape[0] + 1, x0.size))
+    X[0] = x = x0
+    picked = ("z_d", "d_thr", "d_lat", "d_lon")
+    for k in range(W.shape[0]):
+        command = trim_thrust + C_thr @ x + D_thr @ W[k]
+        added = forcing.at(k * loop.period_s, {n: x[state[n]] for n in picked}, float(command))
+        W[k, cur] += added
+        if k + 1 < W.shape[0]:
+            W[k + 1, prev] += added
+        x = A @ x + B @ W[k]
+        X[k + 1] = x
+    return X
+
+
 def _lift(
     loop: ClosedLoop,
     x: np.ndarray,
     outputs: Mapping[str, np.ndarray],
     external: Mapping[str, tuple[np.ndarray, np.ndarray]],
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Plant states and their derivatives on the fine grid, shape (n_steps * n_sub, 15) each."""
+    """Plant states and the derivatives the accelerometers feel on the fine grid, shape (n_steps * n_sub, 15) each."""
     n_steps, m_sub = x.shape[0], loop.n_sub
     A, B = loop.plant.A, loop.plant.B
     prev = np.zeros((n_steps, len(PLANT_INPUTS)))
@@ -197,7 +244,9 @@ def _lift(
     fine = np.einsum("mij,kj->kmi", phis, x)
     fine += np.einsum("kj,jmi->kmi", prev, before) + np.einsum("kj,jmi->kmi", cur, after)
     acting = np.where(active[None, :, :], cur[:, None, :], prev[:, None, :])
-    derivative = fine @ A.T + acting @ B.T
+    felt = B.copy()  # the air's own acceleration changes u and v, but no accelerometer feels it
+    felt[:, [PLANT_INPUTS.index(name) for name in AIR_INPUTS]] = 0.0
+    derivative = fine @ A.T + acting @ felt.T
     return fine.reshape(-1, len(STATES)), derivative.reshape(-1, len(STATES))
 
 

@@ -480,3 +480,60 @@ def test_corpus_fixture_writes_each_case_once(independent_corpus) -> None:
     assert independent_corpus.files("heldout-ap-hover") is files
     assert files.truth.maneuvers == () and files.truth.unexcited_axes == ("lat", "lon", "yaw", "thr")
     assert files.segments_csv.read_text().splitlines() == ["start_s,end_s,axis,kind,f_min_hz,f_max_hz"]
+
+
+# ------------------------------------------------------------------ physics outside the plant (discrepancy pairs)
+
+
+@pytest.fixture(scope="module", name="physics_flights")
+def physics_flights_fixture():  # type: ignore[no-untyped-def]
+    """The pair plan flown plain, with a payload picked up at 120 s, with a strong ground cushion, in wind."""
+    from independent_sim.effects import GroundCushion, PayloadPickUp
+    from independent_sim.pairs import physics_pair_case
+
+    wind = WindModel(mean_speed_m_s=5.4, sigma_m_s=0.0, from_deg=30.0)
+    return {
+        "plain": simulate(physics_pair_case("plain", 7)),
+        "payload": simulate(physics_pair_case("payload", 7, effects=(PayloadPickUp(at_s=120.0, ratio=0.06),))),
+        "cushion": simulate(physics_pair_case("cushion", 7, effects=(GroundCushion(gain=0.25),))),
+        "wind": simulate(physics_pair_case("wind", 7, wind=wind)),
+    }
+
+
+def _mean_over(flight, name: str, start_s: float, end_s: float) -> float:  # type: ignore[no-untyped-def]
+    """Mean of a truth signal from `start_s` to `end_s` after take-off."""
+    t = flight.time_s - flight.time_s[flight.airborne][0]
+    return float(np.mean(flight.truth[name][(t >= start_s) & (t < end_s)]))
+
+
+def test_a_payload_raises_the_hover_thrust_by_its_weight(physics_flights) -> None:  # type: ignore[no-untyped-def]
+    """Mass 1.06 m from 120 s: the loop needs g 0.06 / -Z_thr more thrust command (the linear plant's slope)."""
+    flight, plain = physics_flights["payload"], physics_flights["plain"]
+    before = _mean_over(flight, "delta_thr", 110.0, 119.0) - _mean_over(plain, "delta_thr", 110.0, 119.0)
+    after = _mean_over(flight, "delta_thr", 125.0, 140.0) - _mean_over(plain, "delta_thr", 125.0, 140.0)
+    assert abs(before) < 1e-4
+    assert after == pytest.approx(G * 0.06 / -flight.plant.Z_thr, rel=0.02)
+
+
+def test_the_low_hover_goes_down_to_its_height_and_the_cushion_lifts_there(physics_flights) -> None:  # type: ignore[no-untyped-def]
+    """20 s at 0.35 m: the cushion 0.25 exp(-(h + 0.12) / 0.15) of thrust at the height flown is taken off the command."""
+    from independent_sim.pairs import LOW_HOVER_M
+
+    flight, plain = physics_flights["cushion"], physics_flights["plain"]
+    height = _mean_over(flight, "height", 198.0, 210.0)
+    assert height == pytest.approx(LOW_HOVER_M, abs=0.05)  # the height loop's own error (plain flight: +0.023 m)
+    saved = _mean_over(plain, "delta_thr", 198.0, 210.0) - _mean_over(flight, "delta_thr", 198.0, 210.0)
+    cushion = 0.25 * math.exp(-(height + 0.12) / 0.15)
+    assert saved == pytest.approx(G * cushion / -flight.plant.Z_thr, rel=0.05)
+    assert abs(_mean_over(plain, "delta_thr", 60.0, 100.0) - _mean_over(flight, "delta_thr", 60.0, 100.0)) < 1e-4
+
+
+def test_the_calm_airframe_holds_its_place_in_a_steady_wind(physics_flights) -> None:  # type: ignore[no-untyped-def]
+    """Nose into 5.4 m/s: no ground speed, the accelerometer reads the drag, the air flows level past it."""
+    flight = physics_flights["wind"]
+    plant = flight.plant
+    for name in ("vn", "ve", "vd"):
+        assert abs(_mean_over(flight, name, 60.0, 100.0)) < 0.05, name
+    assert _mean_over(flight, "ax", 60.0, 100.0) == pytest.approx(G * math.sin(plant.trim.theta0), rel=0.02)
+    assert _mean_over(flight, "u", 60.0, 100.0) == pytest.approx(5.4 * math.cos(plant.trim.theta0), rel=0.02)
+    assert abs(_mean_over(flight, "w", 60.0, 100.0) - 5.4 * math.sin(plant.trim.theta0)) < 0.05

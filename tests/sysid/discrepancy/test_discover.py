@@ -14,6 +14,7 @@ reads about 2.2 (truth 2).
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -142,8 +143,12 @@ def test_the_delay_is_the_one_added(results: Results) -> None:
 def test_the_mass_step_has_its_size_and_time(results: Results) -> None:
     """5.7 % of the mass picked up at 70 s: the specific force per thrust drops by 0.057 / 1.057."""
     ratio, _ = _parameter(results["octo", "mass_change"], "mass_ratio")
+    fraction, _ = _parameter(results["octo", "mass_change"], "mass_change_fraction")
     time_s, time_sigma = _parameter(results["octo", "mass_change"], "time_s")
     assert ratio == pytest.approx(0.057 / 1.057, rel=0.05)
+    assert fraction == pytest.approx(0.057, rel=0.05) and fraction == pytest.approx(ratio / (1.0 - ratio), rel=1e-12)
+    said = re.search(r"The mass changes by \+(\d+\.\d+) ± ", results["octo", "mass_change"].summary)
+    assert said is not None and float(said.group(1)) == pytest.approx(100.0 * fraction, abs=0.01)
     assert abs(time_s - 70.0) <= max(0.5, 3 * time_sigma)
     assert results["octo", "mass_change"].findings[0].regime.variable == "time"
 
