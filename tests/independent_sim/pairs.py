@@ -56,7 +56,14 @@ def pair_case(name: str, seed: int, changes: Changes) -> Case:
     return Case(name=name, fmt="ulog", plan=plan, maneuvers=_sweeps(), seed=seed, plant_changes=changes)
 
 
-def physics_pair_case(name: str, seed: int, *, effects: tuple[Effect, ...] = (), wind: WindModel | None = None) -> Case:
+def physics_pair_case(
+    name: str,
+    seed: int,
+    *,
+    changes: Changes = (),
+    effects: tuple[Effect, ...] = (),
+    wind: WindModel | None = None,
+) -> Case:
     """One flight of the longer plan with a low hover: sweeps, repositions, 20 s at 0.35 m, landing.
 
     Parameters
@@ -65,6 +72,8 @@ def physics_pair_case(name: str, seed: int, *, effects: tuple[Effect, ...] = (),
         Case name.
     seed : int
         Noise seed.
+    changes : Changes
+        Plant fields set to other values (none for SIM).
     effects : tuple of Effect
         Physics outside the plant acting on this vehicle (none for SIM).
     wind : WindModel or None
@@ -76,4 +85,13 @@ def physics_pair_case(name: str, seed: int, *, effects: tuple[Effect, ...] = (),
         repositions=_REPOSITIONS,
         height_changes=(HeightChange(start_s=188.0, down_m=down), HeightChange(start_s=213.0, down_m=-down)),
     )
-    return Case(name=name, fmt="ulog", plan=plan, maneuvers=_sweeps(), seed=seed, wind=wind, effects=effects)
+    return Case(
+        name=name,
+        fmt="ulog",
+        plan=plan,
+        maneuvers=_sweeps(),
+        seed=seed,
+        plant_changes=changes,
+        wind=wind,
+        effects=effects,
+    )
