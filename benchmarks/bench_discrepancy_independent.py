@@ -29,14 +29,14 @@ from pathlib import Path
 _ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(_ROOT), str(_ROOT / "tests")]  # the generator lives in tests/ (whose flightlogs/ holds tests)
 
-from independent_sim.corpus import write_case
-from independent_sim.effects import BatteryFade, GroundCushion, OffsetCentre, PayloadPickUp
-from independent_sim.pairs import delayed, physics_pair_case, scaled
-from independent_sim.wind import WindModel
+from independent_sim.corpus import write_case  # noqa: E402
+from independent_sim.effects import BatteryFade, GroundCushion, OffsetCentre, PayloadPickUp  # noqa: E402
+from independent_sim.pairs import delayed, physics_pair_case, scaled  # noqa: E402
+from independent_sim.wind import WindModel  # noqa: E402
 
-from flightlogs.conditioning.condition import ConditioningOptions
-from flightlogs.store.campaign import ingest_campaign
-from sysid.discrepancy import discover, flight_series
+from flightlogs.conditioning.condition import ConditioningOptions  # noqa: E402
+from flightlogs.store.campaign import ingest_campaign  # noqa: E402
+from sysid.discrepancy import discover, flight_series  # noqa: E402
 
 STRENGTHS = ("strong", "moderate", "weak")
 _FACTOR = {"strong": 1.0, "moderate": 0.5, "weak": 0.25}

@@ -1,9 +1,10 @@
 """Physics the linear plant leaves out, flown into a REAL vehicle of a discrepancy pair (issue 15).
 
 The plant (:mod:`.plant`) is linear and knows nothing of the ground, the battery or a payload. A
-discrepancy pair needs a REAL vehicle that differs from the simulated one by such physics, written
-here without looking at how the workbench's search models it (``sysid.discrepancy.terms``) or how
-our own simulator flies it (``simulator.world``): other laws, other constants.
+discrepancy pair needs a REAL vehicle that differs from the simulated one by such physics, here with
+laws and constants that neither our own simulator (``simulator.world``) nor the search's terms
+(``sysid.discrepancy.terms``) use: an exponential cushion where they have the chapter 2 laws and an
+inverse square, a fade of the control moments with the voltage that the search does not model.
 
 Each effect is a force or moment that the closed loop feels at every control step, computed from
 the state the loop has reached (height, thrust, time) and added to the plant's unmeasured
