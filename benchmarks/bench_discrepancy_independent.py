@@ -37,6 +37,7 @@ from independent_sim.wind import WindModel  # noqa: E402
 from flightlogs.conditioning.condition import ConditioningOptions  # noqa: E402
 from flightlogs.store.campaign import ingest_campaign  # noqa: E402
 from sysid.discrepancy import discover, flight_series  # noqa: E402
+from sysid.discrepancy.terms import EFFECTS  # noqa: E402
 
 STRENGTHS = ("strong", "moderate", "weak")
 _FACTOR = {"strong": 1.0, "moderate": 0.5, "weak": 0.25}
@@ -57,16 +58,6 @@ def _single(effect: str, strength: str) -> dict[str, object]:
     }[effect]
 
 
-EFFECTS = (
-    "ground_effect",
-    "rotor_drag",
-    "wind",
-    "time_delay",
-    "actuator_lag",
-    "battery_sag",
-    "mass_change",
-    "cg_offset",
-)
 DOUBLES = (
     ("ground_effect", "time_delay"),
     ("rotor_drag", "battery_sag"),
