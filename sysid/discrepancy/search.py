@@ -11,7 +11,8 @@
    passes if its held-out score beats three times its null score and a
    floor (the first term: 1 % of the whole flight's residual and 5 % where
    it acts, so that an effect of 20 s near the ground is judged there; a
-   later one: 5 % of the whole), and if 80 % of what it changes lies in at least 2 s of flight
+   later one: 5 % of the whole), and if 80 % of what it changes lies in at least 2 s of flight or in
+   episodes 10 s apart (near the ground at take-off and at landing)
    (a touchdown's spike is no physics); of those that pass, the one that lowers the Bayesian information
    criterion most (effective samples, the parameter inside its shape
    counted) is kept; its contribution joins the model and the others are
@@ -59,8 +60,11 @@ _REGIMES = (
     ("t_flight", "s"),
 )
 
+_NULL_BLOCK_S = 4.0  # the simulated flight's alternate blocks for its noise floor: each half sees every manoeuvre
 _SUPPORT_SHARE = 0.8  # a term's support: the samples that hold this share of its contribution ...
-_MIN_SUPPORT_S = 2.0  # ... must span this much flight (a touchdown's spike: 0.3 s; a 15 m reposition's drag: 5 s)
+_MIN_SUPPORT_S = 2.0  # ... must span this much flight (a touchdown's spike: 0.3 s; a 15 m reposition's drag: 5 s),
+_EPISODE_S = 0.25  # ... or recur: episodes of at least this long ...
+_APART_S = 10.0  # ... this far apart (a ground effect at take-off and at landing, 1.1-1.9 s in all)
 
 Progress = Callable[[str, int, int], None]
 
@@ -159,8 +163,8 @@ def discover(
                 if candidate.kind == "transform" and fit.value >= candidate.grid[-1]:
                     continue  # at the end of the range searched: a bound, not a measured delay or lag
                 prediction = fit.prediction(base, adds)
-                if _support_s(prediction, current, scale, flown.rate_hz) < _MIN_SUPPORT_S:
-                    continue  # a few seconds of flight (a touchdown, a spike) are no physical effect
+                if not _sustained(_support(prediction, current, scale), flown["t_flight"]):
+                    continue  # a moment of flight (a touchdown, a spike) is no physical effect
                 change = _bic_change(fit, y, prediction, current, len(candidate.coefficients))
                 scores.append((change, score, fit, predicted, candidate, adds))
         _report(progress, "screening terms", len(kept) + 1, options.max_findings + 1)
@@ -271,11 +275,21 @@ def _support(
     return order[: int(np.searchsorted(np.cumsum(energy[order]), _SUPPORT_SHARE * total)) + 1]
 
 
-def _support_s(
-    prediction: Mapping[str, np.ndarray], current: Mapping[str, np.ndarray], scale: Mapping[str, float], rate_hz: float
-) -> float:
-    """Seconds of flight holding 80 % of a term's weighted contribution (its change to the prediction)."""
-    return _support(prediction, current, scale).size / rate_hz
+def _sustained(rows: np.ndarray, clock: np.ndarray) -> bool:
+    """Whether a term's support (sample indices) spans 2 s of flight, or recurs in episodes 10 s apart.
+
+    A spike at one touchdown is an event; an effect that comes back whenever its regime does (near
+    the ground at take-off and at landing) is physics, however short each visit.
+    """
+    if rows.size == 0:
+        return False
+    times = np.sort(clock[rows])
+    step = float(np.median(np.diff(clock))) if clock.size > 1 else 0.0
+    if times.size * step >= _MIN_SUPPORT_S:
+        return True
+    breaks = np.flatnonzero(np.diff(times) > 1.0) + 1  # episodes: support samples less than 1 s apart
+    episodes = [(e[0], e[-1]) for e in np.split(times, breaks) if e[-1] - e[0] + step >= _EPISODE_S]
+    return len(episodes) > 1 and episodes[-1][0] - episodes[0][1] >= _APART_S
 
 
 def _local_score(
@@ -302,12 +316,12 @@ def _local_score(
 def _noise_floor(sim: FlightSeries) -> tuple[dict[str, float], dict[str, float]]:
     """Each output's held-out residual variance on SIM, and every term's held-out score there (its null score).
 
-    Two folds of alternate blocks: the model fitted on one half is judged on the other, and the other way
-    round; both figures are the means of the two. One fold alone depends on where the flight's regimes
-    fall: a reposition held out from the fit makes the model extrapolate along it, and a drag term then
-    gains on noise (0.077 on one split, nothing on the other).
+    Two folds of alternate 4 s blocks: the model fitted on one half is judged on the other, and the other
+    way round; both figures are the means of the two. With long blocks (25 s) the figures depended on
+    where the flight's manoeuvres fell: a reposition held out from the fit made the model extrapolate
+    along it, and a drag term gained on noise (0.077 on one split, 0.28 on another flight's).
     """
-    parts = blocks(sim.n, 8)
+    parts = blocks(sim.n, max(8, int(sim.n / (_NULL_BLOCK_S * sim.rate_hz))))
     halves = (np.concatenate(parts[1::2]), np.concatenate(parts[0::2]))
     scales, nulls = [], []
     for fitting, held in (halves, halves[::-1]):

@@ -22,8 +22,12 @@ seed 501 against REAL seeds 601 on (exploration); every assertion runs on SIM se
 * the mass step's size was printed as the change of thrust per thrust, not of the mass.
 
 The benchmark (``benchmarks/bench_discrepancy_independent.py``) runs the eight effects at three
-strengths on other seeds; it found that the ground effect at half and a quarter of this strength was
-missed, its 20 s near the ground under the 5 % of the whole flight's residual a term had to remove.
+strengths on other seeds. It found three more, each fixed: the ground effect at half and a quarter of
+this strength was missed, its 20 s near the ground under the 5 % of the whole flight's residual a term
+had to remove (the first term is now judged where it acts), or its contribution, mostly at take-off
+and landing, under the 2 s a term had to span (a term may now recur instead); and the speed damping's
+null score came out 0.28 on one simulated flight (25 s blocks: the half that held the reposition out
+made the model extrapolate along it; now 4 s blocks and both halves).
 """
 
 from __future__ import annotations
