@@ -150,8 +150,8 @@ def discover(
             # once a term is kept, the residual where it acts holds its shape's error, which another term acting
             # there fits as well (a mass step at the low hover beside a ground effect): later terms must also
             # remove a share of the whole flight's residual
-            floor = options.min_improvement if kept else options.min_share
-            threshold = max(floor, options.null_margin * max(null.get(candidate.effect, 0.0), 0.0))
+            least = options.min_improvement if kept else options.min_share
+            threshold = max(least, options.null_margin * max(null.get(candidate.effect, 0.0), 0.0))
             against = reference if reference is not None else current
             local = _local_score(y, predicted, against, scale, candidate.outputs)
             if not kept:
@@ -328,17 +328,26 @@ def _noise_floor(sim: FlightSeries) -> tuple[dict[str, float], dict[str, float]]
         model: BaselineModel = fit_baseline(sim, fitting)
         prediction = model.predict(sim)
         scale = {o: max(float(np.var((sim[o] - prediction[o])[held])), 1e-12) for o in OUTPUTS}
-        rest = sim.subset(held)
-        y = {o: rest[o] for o in OUTPUTS}
+        y = {o: sim[o][held] for o in OUTPUTS}
         base = {o: prediction[o][held] for o in OUTPUTS}
-        zeros = {o: np.zeros(rest.n) for o in OUTPUTS}
+        zeros = {o: np.zeros(held.size) for o in OUTPUTS}
         scales.append(scale)
-        nulls.append(
-            {c.effect: cross_validated(c, y, base, zeros, scale)[0] for c in candidate_terms(rest, model, base)}
-        )
+        # the terms are built on the whole flight (a delay's inputs reach back across the blocks) and judged on the half
+        terms = [_on_rows(c, held) for c in candidate_terms(sim, model, prediction)]
+        nulls.append({c.effect: cross_validated(c, y, base, zeros, scale)[0] for c in terms})
     scale = {o: float(np.mean([s[o] for s in scales])) for o in OUTPUTS}
     null = {e: float(np.mean([n.get(e, 0.0) for n in nulls])) for e in set().union(*nulls)}
     return scale, null
+
+
+def _on_rows(candidate: Candidate, rows: np.ndarray) -> Candidate:
+    """`candidate` with its regressors or predictions taken at samples `rows` only."""
+    build = candidate.build
+
+    def built(value: float) -> dict[str, np.ndarray]:
+        return {o: np.asarray(a)[rows] for o, a in build(value).items()}
+
+    return replace(candidate, build=built)
 
 
 def _joined(flights: Sequence[FlightSeries]) -> FlightSeries:
