@@ -281,15 +281,7 @@ def hover_plant(
         table[name] = round(table[name] * control_scale, 10)
     theta0 = math.radians(TRIM_PITCH_DEG[condition])
     speed = MEAN_WIND[condition]
-    u0, w0 = speed * math.cos(theta0), speed * math.sin(theta0)
-    trim = Trim(
-        U0=u0,
-        W0=w0,
-        theta0=theta0,
-        psi0=psi0,
-        delta_lon=-0.005 * speed,
-        delta_thr=hover_thrust / math.cos(theta0),
-    )
+    trim = _into_wind(speed, theta0, psi0, delta_lon=-0.005 * speed, hover_thrust=hover_thrust)
     return HoverPlant(**table, Z_w=0.0, tau_yaw=tau_yaw, tau_thr=tau_thr, trim=trim, condition=condition)
 
 
@@ -323,16 +315,22 @@ def in_wind(plant: HoverPlant, speed_m_s: float, psi0: float) -> HoverPlant:
     for _ in range(5):  # U0 depends on theta0 a little
         u0 = speed_m_s * math.cos(theta0)
         theta0 = math.asin(u0 * (plant.X_u - plant.X_lon * plant.M_u / plant.M_lon) / G)
-    u0, w0 = speed_m_s * math.cos(theta0), speed_m_s * math.sin(theta0)
-    trim = Trim(
-        U0=u0,
-        W0=w0,
+    delta_lon = -plant.M_u * speed_m_s * math.cos(theta0) / plant.M_lon
+    return replace(
+        plant, trim=_into_wind(speed_m_s, theta0, psi0, delta_lon=delta_lon, hover_thrust=plant.trim.delta_thr)
+    )
+
+
+def _into_wind(speed_m_s: float, theta0: float, psi0: float, *, delta_lon: float, hover_thrust: float) -> Trim:
+    """Holding position nose into a steady wind: the air flows level past the pitched body, thrust tilted."""
+    return Trim(
+        U0=speed_m_s * math.cos(theta0),
+        W0=speed_m_s * math.sin(theta0),
         theta0=theta0,
         psi0=psi0,
-        delta_lon=-plant.M_u * u0 / plant.M_lon,
-        delta_thr=plant.trim.delta_thr / math.cos(theta0),
+        delta_lon=delta_lon,
+        delta_thr=hover_thrust / math.cos(theta0),
     )
-    return replace(plant, trim=trim)
 
 
 @dataclass(frozen=True, slots=True)
