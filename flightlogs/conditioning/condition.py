@@ -35,7 +35,7 @@ from flightlogs.flightlog import FlightLog, Signal
 from flightlogs.frames import air_velocity_body, wind_to_body_axes
 from flightlogs.geo import bearing_and_distance, local_north_east
 from flightlogs.maneuvers.excitation_recovery import estimate_excitation
-from flightlogs.maneuvers.segments import Segment, detect_segments, segments_from_sid
+from flightlogs.maneuvers.segments import Segment, SegmentDetector, segments_from_sid
 from flightlogs.masks import true_runs
 from flightlogs.record import Record
 
@@ -523,17 +523,23 @@ def _segments(
     quiet = np.zeros(time_base.size, dtype=bool)
     for start, stop in pieces:
         quiet[start:stop] = True
+    # the sweeps are found in the logged traces, once; the steps in the excitation, refitted below
+    detectors = [
+        (start, stop, SegmentDetector(time_base[start:stop], responses=_finite_traces(values, shown, start, stop)))
+        for start, stop in pieces
+    ]
     detected: list[Segment] = []
+    fitted_on: np.ndarray | None = None
     for _ in range(2):  # fit the feedback where nothing is excited, detect, refit without what was found
-        excitation = estimate_excitation(inputs, values, quiet & ~_near(time_base, detected, 2.0), time_s=time_base)
+        unexcited = quiet & ~_near(time_base, detected, 2.0)
+        if fitted_on is not None and np.array_equal(unexcited, fitted_on):
+            break  # nothing found to leave out: the refit would repeat the first pass exactly
+        fitted_on = unexcited
+        excitation = estimate_excitation(inputs, values, unexcited, time_s=time_base)
         detected = [
             segment
-            for start, stop in pieces
-            for segment in detect_segments(
-                time_base[start:stop],
-                {a: x[start:stop] for a, x in excitation.items()},
-                responses=_finite_traces(values, shown, start, stop),
-            )
+            for start, stop, detector in detectors
+            for segment in detector.detect({a: x[start:stop] for a, x in excitation.items()})
         ]
     flying, vd = _flight_state(time_base, values)
     kept = [

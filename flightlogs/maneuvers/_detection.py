@@ -19,6 +19,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from flightlogs._moving import dilate, moving_mean
+from flightlogs._threads import map_traces
 from flightlogs.maneuvers import _rank
 from flightlogs.maneuvers._rank import spearman
 from flightlogs.masks import true_runs
@@ -120,7 +121,7 @@ def find_maneuvers(
     busy : list of (int, int)
         Inclusive index ranges of every maneuver and every reaction to one.
     """
-    acts = {axis: _activity(x, dt, threshold, trend_window_s) for axis, x in traces.items()}
+    acts = dict(zip(traces, map_traces(lambda x: _activity(x, dt, threshold, trend_window_s), traces.values())))
     bursts = [b for axis, act in acts.items() for b in _bursts(axis, act, dt, threshold, merge_gap_s, min_active_s)]
     maneuvers: list[FoundManeuver] = []
     busy: list[tuple[int, int]] = []

@@ -82,8 +82,10 @@ def _decimated_inverse(band: np.ndarray, first: int, n_short: int, step: int) ->
     ``i`` onto ``i mod n_short``); the inverse of the folded spectrum is the
     decimated signal, exactly, at ``1 / step`` of the cost.
     """
-    bins = np.arange(first, first + band.size) % n_short
-    folded = np.bincount(bins, weights=band.real, minlength=n_short) + 1j * np.bincount(
-        bins, weights=band.imag, minlength=n_short
-    )
+    folded = np.zeros(n_short, dtype=np.complex128)
+    at, done = first % n_short, 0
+    while done < band.size:  # each turn of the band round the short spectrum, added in bin order
+        take = min(n_short - at, band.size - done)
+        folded[at : at + take] += band[done : done + take]
+        at, done = 0, done + take
     return np.asarray(np.fft.ifft(folded) / step)

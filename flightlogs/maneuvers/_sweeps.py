@@ -26,6 +26,7 @@ from typing import Literal
 import numpy as np
 
 from flightlogs._moving import moving_rank
+from flightlogs._threads import map_traces
 from flightlogs.maneuvers._detection import _activity, _bursts, _edges
 from flightlogs.maneuvers._rank import spearman
 from flightlogs.maneuvers._scalogram import band_envelopes, band_frequencies
@@ -116,7 +117,12 @@ def find_sweeps(t: np.ndarray, dt: float, traces: Mapping[str, Mapping[str, np.n
     """
     step = max(1, int(round(_FRAME_S / dt)))
     freqs = band_frequencies(_F_MIN_HZ, min(_F_MAX_HZ, 0.4 / dt), _PER_OCTAVE)
-    ridges = _yield_to_stronger({axis: _ridge(named, dt, freqs, step) for axis, named in traces.items()})
+    scores = iter(
+        map_traces(lambda x: _normalised(x, dt, freqs, step), [x for n in traces.values() for x in n.values()])
+    )
+    ridges = _yield_to_stronger(
+        {axis: _ridge(named, [next(scores) for _ in named], freqs, dt, step) for axis, named in traces.items()}
+    )
     found: list[FoundSweep] = []
     for axis, named in traces.items():
         ridge = ridges[axis]
@@ -136,7 +142,7 @@ class _Activities:
     """
 
     def __init__(self, named: Mapping[str, np.ndarray], dt: float) -> None:
-        activities = {name: _activity(x, dt, _THRESHOLD, _TREND_S) for name, x in named.items()}
+        activities = dict(zip(named, map_traces(lambda x: _activity(x, dt, _THRESHOLD, _TREND_S), named.values())))
         noisy = {name: act for name, act in activities.items() if act.sigma > _HELD * np.max(np.abs(act.detrended))}
         self.used = noisy or activities
         self.bursts = {
@@ -145,9 +151,14 @@ class _Activities:
         self.n = next(iter(named.values())).size
 
 
-def _ridge(named: Mapping[str, np.ndarray], dt: float, freqs: np.ndarray, step: int) -> _Ridge:
-    """The best band of the best trace per frame, its score and log frequency smoothed by a running median."""
-    scores = np.stack([_normalised(x, dt, freqs, step) for x in named.values()])  # (n_traces, n_frames, n_bands)
+def _ridge(
+    named: Mapping[str, np.ndarray], normalised: list[np.ndarray], freqs: np.ndarray, dt: float, step: int
+) -> _Ridge:
+    """The best band of the best trace per frame, its score and log frequency smoothed by a running median.
+
+    `normalised` holds each trace's :func:`_normalised` envelopes, shape (n_frames, n_bands), in the order of `named`.
+    """
+    scores = np.stack(normalised)  # (n_traces, n_frames, n_bands)
     best_trace = np.argmax(scores, axis=0)
     combined = np.take_along_axis(scores, best_trace[None], axis=0)[0]
     band = np.argmax(combined, axis=1)

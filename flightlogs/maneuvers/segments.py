@@ -35,6 +35,7 @@ __all__ = [
     "SID_AXES",
     "Segment",
     "detect_segments",
+    "SegmentDetector",
     "segments_from_sid",
     "read_segments_file",
 ]
@@ -231,66 +232,116 @@ def detect_segments(
     by a poorly fitted feedback can show an adjacent pair of pulses that
     passes for a doublet).
     """
-    t, dt = _uniform(time_s)
-    if not inputs and responses is None:
-        raise DataError("no mixer input given")
-    traces = _check_inputs(inputs, t.size) if inputs else {}
-    maneuvers, busy = (
-        find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s) if traces else ([], [])
+    detector = SegmentDetector(
+        time_s,
+        responses=responses,
+        min_hover_s=min_hover_s,
+        threshold=threshold,
+        trend_window_s=trend_window_s,
+        merge_gap_s=merge_gap_s,
+        min_active_s=min_active_s,
+        hover_margin_s=hover_margin_s,
     )
-    segments: list[Segment] = []
-    if responses is not None:
-        steps = [m for m in maneuvers if m.kind in ("doublet", "3211")]
-        sweeps = [s for s in find_sweeps(t, dt, _check_responses(responses, t.size)) if not _ringing(s, steps, dt)]
+    return detector.detect(inputs)
+
+
+class SegmentDetector:
+    """:func:`detect_segments` over one stretch of flight, for several sets of mixer inputs.
+
+    Sweeps and multisines are found from the response traces alone (their
+    time-frequency signature), doublets and 3211s from the mixer inputs. A
+    caller that detects again with other inputs (an excitation estimate
+    refitted without the maneuvers found first) pays for the response
+    traces' part once: :meth:`detect` with the same inputs gives what
+    :func:`detect_segments` gives. Parameters as there.
+    """
+
+    def __init__(
+        self,
+        time_s: np.ndarray,
+        *,
+        responses: Mapping[str, Mapping[str, np.ndarray]] | None = None,
+        min_hover_s: float = 3.0,
+        threshold: float = 4.0,
+        trend_window_s: float = 10.0,
+        merge_gap_s: float = 2.0,
+        min_active_s: float = 0.3,
+        hover_margin_s: float = 0.5,
+    ) -> None:
+        self._t, self._dt = _uniform(time_s)
+        self._responses = None if responses is None else _check_responses(responses, self._t.size)
+        self._found_sweeps: list[FoundSweep] | None = None
+        self._options = (min_hover_s, threshold, trend_window_s, merge_gap_s, min_active_s, hover_margin_s)
+
+    def _sweeps(self) -> list[FoundSweep]:
+        if self._found_sweeps is None:
+            assert self._responses is not None
+            self._found_sweeps = find_sweeps(self._t, self._dt, self._responses)
+        return self._found_sweeps
+
+    def detect(self, inputs: Mapping[str, np.ndarray]) -> tuple[Segment, ...]:
+        """The segments, with `inputs` the mixer input by axis (as :func:`detect_segments`'), in time order."""
+        t, dt = self._t, self._dt
+        min_hover_s, threshold, trend_window_s, merge_gap_s, min_active_s, hover_margin_s = self._options
+        if not inputs and self._responses is None:
+            raise DataError("no mixer input given")
+        traces = _check_inputs(inputs, t.size) if inputs else {}
+        maneuvers, busy = (
+            find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s) if traces else ([], [])
+        )
+        segments: list[Segment] = []
+        if self._responses is not None:
+            checked = self._responses
+            steps = [m for m in maneuvers if m.kind in ("doublet", "3211")]
+            sweeps = [s for s in self._sweeps() if not _ringing(s, steps, dt)]
+            segments += [
+                Segment(
+                    axis=cast(Axis, s.axis),
+                    kind=s.kind,
+                    start_s=t[s.first],
+                    end_s=t[s.last],
+                    source="detected",
+                    f_min_hz=s.f_min_hz,
+                    f_max_hz=s.f_max_hz,
+                    detail=(
+                        f"{s.direction} ridge in {', '.join(s.evidence)}"
+                        if s.direction != "none"
+                        else f"piloted, broadband without a trend, in {', '.join(s.evidence)}"
+                    ),
+                )
+                for s in sweeps
+            ]
+            busy += [(s.first, s.last) for s in sweeps]
+            # sweeps come from their signature alone; steps (doublets, 3211s) and multisines of any phasing from
+            # the inputs, where no tone runs
+            maneuvers = [
+                m
+                for m in maneuvers
+                if m.kind != "sweep" and not any(m.first <= s.last and s.first <= m.last for s in sweeps)
+            ]
+            maneuvers = [
+                stepped
+                for m in maneuvers
+                if (stepped := _stepped(m, checked.get(m.axis, {}).get(f"delta_{m.axis}"), dt)) is not None
+                and _followed(stepped, checked.get(m.axis, {}).get(_RATE_OF[m.axis]), dt)
+            ]
         segments += [
             Segment(
-                axis=cast(Axis, s.axis),
-                kind=s.kind,
-                start_s=t[s.first],
-                end_s=t[s.last],
+                axis=cast(Axis, m.axis),  # the keys of `traces`, checked against AXES
+                kind=m.kind,
+                start_s=t[m.first],
+                end_s=t[m.last],
                 source="detected",
-                f_min_hz=s.f_min_hz,
-                f_max_hz=s.f_max_hz,
-                detail=(
-                    f"{s.direction} ridge in {', '.join(s.evidence)}"
-                    if s.direction != "none"
-                    else f"piloted, broadband without a trend, in {', '.join(s.evidence)}"
-                ),
+                f_min_hz=m.f_min_hz,
+                f_max_hz=m.f_max_hz,
             )
-            for s in sweeps
-        ]
-        busy += [(s.first, s.last) for s in sweeps]
-        # sweeps come from their signature alone; steps (doublets, 3211s) and multisines of any phasing from
-        # the inputs, where no tone runs
-        maneuvers = [
-            m
             for m in maneuvers
-            if m.kind != "sweep" and not any(m.first <= s.last and s.first <= m.last for s in sweeps)
         ]
-        checked = _check_responses(responses, t.size)
-        maneuvers = [
-            stepped
-            for m in maneuvers
-            if (stepped := _stepped(m, checked.get(m.axis, {}).get(f"delta_{m.axis}"), dt)) is not None
-            and _followed(stepped, checked.get(m.axis, {}).get(_RATE_OF[m.axis]), dt)
+        segments += [
+            Segment(axis=None, kind="hover", start_s=a, end_s=b, source="detected")
+            for a, b in hover_spans(t, busy, min_hover_s, hover_margin_s)
         ]
-    segments += [
-        Segment(
-            axis=cast(Axis, m.axis),  # the keys of `traces`, checked against AXES
-            kind=m.kind,
-            start_s=t[m.first],
-            end_s=t[m.last],
-            source="detected",
-            f_min_hz=m.f_min_hz,
-            f_max_hz=m.f_max_hz,
-        )
-        for m in maneuvers
-    ]
-    segments += [
-        Segment(axis=None, kind="hover", start_s=a, end_s=b, source="detected")
-        for a, b in hover_spans(t, busy, min_hover_s, hover_margin_s)
-    ]
-    return tuple(sorted(segments, key=lambda s: s.start_s))
+        return tuple(sorted(segments, key=lambda s: s.start_s))
 
 
 def segments_from_sid(

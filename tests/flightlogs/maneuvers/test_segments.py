@@ -13,6 +13,7 @@ from flightlogs.flightlog import SystemIdRun
 from flightlogs.maneuvers.segments import (
     SID_AXES,
     Segment,
+    SegmentDetector,
     detect_segments,
     read_segments_file,
     segments_from_sid,
@@ -350,3 +351,21 @@ def test_a_doublet_counts_only_when_the_rate_answers_it(follows: bool, expected:
     q = answer + 0.01 * rng.standard_normal(t.size)
     found = detect_segments(t, {"lon": delta}, responses={"lon": {"delta_lon": delta, "q": q}})
     assert [s.kind for s in found if s.kind != "hover"] == expected
+
+
+def test_a_detector_run_twice_gives_what_detect_segments_gives_each_time() -> None:
+    """The sweeps found once from the responses serve both sets of inputs (a doublet, then none)."""
+    rng = np.random.default_rng(13)
+    t = np.arange(12000) / RATE_HZ
+    sweep = np.where((t > 20.0) & (t < 60.0), np.sin(2 * np.pi * (0.2 + 0.05 * (t - 20.0)) * (t - 20.0)), 0.0)
+    delta_lat = 0.05 * sweep + 1e-3 * rng.standard_normal(t.size)
+    p = np.cumsum(delta_lat) / RATE_HZ * 30.0 + 0.01 * rng.standard_normal(t.size)
+    delta_lon = 0.1 * _doublet(t - 80.0) + 1e-3 * rng.standard_normal(t.size)
+    q = np.cumsum(delta_lon) / RATE_HZ * 30.0 + 0.01 * rng.standard_normal(t.size)
+    responses = {"lat": {"delta_lat": delta_lat, "p": p}, "lon": {"delta_lon": delta_lon, "q": q}}
+    detector = SegmentDetector(t, responses=responses)
+    quiet_lon = 1e-3 * rng.standard_normal(t.size)
+    for inputs in ({"lat": delta_lat, "lon": delta_lon}, {"lat": delta_lat, "lon": quiet_lon}):
+        assert detector.detect(inputs) == detect_segments(t, inputs, responses=responses)
+    kinds = [[(s.axis, s.kind) for s in detector.detect(i) if s.kind != "hover"] for i in ({"lon": delta_lon}, {})]
+    assert kinds == [[("lat", "sweep"), ("lon", "doublet")], [("lat", "sweep")]]
