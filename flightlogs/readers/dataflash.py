@@ -198,7 +198,7 @@ class DataFlashMessages:
             return {}
         column = self.instance_field(name)
         if column is not None:
-            values = _peek(self.tables[name], column)
+            values = self.tables[name][column]
             return {int(i): self.tables[name].select(values == i) for i in np.unique(values)}
         found = {0: self.tables[name]}
         for k in range(2, 10):
@@ -383,11 +383,11 @@ def _decode_table(buf: np.ndarray, fmt: MessageFormat, offsets: np.ndarray, rele
 class _LazyColumns(Mapping[str, np.ndarray]):
     """The columns of one layout, decoded from the log's bytes when first read (then kept, read-only).
 
-    A reader maps a few columns of a few types: the messages of a table are
-    copied out of the file at the first column read, and only the columns
-    read are converted. A column read before that (the instance number, to
-    split a table) is taken from the file alone. The file stays referenced
-    (its memory map open) until the table's messages are copied.
+    A reader maps a few columns of a few types: each column read is gathered
+    from the file's bytes alone (its field at every message's offset) and
+    converted. The messages are never copied whole: with the decoded columns
+    beside them, that copy held about the file's size again at the reading's
+    peak. The file stays referenced (its memory map open) while the table lives.
     """
 
     def __init__(
@@ -399,45 +399,24 @@ class _LazyColumns(Mapping[str, np.ndarray]):
         decoded: dict[str, np.ndarray] | None = None,
     ) -> None:
         dtype, chars = layout(fmt.format, fmt.length)
-        self._buf: np.ndarray | None = buf
-        self._release = release
+        self._buf, self._release = buf, release
         self._fmt, self._offsets, self._dtype, self._chars = fmt, offsets, dtype, chars
         self._field = {name: i for i, name in enumerate(fmt.columns[: len(chars)])}  # a repeated name: its last
         self._decoded = decoded if decoded is not None else {}
-        self._messages: np.ndarray | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:
         column = self._decoded.get(name)
         if column is None:
+            fields = self._dtype.fields
+            assert fields is not None  # a structured dtype
             i = self._field[name]
-            column = _column(self._raw(f"f{i}"), self._chars[i], self._fmt.name, copy=False)  # numbers: views
+            base, at = fields[f"f{i}"][:2]
+            one = np.dtype({"names": ["v"], "formats": [base], "offsets": [0], "itemsize": base.itemsize})
+            raw = gather(self._buf, self._offsets + at, base.itemsize, self._release).view(one).ravel()["v"]
+            column = _column(raw, self._chars[i], self._fmt.name)
             column.flags.writeable = False
             self._decoded[name] = column
         return column
-
-    def peek(self, name: str) -> np.ndarray:
-        """One column, read from the file alone while the messages are not copied yet (to split or check them)."""
-        column = self._decoded.get(name)
-        if column is not None or self._buf is None:
-            return self[name]
-        fields = self._dtype.fields
-        assert fields is not None  # a structured dtype
-        i = self._field[name]
-        base, at = fields[f"f{i}"][:2]
-        one = np.dtype({"names": ["v"], "formats": [base], "offsets": [0], "itemsize": base.itemsize})
-        raw = gather(self._buf, self._offsets + at, base.itemsize, self._release).view(one).ravel()["v"]
-        column = _column(raw, self._chars[i], self._fmt.name)
-        column.flags.writeable = False
-        self._decoded[name] = column
-        return column
-
-    def _raw(self, field: str) -> np.ndarray:
-        if self._messages is None:
-            assert self._buf is not None
-            messages = gather(self._buf, self._offsets, self._fmt.length, self._release)
-            self._messages = messages.view(self._dtype).ravel()
-            self._buf = None  # the file is no longer needed by this table
-        return self._messages[field]
 
     def __contains__(self, name: object) -> bool:  # Mapping's would decode the column to answer
         return name in self._field
@@ -453,20 +432,11 @@ class _LazyColumns(Mapping[str, np.ndarray]):
         decoded = {name: column[rows] for name, column in self._decoded.items()}
         for column in decoded.values():
             column.flags.writeable = False
-        buf = self._buf if self._buf is not None else np.empty(0, np.uint8)
-        picked = _LazyColumns(buf, self._fmt, self._offsets[rows], self._release, decoded)
-        if self._messages is not None:  # copied already: the picked ones from the copy
-            picked._messages, picked._buf = self._messages[rows], None
-        return picked
+        return _LazyColumns(self._buf, self._fmt, self._offsets[rows], self._release, decoded)
 
 
-def _peek(table: MessageTable, column: str) -> np.ndarray:
-    """One column of `table`, without copying its messages out of the file when they are not yet."""
-    return table.columns.peek(column) if isinstance(table.columns, _LazyColumns) else table[column]
-
-
-def _column(raw: np.ndarray, char: str, message: str, *, copy: bool = True) -> np.ndarray:
-    """Convert one raw field to the values DFReader returns; numbers kept as they are left a view unless `copy`."""
+def _column(raw: np.ndarray, char: str, message: str) -> np.ndarray:
+    """Convert one raw field to the values DFReader returns (numbers kept as they are, contiguous)."""
     mult = FORMAT_TO_STRUCT[char][1]
     if mult is not None:
         if 0.0 < mult < 1.0:  # DFReader divides by 1/mult for accuracy
@@ -476,7 +446,7 @@ def _column(raw: np.ndarray, char: str, message: str, *, copy: bool = True) -> n
         if message == "FILE" and char == "Z":
             return np.array([bytes(v).ljust(raw.dtype.itemsize, b"\0") for v in raw.tolist()], dtype=object)
         return strings(raw, _df_string)
-    return np.ascontiguousarray(raw) if copy else raw
+    return np.ascontiguousarray(raw)
 
 
 def _df_string(value: bytes) -> str:
@@ -534,7 +504,7 @@ def _time_resets(tables: dict[str, MessageTable]) -> list[str]:
         column = next((c for c in ("TimeUS", "TimeMS") if c in table.columns), None)
         if column is None or not len(table) or key.startswith("GPS"):
             continue
-        name, stamp = key.split("@")[0], _peek(table, column).astype(np.int64)
+        name, stamp = key.split("@")[0], table[column].astype(np.int64)
         drops = np.flatnonzero(np.diff(stamp) < -(10**6 if column == "TimeUS" else 10**3))
         if not drops.size and name not in last_time:
             last_time[name] = stamp[-1] / (1e6 if column == "TimeUS" else 1e3)
