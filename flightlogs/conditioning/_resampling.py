@@ -20,7 +20,6 @@ TIME_TOL_S = 1e-7  # below the 1 µs resolution of log timestamps
 _STOPBAND_DB = 60.0  # anti-alias attenuation from 0.6 × the target rate
 _PASS_EDGE = 0.4  # anti-alias pass-band edge, × target rate
 _STOP_EDGE = 0.6  # anti-alias stop-band edge, × target rate
-_GROUP_ELEMENTS = 1 << 20  # a spline's working arrays (several of n × columns) stay near this many numbers
 
 
 def check_times(time_s: np.ndarray, name: str) -> np.ndarray:
@@ -124,12 +123,8 @@ def interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: str, out: 
         return out
     if method in ("spline", "pchip"):
         columns = v if v.ndim == 2 else v[:, None]
-        values = np.empty((at.size, columns.shape[1])) if out is None else out if out.ndim == 2 else out[:, None]
-        slopes_of = spline_slopes if method == "spline" else pchip_slopes
-        group = max(1, _GROUP_ELEMENTS // t.size)  # columns at a time: each column's arithmetic is its own
-        for c0 in range(0, columns.shape[1], group):
-            part = columns[:, c0 : c0 + group]
-            hermite(t, part, slopes_of(t, part), at, values[:, c0 : c0 + group])
+        slopes = spline_slopes(t, columns) if method == "spline" else pchip_slopes(t, columns)
+        values = hermite(t, columns, slopes, at, None if out is None else out if out.ndim == 2 else out[:, None])
         return values if v.ndim == 2 else values[:, 0]
     raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
 
