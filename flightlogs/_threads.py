@@ -10,7 +10,7 @@ scheduler that already runs one task per core.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from typing import TypeVar
 
@@ -21,8 +21,8 @@ _R = TypeVar("_R")
 _MAX_THREADS = 4  # the per-trace tasks are few (4-20); beyond this threads only contend
 
 
-def map_traces(function: Callable[[_T], _R], items: Iterable[_T]) -> list[_R]:
-    """``[function(item) for item in items]``, the items spread over the available cores.
+def map_traces(function: Callable[[_T], _R], items: Iterable[_T]) -> Iterator[_R]:
+    """``function(item)`` for each item, the items spread over the available cores, the results in order.
 
     Parameters
     ----------
@@ -33,14 +33,15 @@ def map_traces(function: Callable[[_T], _R], items: Iterable[_T]) -> list[_R]:
 
     Returns
     -------
-    list
-        The results in the order of `items`; the first exception raised, if any, is raised here.
+    iterator
+        The results in the order of `items`, each as soon as it and those before it are done (a caller that
+        folds them as they come holds a few at a time); the first exception raised, if any, is raised there.
     """
     tasks = list(items)
     pool = _pool()
     if pool is None or len(tasks) < 2:
-        return [function(item) for item in tasks]
-    return list(pool.map(function, tasks))
+        return (function(item) for item in tasks)
+    return pool.map(function, tasks)
 
 
 _POOLS: dict[int, ThreadPoolExecutor | None] = {}  # by process id: a forked child must not use its parent's threads

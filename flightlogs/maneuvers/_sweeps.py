@@ -117,12 +117,7 @@ def find_sweeps(t: np.ndarray, dt: float, traces: Mapping[str, Mapping[str, np.n
     """
     step = max(1, int(round(_FRAME_S / dt)))
     freqs = band_frequencies(_F_MIN_HZ, min(_F_MAX_HZ, 0.4 / dt), _PER_OCTAVE)
-    scores = iter(
-        map_traces(lambda x: _normalised(x, dt, freqs, step), [x for n in traces.values() for x in n.values()])
-    )
-    ridges = _yield_to_stronger(
-        {axis: _ridge(named, [next(scores) for _ in named], freqs, dt, step) for axis, named in traces.items()}
-    )
+    ridges = _yield_to_stronger({axis: _ridge(named, dt, freqs, step) for axis, named in traces.items()})
     found: list[FoundSweep] = []
     for axis, named in traces.items():
         ridge = ridges[axis]
@@ -151,23 +146,28 @@ class _Activities:
         self.n = next(iter(named.values())).size
 
 
-def _ridge(
-    named: Mapping[str, np.ndarray], normalised: list[np.ndarray], freqs: np.ndarray, dt: float, step: int
-) -> _Ridge:
+def _ridge(named: Mapping[str, np.ndarray], dt: float, freqs: np.ndarray, step: int) -> _Ridge:
     """The best band of the best trace per frame, its score and log frequency smoothed by a running median.
 
-    `normalised` holds each trace's :func:`_normalised` envelopes, shape (n_frames, n_bands), in the order of `named`.
+    The traces' envelopes are taken on the cores at once and folded into a running best (first trace on a
+    tie, as ``argmax``), so one axis's traces are held together, not every axis's.
     """
-    scores = np.stack(normalised)  # (n_traces, n_frames, n_bands)
-    best_trace = np.argmax(scores, axis=0)
-    combined = np.take_along_axis(scores, best_trace[None], axis=0)[0]
+    index = np.uint8 if len(named) <= 256 else np.intp  # an axis has a few traces: a byte per frame and band
+    combined, best_trace = np.empty((0, freqs.size)), np.empty((0, freqs.size), dtype=index)
+    for k, score in enumerate(map_traces(lambda x: _normalised(x, dt, freqs, step), named.values())):
+        if k == 0:
+            combined, best_trace = score, np.zeros(score.shape, dtype=index)
+            continue
+        better = score > combined
+        np.copyto(combined, score, where=better)
+        best_trace[better] = k
     band = np.argmax(combined, axis=1)
     frames = np.arange(band.size)
     width = max(1, int(round(_SMOOTH_S / (step * dt)))) | 1
     return _Ridge(
         score=moving_rank(combined[frames, band], width, mode="nearest"),
         freq_hz=np.exp(moving_rank(np.log(freqs[band]), width, mode="nearest")),
-        trace=best_trace[frames, band],
+        trace=best_trace[frames, band].astype(np.intp),
         names=tuple(named),
     )
 
@@ -223,7 +223,8 @@ def _normalised(x: np.ndarray, dt: float, freqs: np.ndarray, step: int) -> np.nd
     quiet = (sample / floor).max(axis=1) < _SCORE
     if quiet.sum() >= 0.1 * quiet.size:
         floor = np.maximum(np.quantile(sample[quiet], _FLOOR_QUANTILE, axis=0), lowest)
-    return np.asarray(envelope / floor)
+    envelope /= floor  # in place: one (n_frames, n_bands) array per trace at a time
+    return envelope
 
 
 def _sweeping(ridge: _Ridge, a: int, b: int, frame_s: float) -> bool:

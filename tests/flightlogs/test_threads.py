@@ -19,7 +19,7 @@ def _spectrum_peak(seed: int) -> float:
 
 def test_results_are_the_loops_in_order() -> None:
     seeds = list(range(12))
-    assert map_traces(_spectrum_peak, seeds) == [_spectrum_peak(s) for s in seeds]
+    assert list(map_traces(_spectrum_peak, seeds)) == [_spectrum_peak(s) for s in seeds]
 
 
 def test_an_exception_in_one_task_reaches_the_caller() -> None:
@@ -29,24 +29,24 @@ def test_an_exception_in_one_task_reaches_the_caller() -> None:
         return k
 
     with pytest.raises(ValueError, match="trace 3"):
-        map_traces(fail_on_three, range(6))
+        list(map_traces(fail_on_three, range(6)))
 
 
 def test_one_thread_asked_for_means_no_pool(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("FLIGHT_SYSID_THREADS", "1")
     monkeypatch.setattr(_threads, "_POOLS", {})
     assert _threads._pool() is None
-    assert map_traces(_spectrum_peak, [1, 2]) == [_spectrum_peak(1), _spectrum_peak(2)]
+    assert list(map_traces(_spectrum_peak, [1, 2])) == [_spectrum_peak(1), _spectrum_peak(2)]
 
 
 def _in_child(queue: multiprocessing.Queue) -> None:  # type: ignore[type-arg]
-    queue.put(map_traces(_spectrum_peak, [5, 6, 7]))
+    queue.put(list(map_traces(_spectrum_peak, [5, 6, 7])))
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="fork is POSIX")
 def test_a_forked_child_gets_its_own_pool() -> None:
     """The parent's pool threads do not exist in a fork: the child must not wait on them (it would hang)."""
-    map_traces(_spectrum_peak, [1, 2])  # the parent's pool exists before the fork
+    list(map_traces(_spectrum_peak, [1, 2]))  # the parent's pool exists before the fork
     context = multiprocessing.get_context("fork")
     queue = context.Queue()
     child = context.Process(target=_in_child, args=(queue,))
