@@ -8,7 +8,15 @@ from typing import Any, Literal
 import numpy as np
 from matplotlib.figure import Figure
 
-from simulator.mrac import CONTROLLERS, ControllerResult, MetricStatistics, MracComparison, Statistic, StepCase
+from simulator.mrac import (
+    CONTROLLERS,
+    ControllerResult,
+    MetricStatistics,
+    MracComparison,
+    Statistic,
+    StepCase,
+    flown_rise_time,
+)
 
 from .html import render_html, write_html
 from .svg import figure_svg, new_figure
@@ -193,8 +201,11 @@ def _checks(comparison: MracComparison) -> list[dict[str, Any]]:
                 "phase": _PHASE_LABELS[phase],
             }
             pid = stats["pid"].rise_time_s.mean if "pid" in stats else float("nan")
+            flown = flown_rise_time(case.height_ratio, phase)
             for n in ("mrac_linear", "mrac_rbf"):
                 row[n] = stats[n].rise_time_s.mean / pid if n in stats else float("nan")
+                cut = None if flown is None else flown.cut(n)
+                row[f"flown_{n}"] = float("nan") if cut is None else cut
             both = "mrac_linear" in stats and "mrac_rbf" in stats
             row["mse"] = stats["mrac_rbf"].mse_m2.mean / stats["mrac_linear"].mse_m2.mean if both else float("nan")
             rows.append(row)

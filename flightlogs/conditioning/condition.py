@@ -528,12 +528,21 @@ def _segments(
         (start, stop, SegmentDetector(time_base[start:stop], responses=_finite_traces(values, shown, start, stop)))
         for start, stop in pieces
     ]
+    flying, vd = _flight_state(time_base, values)
+
+    def flown(found: Sequence[Segment]) -> list[Segment]:
+        return [
+            s
+            for s in found
+            if not any(_overlaps(s, run) for run in logged) and s.kind != "hover" and _flown(s, time_base, flying, vd)
+        ]
+
     detected: list[Segment] = []
     fitted_on: np.ndarray | None = None
-    for _ in range(2):  # fit the feedback where nothing is excited, detect, refit without what was found
-        unexcited = quiet & ~_near(time_base, detected, 2.0)
+    for _ in range(2):  # fit the feedback where nothing is excited, detect, refit without the maneuvers flown
+        unexcited = quiet & ~_near(time_base, flown(detected), 2.0)
         if fitted_on is not None and np.array_equal(unexcited, fitted_on):
-            break  # nothing found to leave out: the refit would repeat the first pass exactly
+            break  # nothing flown to leave out: the refit would repeat the first pass exactly
         fitted_on = unexcited
         excitation = estimate_excitation(inputs, values, unexcited, time_s=time_base)
         detected = [
@@ -541,12 +550,7 @@ def _segments(
             for start, stop, detector in detectors
             for segment in detector.detect({a: x[start:stop] for a, x in excitation.items()})
         ]
-    flying, vd = _flight_state(time_base, values)
-    kept = [
-        s
-        for s in detected
-        if not any(_overlaps(s, run) for run in logged) and s.kind != "hover" and _flown(s, time_base, flying, vd)
-    ]
+    kept = flown(detected)
     hovers = [piece for s in detected if s.kind == "hover" for piece in _airborne(s, time_base, flying)]
     return tuple(sorted([*logged, *kept, *hovers], key=lambda s: s.start_s))
 

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from simulator.mrac.compare import MracComparison
+from simulator.mrac.flown import flown_rise_time
 from simulator.mrac.metrics import StepMetrics
 
 __all__ = ["comparison_json"]
@@ -44,6 +45,9 @@ def comparison_json(comparison: MracComparison, *, per_trial: bool = False) -> d
                 entry["rise_time_over_pid"] = {
                     n: _ratio(stats[n].rise_time_s.mean, stats["pid"].rise_time_s.mean) for n in names if n != "pid"
                 }
+            flown = flown_rise_time(case.height_ratio, phase)
+            if flown is not None:  # Tables 2.6-2.8; null where the table has no figure
+                entry["flown_rise_time_over_pid"] = {n: flown.cut(n) for n in ("mrac_linear", "mrac_rbf")}
             if "mrac_linear" in stats and "mrac_rbf" in stats:
                 entry["mse_rbf_over_linear"] = _ratio(stats["mrac_rbf"].mse_m2.mean, stats["mrac_linear"].mse_m2.mean)
             if per_trial:

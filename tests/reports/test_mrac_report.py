@@ -43,3 +43,16 @@ def test_a_pid_only_comparison_renders_without_theta(tmp_path: Path) -> None:
     assert theta_figure(comparison, 4.0) is None
     page = render_mrac_report(comparison)
     assert page.count("<svg") == 2
+
+
+def test_the_flown_rise_times_stand_beside_the_simulated(comparison: MracComparison) -> None:
+    """Z/R 3 (Table 2.7): flown linear/PID 4.58/25.86 = 0.177 at take-off and 5.23/27.62 = 0.189 at landing, RBF
+    3.15/25.86 = 0.122 and 3.53/27.62 = 0.128; Z/R 22 was not flown (a dash in both flown columns)."""
+    page = render_mrac_report(comparison)
+    claims = page[page.index("Against the dissertation") : page.index("All cases")]
+    rows = re.findall(r"<tr><td>([^<]*)</td><td>([^<]*)</td>(.*?)</tr>", claims, flags=re.S)
+    cells = {(z, phase): re.findall(r"<td[^>]*>([^<]*)</td>", rest) for z, phase, rest in rows}
+    assert [cells["3", "take-off"][k] for k in (1, 3)] == ["0.177", "0.122"]
+    assert [cells["3", "landing"][k] for k in (1, 3)] == ["0.189", "0.128"]
+    assert [cells["22 (out)", "take-off"][k] for k in (1, 3)] == ["—", "—"]
+    assert "flight tests (Tables 2.6–2.8" in claims and "67–74 %" in claims

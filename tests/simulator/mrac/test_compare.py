@@ -8,6 +8,7 @@ import pytest
 from flightlogs.errors import DataError
 from simulator.flights.altitude import CRAZYFLIE_ALTITUDE
 from simulator.mrac import (
+    FLOWN_RISE_TIMES,
     REFERENCE_EQ_2_20,
     CompareConfig,
     MracComparison,
@@ -15,6 +16,7 @@ from simulator.mrac import (
     StepMetrics,
     compare_controllers,
     comparison_json,
+    flown_rise_time,
     step_case,
     step_metrics,
 )
@@ -58,22 +60,33 @@ def test_rise_time_ordering_pid_then_linear_then_rbf(comparison: MracComparison,
     assert linear <= 0.5 * pid
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "chapter 2 reports a cut of at least 80 %; built as the text states (eqs. 2.14-2.26, A.4, Tables 2.1, 2.5, "
-        "eq. 2.5: B = [0, 1/m], Gamma = 1e-3, e = x - x_ref, steps 6.2/4.2/2.2 cm) this simulation cuts 67-73 % "
-        "(linear) and 77-81 % (RBF). The MRAC's integral action Gamma p12 |Phi|^2 / m is 3.5 |Phi|^2 times the "
-        "PID's Ki n k_f, so to first order the linear MRAC rises in 1 / 4.5 = 22 % of the PID's time plus the "
-        "reference model's own lag; the flown PID was slower than this one (its 40-s errors 0.26-1.03 cm against "
-        "0.03-0.16 cm here; test_mrac.py::test_eq_2_20_is_table_2_5s_pd_loop_with_a_lower_pwm_gain)"
-    ),
-)
+#: Issue 17's decision: a faithful build of chapter 2 (eqs. 2.14-2.26, A.4, Tables 2.1, 2.5, eq. 2.5: B = [0, 1/m],
+#: Gamma = 1e-3, e = x - x_ref, steps 6.2/4.2/2.2 cm) cuts the PID's rise time by 67-74 % (linear) and 77-81 % (RBF),
+#: not the flights' 80 % or more; the faithful figure is accepted. The MRAC's integral action Gamma p12 |Phi|^2 / m is
+#: 3.5 |Phi|^2 times the PID's Ki n k_f, so to first order the linear MRAC rises in 1 / 4.5 = 22 % of the PID's time
+#: plus the reference model's own lag; the flown PID was slower than this one (its 40-s errors 0.26-1.03 cm against
+#: 0.03-0.16 cm here; test_mrac.py::test_eq_2_20_is_table_2_5s_pd_loop_with_a_lower_pwm_gain).
+FAITHFUL_CUT_PERCENT = {"mrac_linear": (67, 74), "mrac_rbf": (77, 81)}  # whole percents, as the issue states them
+
+
 @pytest.mark.parametrize("name", ["mrac_linear", "mrac_rbf"])
-def test_mrac_cuts_the_rise_time_by_80_percent(comparison: MracComparison, name: str) -> None:
-    """Issue 8: at least 80 % shorter rise than the PID at Z/R 4, 3, 2, take-off and landing (Tables 2.6-2.8)."""
-    ratios = [_rise(comparison, name, r, p) / _rise(comparison, "pid", r, p) for r in IN_GROUND_EFFECT for p in PHASES]
-    assert max(ratios) <= 0.2
+def test_mrac_cuts_the_rise_time_as_the_faithful_build_does(comparison: MracComparison, name: str) -> None:
+    """In ground effect, take-off and landing at Z/R 4, 3, 2: the cut the decision accepted, each case inside it."""
+    low, high = FAITHFUL_CUT_PERCENT[name]
+    for ratio in IN_GROUND_EFFECT:
+        for phase in PHASES:
+            cut = 100.0 * (1.0 - _rise(comparison, name, ratio, phase) / _rise(comparison, "pid", ratio, phase))
+            assert low <= round(cut) <= high, f"{name} at Z/R {ratio} {phase}: cut {cut:.1f} %"
+
+
+def test_the_flown_figures_are_the_chapters() -> None:
+    """Tables 2.6-2.8 as transcribed: every MRAC rise time flown is under 20 % of the PID's (the chapter's "at least
+    80 %"), RBF under linear in every case, and the PID's landing at Z/R 2 has no figure (it never touched down)."""
+    assert {(f.height_ratio, f.phase) for f in FLOWN_RISE_TIMES} == {(r, p) for r in IN_GROUND_EFFECT for p in PHASES}
+    cuts = [f.cut(n) for f in FLOWN_RISE_TIMES for n in ("mrac_linear", "mrac_rbf")]
+    assert all(c <= 0.21 for c in cuts if c is not None)  # 4.53 / 22.40 = 0.202 at Z/R 4: "at least 80 %" rounded
+    assert all(f.rbf_s < f.linear_s for f in FLOWN_RISE_TIMES if f.rbf_s and f.linear_s)
+    assert flown_rise_time(2.0, "landing").pid_s is None and flown_rise_time(22.0, "takeoff") is None
 
 
 @pytest.mark.parametrize("phase", PHASES)
@@ -158,6 +171,15 @@ def test_the_json_summary_has_the_documented_shape(comparison: MracComparison) -
     case = summary["cases"][0]
     assert case["height_ratio"] == 4.0 and case["in_ground_effect"]
     assert set(case["phases"]["takeoff"]["rise_time_over_pid"]) == {"mrac_linear", "mrac_rbf"}
+    assert case["phases"]["takeoff"]["flown_rise_time_over_pid"] == {
+        "mrac_linear": 4.53 / 22.40,
+        "mrac_rbf": 2.99 / 22.40,
+    }
+    assert summary["cases"][2]["phases"]["landing"]["flown_rise_time_over_pid"] == {
+        "mrac_linear": None,
+        "mrac_rbf": None,
+    }
+    assert "flown_rise_time_over_pid" not in summary["cases"][3]["phases"]["takeoff"]  # Z/R 22: not flown
     assert "trials" not in case["phases"]["landing"]
     trials = comparison_json(comparison, per_trial=True)["cases"][3]["phases"]["landing"]["trials"]
     assert len(trials["mrac_rbf"]) == 3 and set(trials["pid"][0]) == set(StepMetrics.__dataclass_fields__)
