@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 from collections.abc import Callable, Iterator
@@ -11,9 +12,10 @@ from typing import Any, Literal
 
 import click
 
+from flightlogs.errors import DataError
 from flightlogs.writers.jsonio import json_text, write_json
 
-__all__ = ["OutputPath", "json_option", "emit_json", "progress_bar", "staged_progress"]
+__all__ = ["OutputPath", "SysidCommand", "json_option", "emit_json", "progress_bar", "staged_progress"]
 
 
 class OutputPath(click.Path):
@@ -47,6 +49,7 @@ class OutputPath(click.Path):
 
     def __init__(self, *, folder: bool = False, allow_dash: bool = False, path_type: type = Path) -> None:
         super().__init__(file_okay=not folder, dir_okay=folder, allow_dash=allow_dash, path_type=path_type)
+        self.folder = folder
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """The path, once its folder is known to exist (click.BadParameter otherwise)."""
@@ -62,6 +65,68 @@ class OutputPath(click.Path):
         if not os.access(parent, os.W_OK | os.X_OK):
             self.fail(f"{path}: folder {parent} is not writable", param, ctx)
         return converted
+
+
+class SysidCommand(click.Command):
+    """A command whose file outputs are checked before it runs.
+
+    An output that is one of the command's input files is refused (it would
+    be destroyed); with ``--no-clobber``, added to every command that writes
+    a file, an output that exists already is refused too. Either is one
+    sentence and exit code 1, before any work. Otherwise an existing output
+    is replaced only once the new one is complete (see
+    :func:`flightlogs.writers.atomic.atomic_output`).
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        if self.callback is not None and any(isinstance(p.type, OutputPath) for p in self.params):
+            self.params.append(
+                click.Option(
+                    ["--no-clobber"],
+                    is_flag=True,
+                    help="Refuse to replace an output file that exists (exit 1) instead of replacing it.",
+                )
+            )
+            command = self.callback
+
+            @functools.wraps(command)
+            def without_the_flag(*args: Any, no_clobber: bool = False, **kwargs: Any) -> Any:  # the flag is ours
+                return command(*args, **kwargs)
+
+            self.callback = without_the_flag
+
+    def invoke(self, ctx: click.Context) -> Any:
+        """Check the outputs, then run the command."""
+        no_clobber = bool(ctx.params.get("no_clobber", False))
+        inputs = [Path(os.fsdecode(v)) for p in self.params if _is_input(p) for v in _values(ctx.params.get(p.name))]
+        for param in self.params:
+            if not isinstance(param.type, OutputPath) or param.type.folder:
+                continue
+            for value in _values(ctx.params.get(param.name)):
+                out = Path(os.fsdecode(value))
+                if str(value) == "-" or not out.exists():
+                    continue
+                same = next((i for i in inputs if i.exists() and os.path.samefile(i, out)), None)
+                if same is not None:
+                    raise DataError(
+                        f"{out}: is also an input ({same}); writing {param.opts[-1]} there would destroy it"
+                    )
+                if no_clobber and out.is_file():
+                    raise DataError(
+                        f"{out}: exists, and --no-clobber leaves it as it is; give another {param.opts[-1]}"
+                    )
+        return super().invoke(ctx)
+
+
+def _is_input(param: click.Parameter) -> bool:
+    return isinstance(param.type, click.Path) and not isinstance(param.type, OutputPath) and param.type.exists
+
+
+def _values(value: Any) -> list[Any]:
+    if value is None:
+        return []
+    return list(value) if isinstance(value, (tuple, list)) else [value]
 
 
 json_option = click.option(

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from ._common import OutputPath
+from ._common import OutputPath, SysidCommand
 
 __all__ = ["demo"]
 
@@ -66,7 +66,7 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
     return text
 
 
-@click.command(epilog=_EPILOG)
+@click.command(cls=SysidCommand, epilog=_EPILOG)
 @click.option(
     "-o",
     "--out",

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from ._common import OutputPath, emit_json, json_option, staged_progress
+from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
 from ._flights import conditioned_flights
 from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
@@ -21,7 +21,7 @@ Examples:
 """
 
 
-@click.command(epilog=_EPILOG)
+@click.command(cls=SysidCommand, epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option(
     "--real",

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from ._common import OutputPath, emit_json, json_option, staged_progress
+from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
 from ._flights import check_sources, dataset_flights
 from ._wind_options import (
     anemometer_at_option,
@@ -68,7 +68,7 @@ class _GuidelineOption(click.Option):
         return value
 
 
-@click.command(epilog=_EPILOG)
+@click.command(cls=SysidCommand, epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option(
     "--model",

@@ -8,7 +8,7 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, emit_json, json_option
+from ._common import OutputPath, SysidCommand, emit_json, json_option
 from ._flights import conditioned_flights
 from ._wind_options import segments_from, segments_option, wind_distance_option, wind_offset_option, wind_option
 
@@ -53,7 +53,7 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
         raise click.BadParameter(str(err)) from None
 
 
-@click.command(epilog=_EPILOG)
+@click.command(cls=SysidCommand, epilog=_EPILOG)
 @click.argument(
     "sources",
     metavar="DATASET|LOG...",

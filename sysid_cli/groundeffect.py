@@ -9,7 +9,7 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, emit_json, json_option, progress_bar
+from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
 from .ingest import parse_columns
 
 __all__ = ["ground_effect"]
@@ -181,7 +181,7 @@ def ground_effect() -> None:
     """Ground-effect models of chapter 2: thrust ratio F/F0 against height ratio Z/R."""
 
 
-@ground_effect.command("fit", epilog=_FIT_EPILOG)
+@ground_effect.command("fit", cls=SysidCommand, epilog=_FIT_EPILOG)
 @click.argument("data", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @_data_options
 @click.option(
@@ -218,7 +218,7 @@ def fit(data: Path, out: Path | None, report: Path | None, json_path: str | None
     emit_json(summary, json_path)
 
 
-@ground_effect.command("spacing", epilog=_SPACING_EPILOG)
+@ground_effect.command("spacing", cls=SysidCommand, epilog=_SPACING_EPILOG)
 @click.argument("data", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option(
     "--spacing",

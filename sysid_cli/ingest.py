@@ -8,7 +8,7 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, emit_json, json_option, progress_bar
+from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
 from ._warnings import mark_reported
 from ._wind_options import (
     anemometer_at_option,
@@ -64,7 +64,7 @@ def _wind_columns(ctx: click.Context, param: click.Parameter, value: str | None)
 _MAX_RATE_HZ = 10_000.0
 
 
-@click.command(epilog=_EPILOG)
+@click.command(cls=SysidCommand, epilog=_EPILOG)
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @wind_option("Anemometer CSV, or a folder of them (repeatable); each log takes the file overlapping it in UTC.")
 @click.option(

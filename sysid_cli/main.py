@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import logging
+import signal
 import sys
+import types
 
 import click
 
@@ -20,20 +22,43 @@ Examples:
 """
 
 
+class _Terminated(BaseException):
+    """SIGTERM, raised where the program is so that every output in progress is cleaned up as on Ctrl-C."""
+
+
+def _terminate(_signum: int, _frame: types.FrameType | None) -> None:
+    raise _Terminated
+
+
+#: Exit codes of a command ended by a signal, as a shell reports one: 128 + the signal's number.
+_INTERRUPTED = {KeyboardInterrupt: (130, "SIGINT"), _Terminated: (143, "SIGTERM")}
+
+
 class _SysidGroup(click.Group):
     """Turn project errors into one sentence and exit code 1 (traceback only with --debug).
 
     The project's warnings raised while the command runs are printed after
     it, once each, as ``warning: <message>`` (see :mod:`sysid_cli._warnings`);
     one made an error by ``-W error`` ends the command like an error.
+    SIGINT (Ctrl-C) and SIGTERM end it with one line and exit 130 or 143:
+    outputs are written through temporary files that are then removed, so
+    nothing half-written is left and an earlier output stays as it was.
     """
 
     def invoke(self, ctx: click.Context) -> object:
+        previous = signal.signal(signal.SIGTERM, _terminate)
         try:
             with warnings_printed_once(ctx.meta):
                 return super().invoke(ctx)
         except (click.exceptions.Exit, click.ClickException, click.Abort):
             raise
+        except (KeyboardInterrupt, _Terminated) as err:
+            if ctx.meta.get("sysid.debug"):
+                raise
+            code, name = _INTERRUPTED[type(err)]
+            fresh_line = "\n" if sys.stderr.isatty() else ""  # past a progress bar's line
+            click.secho(f"{fresh_line}interrupted ({name}): no file was left half-written", fg="red", err=True)
+            ctx.exit(code)
         except SysidError as err:
             if ctx.meta.get("sysid.debug"):
                 raise
@@ -44,7 +69,7 @@ class _SysidGroup(click.Group):
                 raise
             click.secho(f"error: {err} ({type(err).__name__}, an error under -W error)", fg="red", err=True)
             ctx.exit(1)
-        except (KeyboardInterrupt, BrokenPipeError):
+        except BrokenPipeError:
             raise
         except Exception as err:  # a bug or an unwrapped library failure
             if ctx.meta.get("sysid.debug"):
@@ -55,6 +80,8 @@ class _SysidGroup(click.Group):
                 err=True,
             )
             ctx.exit(1)
+        finally:
+            signal.signal(signal.SIGTERM, previous)
 
 
 @click.group(cls=_SysidGroup, epilog=_EPILOG, context_settings={"help_option_names": ["-h", "--help"]})

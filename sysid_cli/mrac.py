@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, emit_json, json_option, progress_bar
+from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
 
 __all__ = ["mrac"]
 
@@ -53,7 +53,7 @@ def mrac() -> None:
     """Model reference adaptive control of the altitude near the ground (chapter 2, eqs. 2.15-2.26)."""
 
 
-@mrac.command(epilog=_COMPARE_EPILOG)
+@mrac.command(cls=SysidCommand, epilog=_COMPARE_EPILOG)
 @click.option(
     "--height-ratio",
     "height_ratios",

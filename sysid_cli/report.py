@@ -9,7 +9,7 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, emit_json, json_option
+from ._common import OutputPath, SysidCommand, emit_json, json_option
 
 __all__ = ["report", "ingest_card"]
 
@@ -82,7 +82,7 @@ def _read_json(path: Path) -> Any:
         raise DataError(f"{path}: cannot read it as JSON ({err})") from None
 
 
-@click.command(epilog=_EPILOG)
+@click.command(cls=SysidCommand, epilog=_EPILOG)
 @click.argument("model_path", metavar="MODEL.json", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.argument(
     "validation_path",

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from ._common import OutputPath, emit_json, json_option, progress_bar
+from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
 
 __all__ = ["simulate"]
 
@@ -44,7 +44,7 @@ def _check_trials(trials: list[int] | None, n_trials: int, name: str) -> None:
         )
 
 
-@click.command(epilog=_EPILOG)
+@click.command(cls=SysidCommand, epilog=_EPILOG)
 @click.argument("scenario", required=False)
 @click.option(
     "-o",

@@ -8,7 +8,7 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, emit_json, json_option
+from ._common import OutputPath, SysidCommand, emit_json, json_option
 from ._flights import conditioned_flights, is_dataset
 from ._wind_options import (
     segments_from,
@@ -30,7 +30,7 @@ Examples:
 """
 
 
-@click.command(epilog=_EPILOG)
+@click.command(cls=SysidCommand, epilog=_EPILOG)
 @click.argument("model_path", metavar="MODEL.json", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @wind_option("Anemometer CSV, or a folder of them (repeatable): verifies the wind term G_w too.")

@@ -49,6 +49,17 @@ FLOWN_RISE_TIMES: tuple[FlownRiseTime, ...] = (
 def flown_rise_time(height_ratio: float, phase: str) -> FlownRiseTime | None:
     """The chapter's figures for a case, or None for a case it did not fly (Z/R 22).
 
+    Parameters
+    ----------
+    height_ratio : float
+        Z/R of the case.
+    phase : {"takeoff", "landing"}
+        The step.
+
+    Returns
+    -------
+    FlownRiseTime or None
+
     Examples
     --------
     >>> round(flown_rise_time(4.0, "takeoff").cut("mrac_rbf"), 3)
