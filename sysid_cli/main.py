@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import logging
 import signal
 import sys
@@ -34,6 +35,23 @@ def _terminate(_signum: int, _frame: types.FrameType | None) -> None:
 _INTERRUPTED = {KeyboardInterrupt: (130, "SIGINT"), _Terminated: (143, "SIGTERM")}
 
 
+#: Each command's module and object, imported when the command runs (``sysid --help`` imports them all): a
+#: command loads only what it uses (20 ms of a 0.4 s ingest of a small log went to the other commands' imports).
+_COMMANDS = {
+    "demo": ("sysid_cli.demo", "demo"),
+    "discrepancy": ("sysid_cli.discrepancy", "discrepancy"),
+    "fit": ("sysid_cli.fit", "fit"),
+    "freqresp": ("sysid_cli.freqresp", "freqresp"),
+    "ground-effect": ("sysid_cli.groundeffect", "ground_effect"),
+    "ingest": ("sysid_cli.ingest", "ingest"),
+    "modes": ("sysid_cli.modes", "modes"),
+    "mrac": ("sysid_cli.mrac", "mrac"),
+    "report": ("sysid_cli.report", "report"),
+    "simulate": ("sysid_cli.simulate", "simulate"),
+    "validate": ("sysid_cli.validate", "validate"),
+}
+
+
 class _SysidGroup(click.Group):
     """Turn project errors into one sentence and exit code 1 (traceback only with --debug).
 
@@ -44,6 +62,17 @@ class _SysidGroup(click.Group):
     outputs are written through temporary files that are then removed, so
     nothing half-written is left and an earlier output stays as it was.
     """
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        """Every command's name, sorted."""
+        return sorted({*super().list_commands(ctx), *_COMMANDS})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        """The command called `cmd_name`, its module imported now."""
+        if cmd_name in _COMMANDS and cmd_name not in self.commands:
+            module, name = _COMMANDS[cmd_name]
+            self.add_command(getattr(importlib.import_module(module), name), cmd_name)
+        return super().get_command(ctx, cmd_name)
 
     def invoke(self, ctx: click.Context) -> object:
         previous = signal.signal(signal.SIGTERM, _terminate)
@@ -96,22 +125,3 @@ def cli(ctx: click.Context, debug: bool) -> None:
         format="%(levelname)s %(name)s: %(message)s",
         stream=sys.stderr,
     )
-
-
-def _register() -> None:
-    from . import demo, freqresp, ingest, simulate
-
-    cli.add_command(ingest.ingest)
-    cli.add_command(simulate.simulate)
-    cli.add_command(demo.demo)
-    cli.add_command(freqresp.freqresp)
-    cli.add_command(__import__("sysid_cli.groundeffect", fromlist=["ground_effect"]).ground_effect)
-    cli.add_command(__import__("sysid_cli.validate", fromlist=["validate"]).validate)
-    cli.add_command(__import__("sysid_cli.mrac", fromlist=["mrac"]).mrac)
-    cli.add_command(__import__("sysid_cli.fit", fromlist=["fit"]).fit)
-    cli.add_command(__import__("sysid_cli.modes", fromlist=["modes"]).modes)
-    cli.add_command(__import__("sysid_cli.report", fromlist=["report"]).report)
-    cli.add_command(__import__("sysid_cli.discrepancy", fromlist=["discrepancy"]).discrepancy)
-
-
-_register()
