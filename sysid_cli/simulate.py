@@ -6,6 +6,8 @@ from pathlib import Path
 
 import click
 
+from flightlogs.writers.atomic import atomic_folder
+
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
 
 __all__ = ["simulate"]
@@ -82,17 +84,17 @@ def simulate(
     plan = read_scenario(scenario) if scenario.endswith(".toml") else load_builtin(scenario)
     _check_trials(trials, plan.n_trials, plan.name)
     folder = out_dir if out_dir is not None else Path(plan.name)
-    with progress_bar(f"simulating {plan.name}", quiet=quiet) as bar:
-        written = run_scenario(plan, folder, progress=bar, trials=trials)
+    with progress_bar(f"simulating {plan.name}", quiet=quiet) as bar, atomic_folder(folder) as tmp:
+        written = run_scenario(plan, tmp, progress=bar, trials=trials)  # the folder appears once complete
     summary = {
         "scenario": plan.name,
         "out": str(folder),
         "trials": [
             {
                 "name": t.plan.name,
-                "logs": [str(p) for p in t.logs],
-                "anemometer": str(t.wind_csv) if t.wind_csv else None,
-                "truth": str(t.truth),
+                "logs": [str(folder / p.name) for p in t.logs],
+                "anemometer": str(folder / t.wind_csv.name) if t.wind_csv else None,
+                "truth": str(folder / t.truth.name),
             }
             for t in written
         ],

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from flightlogs._lazy import lazy_names
 
 if TYPE_CHECKING:
-    from flightlogs.writers.atomic import atomic_output
+    from flightlogs.writers.atomic import atomic_folder, atomic_output
     from flightlogs.writers.dataflash import (
         STANDARD_FORMATS,
         MessageBlock,
@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     from flightlogs.writers.ulog import TopicData, encode_ulog, write_ulog
 
 __all__ = [
+    "atomic_folder",
     "atomic_output",
     "MessageSpec",
     "MessageBlock",
@@ -40,6 +41,7 @@ __all__ = [
 ]
 
 _HOMES = {
+    "atomic_folder": "atomic",
     "atomic_output": "atomic",
     **dict.fromkeys(
         (

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from flightlogs.errors import DataError
 
-__all__ = ["atomic_output"]
+__all__ = ["atomic_folder", "atomic_output"]
 
 
 @contextlib.contextmanager
@@ -73,6 +73,57 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+@contextlib.contextmanager
+def atomic_folder(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary folder beside `path`; on success its files become `path`'s.
+
+    A new `path` is the temporary folder renamed; into an existing folder
+    each file is moved in turn (replacing one of the same name, as
+    :func:`atomic_output` would). If the block raises (an error, Ctrl-C,
+    SIGTERM), the temporary folder is removed and `path` is left as it was.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output folder. Its parent must exist.
+
+    Raises
+    ------
+    DataError
+        If `path` is a file, or its parent folder does not exist.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "campaign"
+    >>> with atomic_folder(target) as tmp:
+    ...     _ = (tmp / "a.txt").write_text("done")
+    >>> sorted(p.name for p in target.iterdir())
+    ['a.txt']
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise DataError(f"{path}: is a file, not a folder to write into")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise DataError(f"{parent}: the output folder's parent does not exist")
+    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".part", dir=parent))
+    os.chmod(tmp, 0o777 & ~_umask())  # as a folder made by mkdir (mkdtemp's is private)
+    try:
+        yield tmp
+        if not path.exists():
+            os.replace(tmp, path)
+            return
+        for entry in sorted(tmp.rglob("*")):
+            target = path / entry.relative_to(tmp)
+            if entry.is_dir():
+                target.mkdir(exist_ok=True)
+            else:
+                os.replace(entry, target)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 @contextlib.contextmanager

@@ -77,3 +77,12 @@ def test_no_clobber_refuses_an_existing_output_and_writes_a_new_one(tmp_path: Pa
     written = CliRunner().invoke(cli, ["ingest", str(log), "-q", "--json", str(fresh), "--no-clobber"])
     assert written.exit_code == 0, written.output
     assert fresh.read_text().startswith("{")
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
+def test_an_interrupted_simulation_leaves_no_folder(tmp_path: Path) -> None:
+    """`sysid simulate` writes its folder whole or not at all (a temporary folder beside it, renamed)."""
+    out = tmp_path / "campaign"
+    done = _run_and_signal(["simulate", "chapter3-campaign", "-o", str(out), "-q"], signal.SIGINT, after_s=3.0)
+    assert done.returncode == 130, done.stderr
+    assert list(tmp_path.iterdir()) == []

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from flightlogs.errors import DataError
-from flightlogs.writers.atomic import atomic_output
+from flightlogs.writers.atomic import atomic_folder, atomic_output
 
 
 def _mode(path: Path) -> int:
@@ -126,3 +126,40 @@ def test_a_character_device_is_written_through_not_replaced(tmp_path: Path) -> N
 def test_a_folder_in_place_of_the_file_is_a_data_error(tmp_path: Path) -> None:
     with pytest.raises(DataError, match="is a folder"), atomic_output(tmp_path):
         pass
+
+
+def test_a_new_output_folder_appears_whole_with_ordinary_permissions(tmp_path: Path) -> None:
+    target = tmp_path / "campaign"
+    with atomic_folder(target) as tmp:
+        (tmp / "a.bin").write_bytes(b"a")
+        (tmp / "sub").mkdir()
+        (tmp / "sub" / "b.csv").write_text("b")
+        assert not target.exists()  # nothing there until the block ends
+    assert sorted(str(p.relative_to(target)) for p in target.rglob("*")) == ["a.bin", "sub", "sub/b.csv"]
+    assert _mode(target) == 0o777 & ~_process_umask()
+    assert [p.name for p in tmp_path.iterdir()] == ["campaign"]
+
+
+def test_into_an_existing_folder_files_are_replaced_and_others_kept(tmp_path: Path) -> None:
+    target = tmp_path / "campaign"
+    target.mkdir()
+    (target / "a.bin").write_bytes(b"old")
+    (target / "keep.txt").write_text("mine")
+    with atomic_folder(target) as tmp:
+        (tmp / "a.bin").write_bytes(b"new")
+    assert (target / "a.bin").read_bytes() == b"new" and (target / "keep.txt").read_text() == "mine"
+    assert [p.name for p in tmp_path.iterdir()] == ["campaign"]
+
+
+@pytest.mark.parametrize("existing", [False, True])
+def test_an_interrupted_folder_leaves_nothing_and_the_old_folder_as_it_was(tmp_path: Path, existing: bool) -> None:
+    target = tmp_path / "campaign"
+    if existing:
+        target.mkdir()
+        (target / "a.bin").write_bytes(b"old")
+    with pytest.raises(KeyboardInterrupt), atomic_folder(target) as tmp:
+        (tmp / "a.bin").write_bytes(b"half")
+        raise KeyboardInterrupt
+    assert [p.name for p in tmp_path.iterdir()] == (["campaign"] if existing else [])
+    if existing:
+        assert [p.name for p in target.iterdir()] == ["a.bin"] and (target / "a.bin").read_bytes() == b"old"
