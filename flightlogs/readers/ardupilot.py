@@ -46,11 +46,11 @@ from typing import cast
 
 import numpy as np
 
-from flightlogs.errors import DataQualityWarning, collected_warnings
+from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError, collected_warnings
 from flightlogs.flightlog import FlightLog, Signal, SystemIdRun
 from flightlogs.readers._references import dataflash_references
 from flightlogs.readers._series import make_signal
-from flightlogs.readers.dataflash import DataFlashMessages, MessageTable, read_messages
+from flightlogs.readers.dataflash import DataFlashMessages, MessageTable, MissingColumnError, read_messages
 
 __all__ = ["read_dataflash", "flightlog_from_messages", "SystemIdRun", "system_id_runs", "gps_leap_seconds"]
 
@@ -187,7 +187,12 @@ def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
         that is zero throughout, GNSS samples without a 3-D fix.
     """
     with collected_warnings() as caught:
-        log = _flightlog(messages)
+        try:
+            log = _flightlog(messages)
+        except MissingColumnError as err:
+            raise LogFormatError(
+                f"{messages.path}: {err.args[0]}; a damaged FMT message? The log cannot be mapped."
+            ) from err
     return dataclasses.replace(log, warnings=messages.warnings + caught.messages)
 
 
@@ -210,6 +215,10 @@ def _flightlog(messages: DataFlashMessages) -> FlightLog:
         source: str,
         convert: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> None:
+        if column not in table.columns:  # a format that lacks the field (a damaged FMT, another firmware)
+            message = f"{messages.path.name}: {table.format.name} has no column {column}; {name} is not read from it"
+            warnings.warn(LogCorruptionWarning(message), stacklevel=2)
+            return
         if id(table) not in times:
             times[id(table)] = (table, table.time_s)
         time_s, values = times[id(table)][1], table[column].astype(np.float64)

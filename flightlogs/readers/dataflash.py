@@ -62,6 +62,7 @@ from flightlogs.readers._dataflash_frame import (  # noqa: F401  (kept importabl
 )
 
 __all__ = [
+    "MissingColumnError",
     "MessageFormat",
     "MessageTable",
     "DataFlashMessages",
@@ -72,6 +73,10 @@ __all__ = [
 
 _ULOG_MAGIC = b"ULog\x01\x12\x35"
 _INSTANCE_COLUMNS = ("I", "Instance", "Inst", "C", "Core")
+
+
+class MissingColumnError(LogFormatError, KeyError):
+    """A message type read for a field its format does not define (a damaged or unusual FMT message)."""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -104,6 +109,8 @@ class MessageTable:
         return int(self.offsets.size)
 
     def __getitem__(self, column: str) -> np.ndarray:
+        if column not in self.columns:
+            raise MissingColumnError(f"{self.format.name} has no column {column!r} (its format: {self.format.format})")
         return self.columns[column]
 
     def __contains__(self, column: object) -> bool:
@@ -322,7 +329,10 @@ def _decode(
             progress(0, size)
         held = _Held()
         meta = {k: _decode_table(buf, f, o, release, held) for k, f, o in groups if k in ("FMTU", "UNIT", "MULT")}
-        units = _unit_context(meta)
+        try:
+            units = _unit_context(meta)
+        except MissingColumnError as err:
+            raise LogFormatError(f"{path}: {err.args[0]}; a damaged FMT message? The units cannot be read.") from err
         tables: dict[str, MessageTable] = {}
         counts: dict[str, int] = {}
         for key, fmt, offsets in groups:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import h5py
 
-from flightlogs.errors import LogFormatError
+from flightlogs.errors import LogFormatError, SysidError
 
 __all__ = ["software_version", "stamp_schema", "open_schema"]
 
@@ -50,6 +50,11 @@ def stamp_schema(h5: h5py.File, schema: str, version: int) -> None:
     h5.attrs["schema_version"] = version
     h5.attrs["software"] = f"flight-sysid {software_version()}"
     h5.attrs["created_utc"] = datetime.now(UTC).isoformat(timespec="seconds")
+
+
+#: Exceptions of reading a damaged HDF5 file: h5py's (OSError, RuntimeError), and a member missing or of another
+#: type than the schema's (KeyError, ValueError, TypeError, IndexError, AttributeError).
+_DAMAGED = (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError, AttributeError)
 
 
 @contextmanager
@@ -88,12 +93,17 @@ def open_schema(
     except (OSError, ValueError) as err:
         raise LogFormatError(f"{path}: not {not_hdf5} ({err}).") from err
     with h5:
-        if h5.attrs.get("schema") != schema:
-            raise LogFormatError(f"{path}: {wrong_schema}")
-        version = int(h5.attrs["schema_version"])
-        if version > newest:
-            raise LogFormatError(
-                f"{path}: {what} schema version {version} is newer than this software reads "
-                f"({newest}); upgrade flight-sysid."
-            )
-        yield h5, version
+        try:
+            if h5.attrs.get("schema") != schema:
+                raise LogFormatError(f"{path}: {wrong_schema}")
+            version = int(h5.attrs["schema_version"])
+            if version > newest:
+                raise LogFormatError(
+                    f"{path}: {what} schema version {version} is newer than this software reads "
+                    f"({newest}); upgrade flight-sysid."
+                )
+            yield h5, version
+        except SysidError:
+            raise
+        except _DAMAGED as err:  # what h5py raises on a damaged file, and a missing or mistyped member
+            raise LogFormatError(f"{path}: the {what} is damaged or incomplete ({type(err).__name__}: {err}).") from err
