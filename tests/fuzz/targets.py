@@ -88,40 +88,21 @@ def _prefixes(*names: str) -> list[bytes]:
     return out
 
 
-def _log(path: Path) -> object:
-    from flightlogs.readers import read_log
+def _reader(module: str, function: str) -> Callable[[Path], object]:
+    """``module.function(path)``, the module imported at the first call (after the fuzzer's instrumentation)."""
 
-    return read_log(path)
+    def read(path: Path) -> object:
+        return getattr(importlib.import_module(module), function)(path)
 
-
-def _anemometer(path: Path) -> object:
-    from flightlogs.readers.anemometer import read_anemometer_csv
-
-    return read_anemometer_csv(path)
+    return read
 
 
-def _segments(path: Path) -> object:
-    from flightlogs.maneuvers.segments import read_segments_file
-
-    return read_segments_file(path)
-
-
-def _model(path: Path) -> object:
-    from sysid.fit.model_file import read_model
-
-    return read_model(path)
-
-
-def _scenario(path: Path) -> object:
-    from simulator.campaign.scenario import read_scenario
-
-    return read_scenario(path)
-
-
-def _dataset(path: Path) -> object:
-    from flightlogs.store.dataset import read_dataset
-
-    return read_dataset(path)
+_log = _reader("flightlogs.readers", "read_log")
+_anemometer = _reader("flightlogs.readers.anemometer", "read_anemometer_csv")
+_segments = _reader("flightlogs.maneuvers.segments", "read_segments_file")
+_model = _reader("sysid.fit.model_file", "read_model")
+_scenario = _reader("simulator.campaign.scenario", "read_scenario")
+_dataset = _reader("flightlogs.store.dataset", "read_dataset")
 
 
 def _anemometer_seeds() -> list[bytes]:
