@@ -292,6 +292,8 @@ def _read_columns(
     default_unit: str | None,
 ) -> WindMeasurement:
     """The ``columns`` layout: a header row, then one sample a row."""
+    if not rows:
+        raise LogFormatError(f"{path}: no header row and no data (only empty fields or delimiters)")
     header, data, lines = rows[0], rows[1:], line_numbers[1:]
     if not data:
         raise LogFormatError(f"{path}: no data rows below the header (line {line_numbers[0]})")

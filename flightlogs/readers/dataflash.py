@@ -333,6 +333,10 @@ def _decode(
             units = _unit_context(meta)
         except MissingColumnError as err:
             raise LogFormatError(f"{path}: {err.args[0]}; a damaged FMT message? The units cannot be read.") from err
+        except (ValueError, TypeError) as err:  # a field of another type than the FMTU/UNIT/MULT layout's
+            message = f"{path.name}: the FMTU, UNIT or MULT messages cannot be read ({err}); no units are applied."
+            warnings.warn(LogCorruptionWarning(message), stacklevel=2)
+            units = None
         tables: dict[str, MessageTable] = {}
         counts: dict[str, int] = {}
         for key, fmt, offsets in groups:
