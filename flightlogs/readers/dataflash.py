@@ -124,11 +124,11 @@ class MessageTable:
         time ``T`` instead (as DFReader's msec clock does). None without any.
         """
         cols = self.columns
-        if "TimeUS" in cols:
+        if "TimeUS" in cols and _numeric(self.format, "TimeUS"):
             return cols["TimeUS"].astype(np.float64) / 1e6
-        if "T" in cols and "Week" in cols and self.format.name.startswith("GPS"):
+        if "T" in cols and "Week" in cols and self.format.name.startswith("GPS") and _numeric(self.format, "T"):
             return cols["T"].astype(np.float64) / 1e3
-        if "TimeMS" in cols:
+        if "TimeMS" in cols and _numeric(self.format, "TimeMS"):
             return cols["TimeMS"].astype(np.float64) / 1e3
         return None
 
@@ -528,13 +528,24 @@ def _with_units(
     )
 
 
+_TEXT_FORMATS = frozenset("nNZa")  # format characters of text and of arrays: never a clock
+
+
+def _numeric(fmt: MessageFormat, column: str) -> bool:
+    """Whether `fmt` gives `column` a number (a damaged FMT may make the clock a string)."""
+    chars = fmt.format
+    names = fmt.columns[: len(chars)]
+    where = len(names) - 1 - names[::-1].index(column) if column in names else -1  # a repeated name: its last
+    return where >= 0 and chars[where] not in _TEXT_FORMATS
+
+
 def _time_resets(tables: dict[str, MessageTable]) -> list[str]:
     """A sentence saying where the log clock jumps back by more than a second (logs appended), if it does."""
     best: tuple[int, str, list[tuple[int, float, float]]] | None = None
     last_time: dict[str, float] = {}
     for key, table in tables.items():
-        column = next((c for c in ("TimeUS", "TimeMS") if c in table.columns), None)
-        if column is None or not len(table) or key.startswith("GPS"):
+        column = next((c for c in ("TimeUS", "TimeMS") if c in table.columns and _numeric(table.format, c)), None)
+        if column is None or not len(table) or key.startswith("GPS") or table.time_s is None:
             continue
         name, stamp = key.split("@")[0], table[column].astype(np.int64)
         drops = np.flatnonzero(np.diff(stamp) < -(10**6 if column == "TimeUS" else 10**3))

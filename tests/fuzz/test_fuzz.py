@@ -2,8 +2,8 @@
 
 Every input kept under ``regressions/TARGET/`` broke the rule of :mod:`fuzz.targets` once (a
 traceback instead of an error naming the file) and is replayed here: DataFlash logs whose FMT
-lacks a field the reader maps (PARM without Value, MULT without Id, XKF1 without VE) or types the
-FMTU's FmtType as text (found by the fuzzer in mutated prefixes of the real logs, rebuilt small with
+lacks a field the reader maps (PARM without Value, MULT without Id, XKF1 without VE) or types a
+number as text (FMTU's FmtType, PARM's TimeUS) (found by the fuzzer in mutated prefixes of the real logs, rebuilt small with
 our writer, so no real log is copied here), an anemometer file of one delimiter, and damaged
 datasets (h5py's KeyError, a JSON attribute cut; gzip-compressed). The slice runs each target's
 atheris fuzzer for a few hundred inputs from a fixed seed (libFuzzer's ``-seed``), so a reader that
