@@ -88,9 +88,18 @@ def demo(ctx: click.Context, out_dir: Path, discrepancy: bool) -> None:
     anemometer 4.6 m upstream whose clock is 1.5 s fast), ingest it (align the wind, find the
     maneuvers), fit the hover-wind model to the sweeps, verify it on the doublets with and without
     its wind term, and write the HTML report. Prints where each file is; the report's path last."""
-    if discrepancy:
-        _discrepancy_demo(ctx, out_dir)
-        return
+    from flightlogs.writers.atomic import folder_in_place
+
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    with folder_in_place(out_dir):  # interrupted or failed: the folder as it was
+        if discrepancy:
+            _discrepancy_demo(ctx, out_dir)
+        else:
+            _demo(ctx, out_dir)
+
+
+def _demo(ctx: click.Context, out_dir: Path) -> None:
+    """The chapter 3 flight: simulate, ingest, fit, verify, report."""
     from simulator.campaign.demo_flight import write_demo_flight
 
     from .fit import fit
@@ -153,7 +162,6 @@ def _discrepancy_demo(ctx: click.Context, out_dir: Path) -> None:
 
     from .discrepancy import discrepancy
 
-    out_dir.mkdir(parents=True, exist_ok=True)
     click.echo(f"simulating a flight and its 'real' twin into {out_dir}/ (about a minute) ...")
     sim, reals = write_pairs(["time_delay"], out_dir, seed=7)
     real = out_dir / "real.ulg"

@@ -1,6 +1,6 @@
 """The HDF5 dataset store: ingested logs and wind measurements, with provenance.
 
-Layout (schema version 1)::
+Layout (schema version 2; version 1 held variable-length strings, still read)::
 
     /                               attrs: schema, schema_version, software, created_utc
     /logs/<key>/                    attrs: path, sha256, log_format, autopilot, vehicle,
@@ -19,7 +19,8 @@ Layout (schema version 1)::
     /conditioned/<key>/records/<i>/ attrs: label, units (JSON), trim (JSON)
     /conditioned/<key>/records/<i>/time_s, /<signal>   float64 (n_samples,), trim removed
 
-Arrays are LZF-compressed after byte shuffling (h5py reads them as any other). ``<key>`` is the file's
+Text (attributes and the compound tables' string fields) is fixed-length UTF-8, and the file is
+in HDF5's checksummed 1.10 format (:mod:`flightlogs.store.schema`). Arrays are LZF-compressed after byte shuffling (h5py reads them as any other). ``<key>`` is the file's
 stem, made unique with a numeric suffix. Later steps
 add groups of their own beside these (aligned records, segments); a reader
 ignores groups it does not know.
@@ -40,7 +41,7 @@ import numpy as np
 
 from flightlogs._arrays import ByContents
 from flightlogs.flightlog import FlightLog, Signal, SystemIdRun
-from flightlogs.store.schema import open_schema, stamp_schema
+from flightlogs.store.schema import create_schema_file, open_schema, put_text, stamp_schema, text, text_dtype
 from flightlogs.writers.atomic import atomic_output
 from flightlogs.writers.jsonio import jsonable
 
@@ -53,7 +54,7 @@ _COMPRESSION: dict[str, Any] = {"compression": "lzf", "shuffle": True}
 __all__ = ["Dataset", "write_dataset", "read_dataset", "file_sha256", "SCHEMA_VERSION"]
 
 SCHEMA = "flight-sysid dataset"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -112,7 +113,7 @@ def write_dataset(
     conditioned : sequence of ConditionedFlight, optional
         Aligned records, segments and alignment of each flight.
     """
-    with atomic_output(path) as tmp, h5py.File(tmp, "w") as h5:
+    with atomic_output(path) as tmp, create_schema_file(tmp) as h5:
         stamp_schema(h5, SCHEMA, SCHEMA_VERSION)
         log_group = h5.create_group("logs")
         for log in logs:
@@ -148,11 +149,17 @@ def read_dataset(path: str | Path) -> Dataset:
         wrong_schema="HDF5 file is not a flight-sysid dataset.",
     ) as (h5, version):
         logs = tuple(_read_log(group) for group in h5["logs"].values())
-        sha = {g.attrs["path"]: g.attrs["sha256"] for g in h5["logs"].values()}
-        winds = tuple(_read_wind(group) for group in h5.get("wind", {}).values())
-        sha.update({g.attrs["path"]: g.attrs["sha256"] for g in h5.get("wind", {}).values()})
-        conditioned = tuple(_read_conditioned(g) for g in h5.get("conditioned", {}).values())
+        sha = {text(g.attrs["path"]): text(g.attrs["sha256"]) for g in h5["logs"].values()}
+        winds = tuple(_read_wind(group) for group in _members(h5, "wind"))
+        sha.update({text(g.attrs["path"]): text(g.attrs["sha256"]) for g in _members(h5, "wind")})
+        conditioned = tuple(_read_conditioned(g) for g in _members(h5, "conditioned"))
     return Dataset(logs=logs, winds=winds, conditioned=conditioned, sha256=sha, schema_version=version)
+
+
+def _members(h5: h5py.File, name: str) -> list[Any]:
+    """The members of the optional group `name`: none when there is no such link; a group that is linked but
+    cannot be opened (damaged) raises, where ``h5.get`` would answer with its default."""
+    return list(h5[name].values()) if name in h5 else []
 
 
 def _unique_key(group: h5py.Group, path: Path) -> str:
@@ -185,29 +192,41 @@ def _source_hash(path: Path) -> str:
 
 
 def _write_log(group: h5py.Group, log: FlightLog) -> None:
-    group.attrs["path"] = str(log.path)
-    group.attrs["sha256"] = _source_hash(log.path)
-    group.attrs["log_format"] = log.log_format
-    group.attrs["autopilot"] = log.autopilot
-    group.attrs["vehicle"] = log.vehicle
+    for name, value in (
+        ("path", str(log.path)),
+        ("sha256", _source_hash(log.path)),
+        ("log_format", log.log_format),
+        ("autopilot", log.autopilot),
+        ("vehicle", log.vehicle),
+        ("warnings", json.dumps(list(log.warnings))),
+    ):
+        put_text(group.attrs, name, value)
     group.attrs["utc_offset_s"] = np.nan if log.utc_offset_s is None else log.utc_offset_s
-    group.attrs["warnings"] = json.dumps(list(log.warnings))
-    names = sorted(log.parameters)
-    table = np.array(
-        [(name, float(log.parameters[name])) for name in names],
-        dtype=[("name", h5py.string_dtype()), ("value", "f8")],
-    )
-    group.create_dataset("parameters", data=table)
+    parameters = [(name, float(log.parameters[name])) for name in sorted(log.parameters)]
+    group.create_dataset("parameters", data=_table((("name", "S"), ("value", "f8")), parameters))
     runs = [dataclasses.astuple(run) for run in log.system_id_runs]
-    group.create_dataset("system_id_runs", data=np.array(runs, dtype=_RUN_DTYPE))
+    group.create_dataset("system_id_runs", data=_table(_RUN_FIELDS, runs))
     signals = group.create_group("signals")
     times = _SharedTimes(group)
     for name, signal in log.signals.items():
         sub = signals.create_group(name)
-        sub.attrs["unit"] = signal.unit
-        sub.attrs["source"] = signal.source
+        put_text(sub.attrs, "unit", signal.unit)
+        put_text(sub.attrs, "source", signal.source)
         sub["time_s"] = times.dataset(signal.time_s)
         sub.create_dataset("values", data=_narrowed(signal.values))
+
+
+def _table(fields: Sequence[tuple[str, str]], rows: Sequence[tuple[Any, ...]]) -> np.ndarray:
+    """A compound array of `rows` (n,), its ``"S"`` fields fixed-length UTF-8 as long as their longest value."""
+    columns = list(zip(*rows, strict=True)) if rows else [() for _ in fields]
+    dtype = [
+        (name, text_dtype(list(column)) if kind == "S" else kind)
+        for (name, kind), column in zip(fields, columns, strict=True)
+    ]
+    encoded = [
+        tuple(v.encode("utf-8") if kind == "S" else v for (_, kind), v in zip(fields, row, strict=True)) for row in rows
+    ]
+    return np.array(encoded, dtype=dtype)
 
 
 def _narrowed(values: np.ndarray) -> np.ndarray:
@@ -224,24 +243,21 @@ def _read_log(group: h5py.Group) -> FlightLog:
             name=name,
             time_s=sub["time_s"][()],
             values=sub["values"][()].astype(np.float64, copy=False),
-            unit=str(sub.attrs["unit"]),
-            source=str(sub.attrs["source"]),
+            unit=text(sub.attrs["unit"]),
+            source=text(sub.attrs["source"]),
         )
         for name, sub in group["signals"].items()
     }
     table = group["parameters"][()]
-    parameters = {
-        (row["name"].decode() if isinstance(row["name"], bytes) else str(row["name"])): float(row["value"])
-        for row in table
-    }
+    parameters = {text(row["name"]): float(row["value"]) for row in table}
     offset = float(group.attrs["utc_offset_s"])
     runs = tuple(_run_from_row(row) for row in group["system_id_runs"][()]) if "system_id_runs" in group else ()
     return FlightLog(
-        path=Path(group.attrs["path"]),
-        log_format=str(group.attrs["log_format"]),  # type: ignore[arg-type]
-        autopilot=str(group.attrs["autopilot"]),  # type: ignore[arg-type]
+        path=Path(text(group.attrs["path"])),
+        log_format=text(group.attrs["log_format"]),  # type: ignore[arg-type]
+        autopilot=text(group.attrs["autopilot"]),  # type: ignore[arg-type]
         signals=signals,
-        vehicle=str(group.attrs["vehicle"]),
+        vehicle=text(group.attrs["vehicle"]),
         parameters=parameters,
         utc_offset_s=None if np.isnan(offset) else offset,
         warnings=tuple(json.loads(group.attrs["warnings"])),
@@ -249,11 +265,10 @@ def _read_log(group: h5py.Group) -> FlightLog:
     )
 
 
-_RUN_DTYPE = np.dtype(
-    [
-        (f.name, h5py.string_dtype() if f.name == "axis_name" else ("i8" if f.name == "axis" else "f8"))
-        for f in dataclasses.fields(SystemIdRun)
-    ]
+#: The SIDS runs' table fields and their types (``axis_name``'s string length is set per file).
+_RUN_FIELDS = tuple(
+    (f.name, "S" if f.name == "axis_name" else ("i8" if f.name == "axis" else "f8"))
+    for f in dataclasses.fields(SystemIdRun)
 )
 
 
@@ -266,27 +281,27 @@ def _run_from_row(row: np.void) -> SystemIdRun:
         start_s=float(row["start_s"]),
         end_s=float(row["end_s"]),
         axis=int(row["axis"]),
-        axis_name=_text(row["axis_name"]),
+        axis_name=text(row["axis_name"]),
         **numbers,
     )
 
 
 def _write_dataclass(group: h5py.Group, item: Any) -> None:
     """Store a frozen dataclass: arrays as datasets, the rest as attributes."""
-    group.attrs["sha256"] = _source_hash(item.path)
+    put_text(group.attrs, "sha256", _source_hash(item.path))
     for field in dataclasses.fields(item):
         value = getattr(item, field.name)
         if isinstance(value, np.ndarray):
             group.create_dataset(field.name, data=value, **_COMPRESSION)
-        elif isinstance(value, Path):
-            group.attrs[field.name] = str(value)
+        elif isinstance(value, (str, Path)):
+            put_text(group.attrs, field.name, str(value))
         elif value is None:
-            group.attrs[field.name] = "null"
+            put_text(group.attrs, field.name, "null")
             group.attrs[f"{field.name}.json"] = True
-        elif isinstance(value, (str, int, float, bool, np.floating, np.integer)):
+        elif isinstance(value, (int, float, bool, np.floating, np.integer)):
             group.attrs[field.name] = value
         else:
-            group.attrs[field.name] = json.dumps(jsonable(value, nonfinite="keep"))
+            put_text(group.attrs, field.name, json.dumps(jsonable(value, nonfinite="keep")))
             group.attrs[f"{field.name}.json"] = True
 
 
@@ -299,6 +314,7 @@ def _read_wind(group: h5py.Group) -> Any:
             kwargs[field.name] = group[field.name][()]
         elif field.name in group.attrs:
             raw = group.attrs[field.name]
+            raw = text(raw) if isinstance(raw, (bytes, str)) else raw
             if group.attrs.get(f"{field.name}.json", False):
                 raw = json.loads(raw)
                 raw = tuple(raw) if isinstance(raw, list) else raw
@@ -307,29 +323,24 @@ def _read_wind(group: h5py.Group) -> Any:
     return WindMeasurement(**kwargs)
 
 
-_SEGMENT_DTYPE = np.dtype(
-    [
-        ("axis", h5py.string_dtype()),
-        ("kind", h5py.string_dtype()),
-        ("start_s", "f8"),
-        ("end_s", "f8"),
-        ("source", h5py.string_dtype()),
-        ("f_min_hz", "f8"),
-        ("f_max_hz", "f8"),
-        ("detail", h5py.string_dtype()),
-    ]
+#: The segments table's fields: "S" a text field, its length set per file by the longest value.
+_SEGMENT_FIELDS = (
+    ("axis", "S"),
+    ("kind", "S"),
+    ("start_s", "f8"),
+    ("end_s", "f8"),
+    ("source", "S"),
+    ("f_min_hz", "f8"),
+    ("f_max_hz", "f8"),
+    ("detail", "S"),
 )
 
 
-def _text(value: Any) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def _write_conditioned(group: h5py.Group, flight: Any) -> None:
-    group.attrs["source"] = str(flight.source)
+    put_text(group.attrs, "source", str(flight.source))
     group.attrs["rate_hz"] = flight.rate_hz
-    group.attrs["warnings"] = json.dumps(list(flight.warnings))
-    group.attrs["wind_alignment"] = json.dumps(jsonable(flight.wind, nonfinite="keep"))
+    put_text(group.attrs, "warnings", json.dumps(list(flight.warnings)))
+    put_text(group.attrs, "wind_alignment", json.dumps(jsonable(flight.wind, nonfinite="keep")))
     rows = [
         (
             s.axis or "",
@@ -343,13 +354,13 @@ def _write_conditioned(group: h5py.Group, flight: Any) -> None:
         )
         for s in flight.segments
     ]
-    group.create_dataset("segments", data=np.array(rows, dtype=_SEGMENT_DTYPE))
+    group.create_dataset("segments", data=_table(_SEGMENT_FIELDS, rows))
     records = group.create_group("records")
     for k, record in enumerate(flight.records):
         sub = records.create_group(str(k))
-        sub.attrs["label"] = record.label
-        sub.attrs["units"] = json.dumps(dict(record.units))
-        sub.attrs["trim"] = json.dumps(dict(record.trim))
+        put_text(sub.attrs, "label", record.label)
+        put_text(sub.attrs, "units", json.dumps(dict(record.units)))
+        put_text(sub.attrs, "trim", json.dumps(dict(record.trim)))
         sub.create_dataset("time_s", data=record.time_s)
         for name in record.signals:
             sub.create_dataset(name, data=record[name])
@@ -364,18 +375,18 @@ def _read_conditioned(group: h5py.Group) -> Any:
 
     segments = tuple(
         Segment(
-            axis=cast(Any, _text(row["axis"]) or None),
-            kind=cast(Any, _text(row["kind"])),
+            axis=cast(Any, text(row["axis"]) or None),
+            kind=cast(Any, text(row["kind"])),
             start_s=float(row["start_s"]),
             end_s=float(row["end_s"]),
-            source=cast(Any, _text(row["source"])),
+            source=cast(Any, text(row["source"])),
             f_min_hz=None if np.isnan(row["f_min_hz"]) else float(row["f_min_hz"]),
             f_max_hz=None if np.isnan(row["f_max_hz"]) else float(row["f_max_hz"]),
-            detail=_text(row["detail"]),
+            detail=text(row["detail"]),
         )
         for row in group["segments"][()]
     )
-    source = Path(group.attrs["source"])
+    source = Path(text(group.attrs["source"]))
     records = []
     for key in sorted(group["records"], key=int):
         sub = group["records"][key]
@@ -387,7 +398,7 @@ def _read_conditioned(group: h5py.Group) -> Any:
                 units=units,
                 trim=json.loads(sub.attrs["trim"]),
                 source=source,
-                label=str(sub.attrs["label"]),
+                label=text(sub.attrs["label"]),
             )
         )
     raw = json.loads(group.attrs["wind_alignment"])

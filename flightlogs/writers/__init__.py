@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from flightlogs._lazy import lazy_names
 
 if TYPE_CHECKING:
-    from flightlogs.writers.atomic import atomic_folder, atomic_output
+    from flightlogs.writers.atomic import atomic_folder, atomic_output, folder_in_place
     from flightlogs.writers.dataflash import (
         STANDARD_FORMATS,
         MessageBlock,
@@ -27,6 +27,7 @@ if TYPE_CHECKING:
 __all__ = [
     "atomic_folder",
     "atomic_output",
+    "folder_in_place",
     "MessageSpec",
     "MessageBlock",
     "STANDARD_FORMATS",
@@ -43,6 +44,7 @@ __all__ = [
 _HOMES = {
     "atomic_folder": "atomic",
     "atomic_output": "atomic",
+    "folder_in_place": "atomic",
     **dict.fromkeys(
         (
             "STANDARD_FORMATS",

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from flightlogs.errors import DataError
 
-__all__ = ["atomic_folder", "atomic_output"]
+__all__ = ["atomic_folder", "atomic_output", "folder_in_place"]
 
 
 @contextlib.contextmanager
@@ -124,6 +124,64 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
                 os.replace(entry, target)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def folder_in_place(path: str | Path) -> Iterator[Path]:
+    """Yield `path` itself, emptied, to write into; whatever it held comes back if the block fails.
+
+    For outputs that record their own paths (a dataset names its logs, a report its files), so
+    cannot be written under a temporary name as in :func:`atomic_folder`. What `path` held is set
+    aside beside it first; if the block raises (an error, Ctrl-C, SIGTERM), what was written is
+    removed and the old contents are put back; on success, the old files the block did not write
+    again are put back beside the new ones.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output folder. Its parent must exist.
+
+    Raises
+    ------
+    DataError
+        If `path` is a file, or its parent folder does not exist.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "demo"
+    >>> target.mkdir(); _ = (target / "notes.txt").write_text("mine")
+    >>> with folder_in_place(target) as folder:
+    ...     _ = (folder / "report.html").write_text("new")
+    >>> sorted(p.name for p in target.iterdir())
+    ['notes.txt', 'report.html']
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise DataError(f"{path}: is a file, not a folder to write into")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise DataError(f"{parent}: the output folder's parent does not exist")
+    aside = None
+    if path.exists():
+        aside = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".old", dir=parent))
+        os.replace(path, aside / path.name)
+    try:
+        path.mkdir()
+        yield path
+    except BaseException:
+        shutil.rmtree(path, ignore_errors=True)
+        if aside is not None:
+            os.replace(aside / path.name, path)
+        raise
+    else:
+        if aside is not None:
+            for entry in sorted((aside / path.name).iterdir()):
+                if not (path / entry.name).exists():
+                    os.replace(entry, path / entry.name)
+    finally:
+        if aside is not None:
+            shutil.rmtree(aside, ignore_errors=True)
 
 
 @contextlib.contextmanager

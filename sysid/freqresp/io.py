@@ -1,6 +1,7 @@
 """Frequency responses to and from HDF5, with units and a schema version.
 
-Layout (schema version 1)::
+Layout (schema version 2: text in fixed-length UTF-8 in the checksummed HDF5 1.10 format, see
+:mod:`flightlogs.store.schema`; version 1 files, with variable-length text, are still read)::
 
     /                         attrs: schema, schema_version, software, created_utc
     /responses/<nnn>/         attrs: input, output, input_unit, output_unit, windows_s,
@@ -17,7 +18,7 @@ Layout (schema version 1)::
 ``<nnn>`` is the zero-padded position, so the order written is the order read.
 ``reference`` and ``whole_record`` are optional attributes: files written
 before them read as responses without a reference or whole-record member,
-and older readers ignore them, so the layout version stays 1.
+and older readers ignore them.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from flightlogs.store.schema import open_schema, stamp_schema
+from flightlogs.store.schema import create_schema_file, open_schema, put_text, stamp_schema, text
 from flightlogs.writers.atomic import atomic_output
 from sysid.freqresp.response import FrequencyResponse
 
@@ -37,7 +38,7 @@ __all__ = ["write_responses", "read_responses", "RESPONSES_SCHEMA_VERSION"]
 
 _SCHEMA = "flight-sysid frequency responses"
 #: Layout version written by :func:`write_responses`.
-RESPONSES_SCHEMA_VERSION = 1
+RESPONSES_SCHEMA_VERSION = 2
 _ARRAYS = (
     "omega",
     "response",
@@ -74,7 +75,7 @@ def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) ->
     >>> back.pair, back.input_unit, bool(np.array_equal(back.response, h.response))
     ('q/delta_lon', '%', True)
     """
-    with atomic_output(path) as tmp, h5py.File(tmp, "w") as h5:
+    with atomic_output(path) as tmp, create_schema_file(tmp) as h5:
         stamp_schema(h5, _SCHEMA, RESPONSES_SCHEMA_VERSION)
         group = h5.create_group("responses")
         width = max(3, len(str(len(responses))))
@@ -112,21 +113,21 @@ def read_responses(path: str | Path) -> tuple[FrequencyResponse, ...]:
 
 
 def _write_one(group: h5py.Group, response: FrequencyResponse) -> None:
-    group.attrs["input"] = response.input
-    group.attrs["output"] = response.output
-    group.attrs["input_unit"] = response.input_unit
-    group.attrs["output_unit"] = response.output_unit
+    put_text(group.attrs, "input", response.input)
+    put_text(group.attrs, "output", response.output)
+    put_text(group.attrs, "input_unit", response.input_unit)
+    put_text(group.attrs, "output_unit", response.output_unit)
     group.attrs["windows_s"] = np.asarray(response.windows_s, dtype=np.float64)
-    group.attrs["conditioned_on"] = json.dumps(list(response.conditioned_on))
+    put_text(group.attrs, "conditioned_on", json.dumps(list(response.conditioned_on)))
     if response.fit_range is not None:
         group.attrs["fit_range"] = np.asarray(response.fit_range, dtype=np.float64)
     if response.reference is not None:
-        group.attrs["reference"] = response.reference
+        put_text(group.attrs, "reference", response.reference)
     group.attrs["whole_record"] = bool(response.whole_record)
     units = _units(response)
     for name in _ARRAYS:
         dataset = group.create_dataset(name, data=np.asarray(getattr(response, name)))
-        dataset.attrs["unit"] = units[name]
+        put_text(dataset.attrs, "unit", units[name])
 
 
 def _units(response: FrequencyResponse) -> dict[str, str]:
@@ -147,18 +148,14 @@ def _read_one(group: h5py.Group) -> FrequencyResponse:
     fit = group.attrs.get("fit_range")
     reference = group.attrs.get("reference")
     return FrequencyResponse(
-        input=_text(group.attrs["input"]),
-        output=_text(group.attrs["output"]),
+        input=text(group.attrs["input"]),
+        output=text(group.attrs["output"]),
         windows_s=tuple(float(t) for t in np.atleast_1d(group.attrs["windows_s"])),
-        conditioned_on=tuple(json.loads(_text(group.attrs["conditioned_on"]))),
-        input_unit=_text(group.attrs["input_unit"]),
-        output_unit=_text(group.attrs["output_unit"]),
+        conditioned_on=tuple(json.loads(text(group.attrs["conditioned_on"]))),
+        input_unit=text(group.attrs["input_unit"]),
+        output_unit=text(group.attrs["output_unit"]),
         fit_range=None if fit is None else (float(fit[0]), float(fit[1])),
-        reference=None if reference is None else _text(reference),
+        reference=None if reference is None else text(reference),
         whole_record=bool(group.attrs.get("whole_record", False)),
         **arrays,
     )
-
-
-def _text(value: object) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)

@@ -86,3 +86,20 @@ def test_an_interrupted_simulation_leaves_no_folder(tmp_path: Path) -> None:
     done = _run_and_signal(["simulate", "chapter3-campaign", "-o", str(out), "-q"], signal.SIGINT, after_s=3.0)
     assert done.returncode == 130, done.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
+def test_an_interrupted_demo_leaves_its_folder_as_it_was(tmp_path: Path) -> None:
+    """`sysid demo` writes into its folder itself (the dataset and the report name their files): what the folder
+    held is set aside and put back when the run is cut short."""
+    out = tmp_path / "sysid-demo"
+    out.mkdir()
+    (out / "report.html").write_text("an earlier demo's report")
+    (out / "notes.txt").write_text("mine")
+    done = _run_and_signal(["demo", "-o", str(out)], signal.SIGTERM, after_s=4.0)
+    assert done.returncode == 143, done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sysid-demo"]  # nothing set aside is left
+    assert {p.name: p.read_text() for p in out.iterdir()} == {
+        "report.html": "an earlier demo's report",
+        "notes.txt": "mine",
+    }

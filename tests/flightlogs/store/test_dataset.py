@@ -178,3 +178,146 @@ def test_system_id_runs_round_trip(tmp_path: Path) -> None:
     back = read_dataset(tmp_path / "sid.h5").logs[0].system_id_runs
     assert back[0] == runs[0]
     assert back[1].axis_name == "mixer roll" and np.isnan(back[1].end_s)
+
+
+def _every_dataset(out: Path) -> None:
+    """Write a dataset with every kind of text one holds: a log with a SIDS run, a wind measurement, a conditioned
+    flight (its segments and records) of a simulated hover."""
+    import warnings
+    from datetime import UTC, datetime
+
+    from flightlogs.flightlog import SystemIdRun
+    from flightlogs.readers.anemometer import read_anemometer_csv
+    from flightlogs.store.campaign import ingest_campaign
+    from simulator.autopilot.excitation import Maneuver
+    from simulator.flights.linear import simulate_hover
+    from simulator.output.px4 import write_px4_log
+
+    run = SystemIdRun(
+        start_s=25.0, end_s=59.99, axis=11, axis_name="mixer pitch", magnitude=0.08, f_start_hz=0.1,
+        f_stop_hz=10.0, fade_in_s=5.0, const_s=0.0, record_s=34.0, fade_out_s=1.0,
+    )  # fmt: skip
+    log = dataclasses.replace(_log(out.parent / "flight.ulg"), system_id_runs=(run,))
+    wind = read_anemometer_csv(Path(__file__).resolve().parents[2] / "data" / "anemometer" / "iso_utc_speed_dir.csv")
+    doublet = Maneuver(axis="lon", kind="doublet", start_s=8.0, amplitude=8.0, duration_s=2.0)
+    flight = simulate_hover(16.0, (doublet,), rate_hz=25.0, substeps=2, seed=3)
+    hover = write_px4_log(flight, out.parent / "hover.ulg", utc_start=datetime(2025, 5, 1, 10, tzinfo=UTC))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        campaign = ingest_campaign([hover], [])
+    write_dataset(out, [log, *campaign.logs], [wind], list(campaign.flights))
+
+
+def _texts(h5: h5py.File) -> list[np.dtype]:
+    """The dtype of every attribute and dataset in `h5` (compound ones by their fields)."""
+    dtypes: list[np.dtype] = []
+
+    def visit(_: str, item: h5py.Group | h5py.Dataset) -> None:
+        dtypes.extend(item.attrs.get_id(name).dtype for name in item.attrs)
+        if isinstance(item, h5py.Dataset):
+            dtypes.extend([item.dtype] if item.dtype.names is None else [item.dtype[n] for n in item.dtype.names])
+
+    dtypes.extend(h5.attrs.get_id(name).dtype for name in h5.attrs)
+    h5.visititems(visit)
+    return dtypes
+
+
+def test_a_dataset_has_no_variable_length_text_and_checksummed_structure(tmp_path: Path) -> None:
+    """Variable-length text lives in HDF5's global heap, which has no checksum and whose damage can hang libhdf5
+    (found by fuzzing); the 1.10 format checksums the superblock and every object header."""
+    out = tmp_path / "set.h5"
+    _every_dataset(out)
+    data = out.read_bytes()
+    assert b"GCOL" not in data and data[8] >= 2  # no global heap; superblock version 2 or 3 (checksummed)
+    with h5py.File(out) as h5:
+        dtypes = _texts(h5)
+    assert all(h5py.check_vlen_dtype(d) is None for d in dtypes)
+    assert all(d.kind != "O" for d in dtypes)
+    assert sum(d.kind == "S" for d in dtypes) > 20  # the text is there, in fixed-length strings
+
+
+def test_damage_to_any_object_header_is_one_sentence_or_harmless(tmp_path: Path) -> None:
+    """A damaged header of an object the reader opens is a checksum error, said in one sentence; never a group
+    read as absent (the wind and conditioned groups were, through ``h5.get``). The headers the reader never
+    opens are the shared time arrays' folders (their datasets are reached by the signals' hard links)."""
+    out = tmp_path / "set.h5"
+    _every_dataset(out)
+    data = out.read_bytes()
+    whole = read_dataset(out)
+    headers = [k for k in range(len(data)) if data.startswith(b"OHDR", k)]
+    harmless = []
+    for at in headers:
+        damaged = bytearray(data)
+        damaged[at + 6] ^= 0x55  # the size of the header's first chunk: what the checksum covers moves
+        path = tmp_path / f"damaged-{at}.h5"
+        path.write_bytes(bytes(damaged))
+        try:
+            back = read_dataset(path)
+        except LogFormatError as err:
+            assert path.name in str(err) and "damaged" in str(err)
+            continue
+        counts = [len(back.logs), len(back.winds), len(back.conditioned), *(len(g.signals) for g in back.logs)]
+        assert counts == [
+            len(whole.logs),
+            len(whole.winds),
+            len(whole.conditioned),
+            *(len(g.signals) for g in whole.logs),
+        ]
+        harmless.append(at)
+    assert len(headers) > 100 and len(harmless) == len(whole.logs)  # one time folder per log
+
+
+def _as_version_1(path: Path) -> None:
+    """Rewrite `path` as version 1 wrote it: every text in variable-length strings (h5py's ``str``)."""
+    with h5py.File(path, "a") as h5:
+
+        def visit(_: str, item: h5py.Group | h5py.Dataset) -> None:
+            for name, value in list(item.attrs.items()):
+                if isinstance(value, bytes):
+                    item.attrs[name] = value.decode()
+            if isinstance(item, h5py.Dataset) and item.dtype.names is not None:
+                vlen = np.dtype(
+                    [(n, h5py.string_dtype() if item.dtype[n].kind == "S" else item.dtype[n]) for n in item.dtype.names]
+                )
+                rows = item[()]
+                table = np.array(
+                    [tuple(v.decode() if isinstance(v, bytes) else v for v in row) for row in rows], dtype=vlen
+                )
+                parent, key = item.parent, item.name.rsplit("/", 1)[1]
+                del parent[key]
+                parent.create_dataset(key, data=table)
+
+        items: list[tuple[str, h5py.Group | h5py.Dataset]] = []
+        h5.visititems(lambda name, item: items.append((name, item)))
+        for name, item in items:
+            visit(name, item)
+        for name, value in list(h5.attrs.items()):
+            if isinstance(value, bytes):
+                h5.attrs[name] = value.decode()
+        h5.attrs["schema_version"] = 1
+
+
+def test_a_version_1_dataset_reads_as_it_was_written(tmp_path: Path) -> None:
+    new, old = tmp_path / "new.h5", tmp_path / "old.h5"
+    _every_dataset(new)
+    old.write_bytes(new.read_bytes())
+    _as_version_1(old)
+    with h5py.File(old) as h5:
+        assert any(h5py.check_string_dtype(d) is not None and d.kind == "O" for d in _texts(h5))
+    a, b = read_dataset(new), read_dataset(old)
+    assert (a.schema_version, b.schema_version) == (SCHEMA_VERSION, 1)
+    assert a.sha256 == b.sha256
+    assert len(a.conditioned) == len(b.conditioned) == 1
+    assert a.conditioned[0].segments == b.conditioned[0].segments and len(a.conditioned[0].segments) > 0
+    assert [(r.label, dict(r.units), dict(r.trim)) for r in a.conditioned[0].records] == [
+        (r.label, dict(r.units), dict(r.trim)) for r in b.conditioned[0].records
+    ]
+    for x, y in ((a.logs[0], b.logs[0]), (a.winds[0], b.winds[0])):
+        for field in dataclasses.fields(x):
+            u, v = getattr(x, field.name), getattr(y, field.name)
+            if field.name == "signals":
+                assert {k: (s.unit, s.source) for k, s in u.items()} == {k: (s.unit, s.source) for k, s in v.items()}
+            elif isinstance(u, np.ndarray):
+                np.testing.assert_array_equal(u, v)
+            else:
+                assert u == v, field.name

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from flightlogs.errors import DataError
-from flightlogs.writers.atomic import atomic_folder, atomic_output
+from flightlogs.writers.atomic import atomic_folder, atomic_output, folder_in_place
 
 
 def _mode(path: Path) -> int:
@@ -163,3 +163,39 @@ def test_an_interrupted_folder_leaves_nothing_and_the_old_folder_as_it_was(tmp_p
     assert [p.name for p in tmp_path.iterdir()] == (["campaign"] if existing else [])
     if existing:
         assert [p.name for p in target.iterdir()] == ["a.bin"] and (target / "a.bin").read_bytes() == b"old"
+
+
+def test_folder_in_place_keeps_the_old_files_it_did_not_rewrite(tmp_path: Path) -> None:
+    folder = tmp_path / "demo"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine")
+    (folder / "report.html").write_text("old")
+    (folder / "logs").mkdir()
+    (folder / "logs" / "a.ulg").write_text("old log")
+    with folder_in_place(folder) as inside:
+        assert inside == folder and list(folder.iterdir()) == []  # the block writes into the folder itself
+        (folder / "report.html").write_text("new")
+    assert {p.name: p.read_text() for p in folder.iterdir() if p.is_file()} == {
+        "notes.txt": "mine",
+        "report.html": "new",
+    }
+    assert (folder / "logs" / "a.ulg").read_text() == "old log"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["demo"]  # nothing set aside is left
+
+
+@pytest.mark.parametrize("error", [RuntimeError("failed"), KeyboardInterrupt()])
+def test_folder_in_place_puts_the_old_folder_back_when_the_block_fails(tmp_path: Path, error: BaseException) -> None:
+    folder = tmp_path / "demo"
+    folder.mkdir()
+    (folder / "report.html").write_text("old")
+    with pytest.raises(type(error)), folder_in_place(folder):
+        (folder / "report.html").write_text("half")
+        (folder / "dataset.h5").write_text("half")
+        raise error
+    assert {p.name: p.read_text() for p in folder.iterdir()} == {"report.html": "old"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["demo"]
+    new = tmp_path / "fresh"
+    with pytest.raises(RuntimeError), folder_in_place(new):
+        (new / "x").write_text("half")
+        raise RuntimeError
+    assert not new.exists()

@@ -128,10 +128,10 @@ def test_responses_round_trip_through_hdf5(tmp_path: Path) -> None:
     with h5py.File(target) as h5:
         assert h5.attrs["schema_version"] == freqresp_io.RESPONSES_SCHEMA_VERSION
         group = h5["responses"]["000"]
-        assert group["omega"].attrs["unit"] == "rad/s"
-        assert group["response"].attrs["unit"] == "(rad/s)/(%)"
-        assert group["input_autospectrum"].attrs["unit"] == "(%)^2/(rad/s)"
-        assert group.attrs["reference"] == "excitation" and "reference" not in h5["responses"]["001"].attrs
+        assert group["omega"].attrs["unit"] == b"rad/s"
+        assert group["response"].attrs["unit"] == b"(rad/s)/(%)"
+        assert group["input_autospectrum"].attrs["unit"] == b"(%)^2/(rad/s)"
+        assert group.attrs["reference"] == b"excitation" and "reference" not in h5["responses"]["001"].attrs
 
 
 def test_a_file_without_the_newer_attributes_reads_as_no_reference(tmp_path: Path) -> None:
