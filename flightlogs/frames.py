@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from typing import cast
-
 import numpy as np
+
+_CHUNK = 1 << 16  # samples rotated at a time
 
 __all__ = ["quaternion_to_euler", "earth_to_body", "air_velocity_body", "wind_to_body_axes"]
 
@@ -80,8 +80,13 @@ def earth_to_body(vectors_ned: np.ndarray, phi: np.ndarray, theta: np.ndarray, p
     vectors_ned = np.asarray(vectors_ned, dtype=np.float64)
     if vectors_ned.ndim != 2 or vectors_ned.shape[1] != 3:
         raise ValueError(f"vectors_ned must have shape (n_samples, 3), got {vectors_ned.shape}")
-    matrices = _earth_to_body_matrices(np.asarray(phi), np.asarray(theta), np.asarray(psi))
-    return cast(np.ndarray, np.einsum("nij,nj->ni", matrices, vectors_ned))
+    angles = [np.asarray(a) for a in (phi, theta, psi)]
+    out = np.empty_like(vectors_ned)
+    for lo in range(0, out.shape[0], _CHUNK):  # a block of (n, 3, 3) matrices at a time: 72 bytes a sample
+        part = slice(lo, lo + _CHUNK)
+        matrices = _earth_to_body_matrices(*(a[part] for a in angles))
+        np.einsum("nij,nj->ni", matrices, vectors_ned[part], out=out[part])
+    return out
 
 
 def air_velocity_body(

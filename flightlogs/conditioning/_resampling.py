@@ -11,7 +11,7 @@ from typing import cast
 import numpy as np
 
 from flightlogs._moving import fast_fft_length
-from flightlogs.conditioning._splines import hermite, pchip_slopes, spline_slopes
+from flightlogs.conditioning._splines import Located, SplineSystem, hermite, pchip_slopes
 from flightlogs.errors import DataError
 
 __all__: list[str] = []  # private to flightlogs.conditioning
@@ -62,19 +62,33 @@ def piece_bounds(t: np.ndarray, dt: float, max_gap_samples: float) -> list[tuple
     return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
 
 
-def lowpass(t: np.ndarray, v: np.ndarray, dt_src: float, target_rate_hz: float) -> tuple[np.ndarray, np.ndarray]:
-    """Anti-alias one contiguous piece (`v` shape (n,) or (n, k)): uniform grid at the source rate, then a zero-phase FIR."""
-    n_fine = max(int(round((t[-1] - t[0]) / dt_src)) + 1, 2)
-    grid = np.linspace(t[0], t[-1], n_fine)
-    if grid.size == t.size and np.allclose(grid, t, rtol=0.0, atol=TIME_TOL_S):
-        grid, values = t, v
-    else:
-        values = interpolate(t, v, grid, "spline")
-    fs = (n_fine - 1) / (grid[-1] - grid[0])
-    taps = kaiser_lowpass(fs, target_rate_hz)
-    half = taps.size // 2
-    pad = [(half, half)] + [(0, 0)] * (values.ndim - 1)
-    return grid, convolve_valid(np.pad(values, pad, mode="reflect", reflect_type="odd"), taps)
+class AntiAlias:
+    """The anti-alias low-pass of one contiguous piece, for any columns sampled at its times `t` (n,).
+
+    Each column is splined onto a uniform grid at the source rate (`grid`; the times themselves when
+    already uniform), then convolved with a zero-phase Kaiser FIR (:func:`kaiser_lowpass`), the ends
+    padded by odd reflection. The grid's spline system and the filter's spectrum are made once.
+    """
+
+    def __init__(self, t: np.ndarray, dt_src: float, target_rate_hz: float) -> None:
+        n_fine = max(int(round((t[-1] - t[0]) / dt_src)) + 1, 2)
+        grid = np.linspace(t[0], t[-1], n_fine)
+        same = grid.size == t.size and np.allclose(grid, t, rtol=0.0, atol=TIME_TOL_S)
+        self.grid = t if same else grid
+        self._to_grid = None if same else Interpolant(t, grid, "spline")
+        fs = (n_fine - 1) / (grid[-1] - grid[0])
+        self._taps = kaiser_lowpass(fs, target_rate_hz)
+        self._kernel = np.fft.rfft(
+            self._taps, fast_fft_length(n_fine + 2 * (self._taps.size // 2) + self._taps.size - 1)
+        )
+
+    def __call__(self, v: np.ndarray) -> np.ndarray:
+        """Column `v` (n,) low-passed, on :attr:`grid`: shape (grid.size,)."""
+        values = v if self._to_grid is None else self._to_grid(v)
+        half = self._taps.size // 2
+        return convolve_valid(
+            np.pad(values, (half, half), mode="reflect", reflect_type="odd"), self._taps, self._kernel
+        )
 
 
 def kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
@@ -95,38 +109,55 @@ def kaiser_lowpass(fs_hz: float, target_rate_hz: float) -> np.ndarray:
     return cast(np.ndarray, taps / taps.sum())  # unit gain at DC
 
 
-def convolve_valid(x: np.ndarray, taps: np.ndarray) -> np.ndarray:
+def convolve_valid(x: np.ndarray, taps: np.ndarray, kernel: np.ndarray | None = None) -> np.ndarray:
     """``x`` (shape (n,) or (n, k)) convolved with ``taps`` along axis 0, the fully overlapped part: (n - len + 1, ...).
 
     By FFT, as ``scipy.signal.fftconvolve(x, taps, mode="valid")`` (to rounding) without importing SciPy.
+    `kernel`, when given, is ``rfft(taps, fast_fft_length(n + len - 1))`` made beforehand.
     """
     n, m = x.shape[0], taps.size
     size = fast_fft_length(n + m - 1)
-    kernel = np.fft.rfft(taps, size).reshape((-1,) + (1,) * (x.ndim - 1))
+    kernel = np.fft.rfft(taps, size) if kernel is None else kernel
+    kernel = kernel.reshape((-1,) + (1,) * (x.ndim - 1))
     full = np.fft.irfft(np.fft.rfft(x, size, axis=0) * kernel, size, axis=0)
     return cast(np.ndarray, full[m - 1 : n])
 
 
-def interpolate(t: np.ndarray, v: np.ndarray, at: np.ndarray, method: str, out: np.ndarray | None = None) -> np.ndarray:
-    """Evaluate the chosen interpolant through (t, v) at times `at` inside [t[0], t[-1]]; `v` (n,) or (n, k).
+class Interpolant:
+    """One interpolant on knots `t` (n,) evaluated at points `at` (m,) inside [t[0], t[-1]], for any columns.
 
-    Into `out` (shaped as the result) when given.
+    The columns of one log message share their times: the spline's system is factored and the points
+    located once, and each column is then solved and evaluated alone (no (n, k) working arrays).
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Strictly increasing knots, s.
+    at : ndarray, shape (m,)
+        Where to evaluate, s.
+    method : {"spline", "pchip", "linear"}
+        Not-a-knot cubic spline, shape-preserving PCHIP, or straight lines (also for fewer than 3 knots).
     """
-    if method == "linear" or t.size < 3:
-        if v.ndim == 1:
-            result = np.interp(at, t, v)
-        else:
-            result = np.column_stack([np.interp(at, t, column) for column in v.T])
-        if out is None:
-            return cast(np.ndarray, result)
-        out[...] = result
-        return out
-    if method in ("spline", "pchip"):
-        columns = v if v.ndim == 2 else v[:, None]
-        slopes = spline_slopes(t, columns) if method == "spline" else pchip_slopes(t, columns)
-        values = hermite(t, columns, slopes, at, None if out is None else out if out.ndim == 2 else out[:, None])
-        return values if v.ndim == 2 else values[:, 0]
-    raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
+
+    def __init__(self, t: np.ndarray, at: np.ndarray, method: str) -> None:
+        if method not in ("spline", "pchip", "linear"):
+            raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
+        self.t, self.at = t, at
+        self._linear = method == "linear" or t.size < 3
+        self._system = SplineSystem(t) if method == "spline" and not self._linear else None
+        self._where = None if self._linear else Located(t, at)
+
+    def __call__(self, v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """Column `v` (n,) at the points: shape (m,), written into `out` when given."""
+        if self._where is None:
+            result = np.interp(self.at, self.t, v)
+            if out is None:
+                return cast(np.ndarray, result)
+            out[...] = result
+            return out
+        column = v[:, None]
+        slopes = self._system.slopes(column) if self._system is not None else pchip_slopes(self.t, column)
+        return hermite(self.t, column, slopes, self._where, None if out is None else out[:, None])[:, 0]
 
 
 def complement(pieces: list[tuple[float, float]], lo: float, hi: float) -> list[tuple[float, float]]:

@@ -25,12 +25,12 @@ import numpy as np
 from flightlogs._arrays import ByContents
 from flightlogs.conditioning._resampling import (
     TIME_TOL_S,
+    AntiAlias,
+    Interpolant,
     check_time_base,
     check_times,
     complement,
-    interpolate,
     intersect,
-    lowpass,
     nominal_interval,
     piece_bounds,
     snap,
@@ -312,7 +312,7 @@ def resample_signal(
     name, t, v = _as_series(signal)
     if outside not in ("nan", "raise"):
         raise DataError(f"{outside=} must be 'nan' or 'raise'")
-    out = _resample_columns(t, v[:, None], time_base, method, max_gap_samples, anti_alias)[:, 0]
+    out = _resample_columns(t, [v], time_base, method, max_gap_samples, anti_alias)[:, 0]
     if outside == "raise" and np.isnan(out).any():
         first = float(time_base[np.isnan(out)][0])
         raise DataError(
@@ -323,30 +323,39 @@ def resample_signal(
 
 
 def _resample_columns(
-    t: np.ndarray, v: np.ndarray, time_base: np.ndarray, method: str, max_gap_samples: float, anti_alias: bool
+    t: np.ndarray,
+    columns: list[np.ndarray],
+    time_base: np.ndarray,
+    method: str,
+    max_gap_samples: float,
+    anti_alias: bool,
 ) -> np.ndarray:
-    """Columns sampled at the same times `t` (s, shape (n,)), `v` shape (n, k), onto `time_base`: shape (n_base, k).
+    """Columns sampled at the same times `t` (s, shape (n,)), each (n,), onto `time_base`: shape (n_base, k).
 
-    One spline (or filter) for all columns: signals of one message share their times.
+    One spline system (or filter) per piece for all columns, each column then solved on its own:
+    signals of one message share their times.
     """
     tb, dt_target = check_time_base(time_base)
     if method not in ("spline", "pchip", "linear"):
         raise DataError(f"{method=} must be 'spline', 'pchip' or 'linear'")
     dt_src = nominal_interval(t)
-    out = np.full((v.shape[1], tb.size), np.nan).T  # (n_base, k), each column contiguous: the signals to come
+    out = np.full((len(columns), tb.size), np.nan).T  # (n_base, k), each column contiguous: the signals to come
     filter_needed = anti_alias and dt_target > _DOWNSAMPLE_MARGIN * dt_src
     for i0, i1 in piece_bounds(t, dt_src, max_gap_samples):
-        pt, pv = t[i0:i1], v[i0:i1]
+        pt = t[i0:i1]
         first = int(np.searchsorted(tb, pt[0] - TIME_TOL_S, side="left"))  # the base's samples inside the piece
         stop = int(np.searchsorted(tb, pt[-1] + TIME_TOL_S, side="right"))
         if stop <= first:
             continue
         if pt.size == 1:
-            out[first:stop] = pv[0]
+            out[first:stop] = [column[i0] for column in columns]
             continue
-        if filter_needed:
-            pt, pv = lowpass(pt, pv, dt_src, 1.0 / dt_target)
-        interpolate(pt, pv, np.clip(tb[first:stop], pt[0], pt[-1]), method, out[first:stop])
+        low = AntiAlias(pt, dt_src, 1.0 / dt_target) if filter_needed else None
+        knots = pt if low is None else low.grid
+        at = Interpolant(knots, np.clip(tb[first:stop], knots[0], knots[-1]), method)
+        for k, column in enumerate(columns):
+            piece = column[i0:i1]
+            at(piece if low is None else low(piece), out[first:stop, k])
     return out
 
 
@@ -399,8 +408,7 @@ def resample_signals(
         members.append((name, v))
     out: dict[str, np.ndarray] = {}
     for kind, t, members in shared:
-        columns = np.column_stack([v for _, v in members])
-        values = _resample_columns(t, columns, time_base, kind, max_gap_samples, anti_alias)
+        values = _resample_columns(t, [v for _, v in members], time_base, kind, max_gap_samples, anti_alias)
         out |= {name: values[:, k] for k, (name, _) in enumerate(members)}
     return {name: out[name] for name in signals}
 

@@ -205,8 +205,9 @@ class DataFlashMessages:
             return {}
         column = self.instance_field(name)
         if column is not None:
-            values = self.tables[name][column]
-            return {int(i): self.tables[name].select(values == i) for i in np.unique(values)}
+            whole = self.tables[name]
+            values = whole.columns.peek(column) if isinstance(whole.columns, _LazyColumns) else whole[column]
+            return {int(i): whole.select(values == i) for i in np.unique(values)}
         found = {0: self.tables[name]}
         for k in range(2, 10):
             table = self.get(f"{name}{k}")
@@ -439,7 +440,9 @@ class _LazyColumns(Mapping[str, np.ndarray]):
         if column is None:
             held = self._held
             if held.owner is not self:
-                held.owner, held.messages = None, np.empty(0)  # the previous table's copy goes before this one is made
+                if held.owner is not None:  # the previous table's copy and columns go before this one's are made
+                    held.owner._decoded.clear()
+                held.owner, held.messages = None, np.empty(0)
                 held.messages = (
                     gather(self._buf, self._offsets, self._fmt.length, self._release).view(self._dtype).ravel()
                 )
@@ -452,6 +455,26 @@ class _LazyColumns(Mapping[str, np.ndarray]):
 
     def __contains__(self, name: object) -> bool:  # Mapping's would decode the column to answer
         return name in self._field
+
+    def peek(self, name: str) -> np.ndarray:
+        """Column `name` decoded from its own bytes only, without copying the messages (nor keeping it).
+
+        For a column read alone, such as the instance number that splits a table: the messages'
+        copy (the whole table) is then made only for the parts, one at a time.
+        """
+        column = self._decoded.get(name)
+        if column is not None:
+            return column
+        i = self._field[name]
+        fields = self._dtype.fields
+        assert fields is not None  # a structured dtype (layout)
+        field = fields[f"f{i}"]
+        if field[0].subdtype is not None:  # an array field (``a``): through the messages' copy
+            return self[name]
+        raw = gather(self._buf[field[1] :], self._offsets, field[0].itemsize, self._release)
+        column = _column(raw.view(field[0]).ravel(), self._chars[i], self._fmt.name)
+        column.flags.writeable = False
+        return column
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._field)

@@ -47,6 +47,7 @@ __all__ = [
     "PX4_GROUPS",
     "PX4_MOTOR_SOURCES",
     "GPS_TOPICS",
+    "MAPPED_TOPICS",
     "MAV_TYPE_NAMES",
     "MAV_TYPE_ROTORS",
     "AUTOSTART_ROTORS",
@@ -339,6 +340,14 @@ PX4_GROUPS: tuple[SignalGroup, ...] = (
 PX4_MOTOR_SOURCES: tuple[MotorSource, ...] = (
     MotorSource(topic="actuator_motors", field_pattern="control[{i}]", unit="normalised", count_from="channels"),
     MotorSource(topic="actuator_outputs", field_pattern="output[{i}]", unit="PWM us", count_from="airframe"),
+)
+
+#: Every topic a canonical signal, a motor command or the UTC offset is read from: the only topics
+#: pyulog is asked to keep (a log's other topics are walked past, not stored).
+MAPPED_TOPICS: frozenset[str] = frozenset(
+    [source.topic for group in PX4_GROUPS for source in group.sources]
+    + [source.topic for source in PX4_MOTOR_SOURCES]
+    + list(GPS_TOPICS)
 )
 
 #: MAVLink ``MAV_TYPE`` values seen on multirotors and their names.

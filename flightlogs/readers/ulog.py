@@ -29,6 +29,7 @@ from flightlogs.frames import quaternion_to_euler
 from flightlogs.readers._series import make_signal
 from flightlogs.readers.px4_topics import (
     GPS_TOPICS,
+    MAPPED_TOPICS,
     PX4_GROUPS,
     PX4_MOTOR_SOURCES,
     MotorSource,
@@ -44,6 +45,10 @@ _ULOG_MAGIC = b"ULog\x01\x12\x35"
 _HEADER_BYTES = 16
 _MAX_PAYLOAD = 65535  # a ULog message payload is at most this long (16-bit size)
 _WHOLE_FILE_LIMIT = 1 << 28  # files up to 256 MB are read into memory when their messages chain cleanly
+#: Files up to this size have every topic read (pyulog then also checks the messages of the topics no signal
+#: comes from, and their damage is reported); larger ones only the topics of
+#: :data:`~flightlogs.readers.px4_topics.MAPPED_TOPICS`: a 1 GB log's other topics are not held in memory.
+_EVERY_TOPIC_UP_TO = _WHOLE_FILE_LIMIT
 _MESSAGE_TYPES = frozenset(
     getattr(ULog, name) for name in dir(ULog) if name.startswith("MSG_TYPE_") and isinstance(getattr(ULog, name), int)
 )
@@ -107,7 +112,9 @@ def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], No
     dropped and counted in a warning; a signal with fewer than two samples
     left is reported missing. ``utc_offset_s`` is the median of
     ``time_utc_usec - timestamp`` over GPS samples with a time set
-    (after 2000-01-01).
+    (after 2000-01-01). A file over 256 MB has only the topics signals come
+    from read (:data:`~flightlogs.readers.px4_topics.MAPPED_TOPICS`): damage
+    in its other topics goes unreported, as they are not read.
 
     Examples
     --------
@@ -122,11 +129,13 @@ def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], No
     if progress is not None:
         progress(0, size)
     with collected_warnings() as caught:
-        ulog = _parse(path, size, progress)
-        datasets: _Datasets = {}
-        for dataset in ulog.data_list:
-            if "timestamp" in dataset.data:  # a damaged format may have lost it
-                datasets.setdefault(dataset.name, {})[dataset.multi_id] = dataset.data
+        large = size > _EVERY_TOPIC_UP_TO
+        ulog = _parse(path, size, progress, MAPPED_TOPICS if large else None)
+        datasets = _datasets(ulog)
+        if large and not datasets:  # none of the mapped topics: every topic, to tell a log of others from an empty one
+            caught.discard()
+            ulog = _parse(path, size, None, None)
+            datasets = _datasets(ulog)
         if not datasets:
             detail = f" ({caught.messages[0]})" if caught.messages else ""
             caught.discard()  # the error names the damage
@@ -154,6 +163,15 @@ def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], No
     if progress is not None:
         progress(size, size)
     return log
+
+
+def _datasets(ulog: ULog) -> _Datasets:
+    """The data pyulog read, by topic and instance (a topic whose damaged format lost its timestamp left out)."""
+    datasets: _Datasets = {}
+    for dataset in ulog.data_list:
+        if "timestamp" in dataset.data:
+            datasets.setdefault(dataset.name, {})[dataset.multi_id] = dataset.data
+    return datasets
 
 
 def _check_header(path: Path) -> int:
@@ -296,11 +314,12 @@ def _zero_tail(stream: Any, size: int) -> int:
 class _PlainULog(ULog):  # type: ignore[misc]
     """pyulog's reader as it is, with the damage counters of :class:`_CountingULog` at zero (a clean file)."""
 
-    def __init__(self, log_file: _TrackedFile | _WholeFile) -> None:
+    def __init__(self, log_file: _TrackedFile | _WholeFile, topics: frozenset[str] | None) -> None:
         self.skipped: dict[str | int, int] = {}  # topic name (wrong size) or unknown msg id
         self.skipped_bytes = 0
         self.resyncs = 0
-        super().__init__(log_file, disable_str_exceptions=True)
+        kept = None if topics is None else sorted(topics)
+        super().__init__(log_file, message_name_filter_list=kept, disable_str_exceptions=True)
 
 
 class _CountingULog(_PlainULog):
@@ -316,9 +335,9 @@ class _CountingULog(_PlainULog):
                 ulog_object.skipped[key] = ulog_object.skipped.get(key, 0) + 1
             return corrupt
 
-    def __init__(self, log_file: _TrackedFile | _WholeFile) -> None:
+    def __init__(self, log_file: _TrackedFile | _WholeFile, topics: frozenset[str] | None) -> None:
         self._last_skip = -1
-        super().__init__(log_file)
+        super().__init__(log_file, topics)
 
     def _find_sync(self, last_n_bytes: int = -1) -> bool:
         start = self._file_handle.tell()
@@ -342,8 +361,11 @@ class _CountingULog(_PlainULog):
         return corrupt
 
 
-def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None) -> ULog:
+def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None, topics: frozenset[str] | None) -> ULog:
     """Run pyulog with its prints and warnings captured as our warnings; turn its errors into LogFormatError.
+
+    pyulog keeps the data of `topics` only (every topic with None): on a log of many topics the
+    others' bytes are walked past instead of being copied, parsed and held.
 
     A file whose messages chain cleanly is parsed in memory by pyulog as it is;
     one that pyulog then finds corrupt, or whose chain is not clean, is parsed
@@ -352,25 +374,25 @@ def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None) -
     whole = _whole_if_clean(path, size, progress)
     if whole is not None:
         try:
-            ulog, tracked, said = _run_pyulog(path, _PlainULog, whole)
+            ulog, tracked, said = _run_pyulog(path, _PlainULog, whole, topics)
         except LogFormatError:
             pass  # the tracked reader says where the damage lies
         else:
             if not ulog.file_corruption:
                 return _reported(ulog, tracked, said, size, path)
     tracked = _TrackedFile(path, size, progress)
-    return _reported(*_run_pyulog(path, _CountingULog, tracked), size, path)
+    return _reported(*_run_pyulog(path, _CountingULog, tracked, topics), size, path)
 
 
 def _run_pyulog(
-    path: Path, kind: type[_PlainULog], source: _TrackedFile | _WholeFile
+    path: Path, kind: type[_PlainULog], source: _TrackedFile | _WholeFile, topics: frozenset[str] | None
 ) -> tuple[_PlainULog, _TrackedFile | _WholeFile, list[str]]:
     """pyulog's parse of `source`, and what it printed or warned."""
     printed = io.StringIO()
     try:
         with contextlib.redirect_stdout(printed), _warnings.catch_warnings(record=True) as caught:
             _warnings.simplefilter("always")
-            ulog = kind(source)
+            ulog = kind(source, topics)
     except ULogIncompatibleFlagException as err:
         raise LogFormatError(f"{path}: uses a ULog extension pyulog cannot read ({err}).") from err
     except _PYULOG_ERRORS as err:

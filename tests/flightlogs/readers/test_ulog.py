@@ -620,3 +620,41 @@ def test_a_clean_file_read_in_memory_equals_the_tracked_read(
     for signal_name, signal in tracked.signals.items():
         np.testing.assert_array_equal(fast.signals[signal_name].time_s, signal.time_s)
         np.testing.assert_array_equal(fast.signals[signal_name].values, signal.values)
+
+
+@pytest.mark.parametrize("name", [QUAD, "kd0aij-impulse-response/log1.ulg"])
+def test_reading_the_mapped_topics_only_gives_the_same_log(
+    real_data: Path, name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """What a log over 256 MB gets (pyulog keeps only the topics signals come from), on real logs: the same
+    signals, bit for bit, parameters, vehicle and UTC offset."""
+    import flightlogs.readers.ulog as ulog_module
+
+    every = _read(real_data / name)
+    monkeypatch.setattr(ulog_module, "_EVERY_TOPIC_UP_TO", 0)
+    mapped = _read(real_data / name)
+    assert mapped.signals.keys() == every.signals.keys() and len(every.signals) > 10
+    for key, signal in every.signals.items():
+        np.testing.assert_array_equal(mapped[key].time_s, signal.time_s)
+        np.testing.assert_array_equal(mapped[key].values, signal.values)
+        assert (mapped[key].unit, mapped[key].source) == (signal.unit, signal.source)
+    assert (mapped.parameters, mapped.vehicle, mapped.utc_offset_s) == (
+        every.parameters,
+        every.vehicle,
+        every.utc_offset_s,
+    )
+
+
+def test_a_large_log_of_other_topics_only_is_read_whole_to_say_so(
+    real_data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """No mapped topic in a large log: every topic is read again, so that a log of other topics is not called
+    empty (the error a file with no data message gets)."""
+    import flightlogs.readers.ulog as ulog_module
+    from flightlogs.readers import px4_topics
+
+    monkeypatch.setattr(ulog_module, "_EVERY_TOPIC_UP_TO", 0)
+    monkeypatch.setattr(ulog_module, "MAPPED_TOPICS", frozenset({"no_such_topic"}))
+    log = _read(real_data / QUAD)
+    assert log.signals  # read on the second pass, with every topic
+    assert px4_topics.MAPPED_TOPICS >= {"vehicle_angular_velocity", "actuator_outputs", "sensor_gps"}
