@@ -52,29 +52,6 @@ _COMMANDS = {
 }
 
 
-_M_MMAP_THRESHOLD = -3  # glibc's mallopt parameter (malloc.h)
-_MMAP_THRESHOLD = 1 << 20  # bytes
-
-
-def _large_blocks_to_the_system() -> None:
-    """Have glibc map every allocation of 1 MiB or more on its own, so that it returns to the system when freed.
-
-    By default glibc raises this threshold each time such a block is freed, up to 32 MiB: after the
-    first large arrays, the next ones come from the heap and stay with the process when freed. On
-    the 113 MB DataFlash log that held about 30 MB more at the peak of ``sysid ingest`` (and 120 MB
-    on a 2-hour log); see benchmarks/README.md. Nothing on other C libraries.
-    """
-    if not sys.platform.startswith("linux"):
-        return
-    import ctypes
-
-    try:
-        mallopt = ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):  # not glibc
-        return
-    mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD)
-
-
 class _SysidGroup(click.Group):
     """Turn project errors into one sentence and exit code 1 (traceback only with --debug).
 
@@ -98,7 +75,6 @@ class _SysidGroup(click.Group):
         return super().get_command(ctx, cmd_name)
 
     def invoke(self, ctx: click.Context) -> object:
-        _large_blocks_to_the_system()
         previous = signal.signal(signal.SIGTERM, _terminate)
         try:
             with warnings_printed_once(ctx.meta):
