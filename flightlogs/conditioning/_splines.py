@@ -123,16 +123,24 @@ def pchip_slopes(t: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 class Located:
-    """Points `at` (m,) located among knots `t` (n,): the piece of each and its position in it, for any columns.
+    """Points `at` (m,) located among knots `t` (n,): the piece of each, for any columns of the same knots.
 
-    Points outside [t[0], t[-1]] extend the end pieces.
+    Points outside [t[0], t[-1]] extend the end pieces. Only the pieces are kept (the search is the
+    costly part; int32 below 2**31 knots): each piece's width and the point's place in it are worked
+    out a chunk at a time when evaluated.
     """
 
     def __init__(self, t: np.ndarray, at: np.ndarray) -> None:
-        self.size = at.size
-        self.piece = np.clip(np.searchsorted(t, at, side="right") - 1, 0, t.size - 2)
-        self.width = t[self.piece + 1] - t[self.piece]
-        self.fraction = (at - t[self.piece]) / self.width
+        self.t, self.at, self.size = t, at, at.size
+        index = np.int32 if t.size < 2**31 else np.int64
+        self.piece = np.clip(np.searchsorted(t, at, side="right") - 1, 0, t.size - 2).astype(index)
+
+    def part(self, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Points ``lo:hi``: their pieces (m,), the pieces' widths (m, 1), s, and the places in them (m, 1), 0-1."""
+        j = self.piece[lo:hi]
+        start = self.t[j]
+        width = (self.t[j + 1] - start)[:, None]
+        return j, width, (self.at[lo:hi] - start)[:, None] / width
 
 
 def hermite(
@@ -150,8 +158,7 @@ def hermite(
     where = at if isinstance(at, Located) else Located(t, at)
     out = np.empty((where.size, v.shape[1])) if out is None else out
     for lo in range(0, where.size, _CHUNK):
-        part = slice(lo, lo + _CHUNK)
-        _hermite_into(v, slopes, where.piece[part], where.width[part, None], where.fraction[part, None], out[part])
+        _hermite_into(v, slopes, *where.part(lo, lo + _CHUNK), out[lo : lo + _CHUNK])
     return out
 
 
@@ -188,7 +195,7 @@ class _Level:
     odd_sub: np.ndarray  # (n_odd,): the odd rows' coefficients
     odd_diag: np.ndarray
     odd_sup: np.ndarray
-    has_next: np.ndarray  # (n_odd,) bool: odd rows followed by an even one
+    with_next: int  # the odd rows followed by an even one: the first n_odd, or n_odd - 1 when n is even
     base: tuple[np.ndarray, np.ndarray, np.ndarray] | None  # the rows themselves when n <= 2 (solved directly)
 
 
@@ -204,7 +211,7 @@ def _factor(sub: np.ndarray, diag: np.ndarray, sup: np.ndarray) -> list[_Level]:
         n = diag.size
         empty = np.empty(0)
         if n <= 2:
-            levels.append(_Level(n, empty, empty, empty, empty, empty, np.empty(0, bool), (sub, diag, sup)))
+            levels.append(_Level(n, empty, empty, empty, empty, empty, 0, (sub, diag, sup)))
             return levels
         even = slice(0, None, 2)
         n_odd = n // 2
@@ -220,9 +227,9 @@ def _factor(sub: np.ndarray, diag: np.ndarray, sup: np.ndarray) -> list[_Level]:
         new_sub[1:] = below[1:] * sub[1::2][: n_even - 1]
         new_diag[:n_odd] += above[:n_odd] * sub[1::2]
         new_sup[: n_odd - (n % 2 == 0)] = (above[:n_odd] * sup[1::2])[: n_odd - (n % 2 == 0)]
-        has_next = np.arange(1, n, 2) + 1 < n
+        with_next = n_odd - (n % 2 == 0)
         odd_sub, odd_diag, odd_sup = (row[1::2].copy() for row in (sub, diag, sup))  # views would keep the rows
-        levels.append(_Level(n, below, above, odd_sub, odd_diag, odd_sup, has_next, None))
+        levels.append(_Level(n, below, above, odd_sub, odd_diag, odd_sup, with_next, None))
         sub, diag, sup = new_sub, new_diag, new_sup
 
 
@@ -245,6 +252,6 @@ def _solve(levels: list[_Level], rhs: np.ndarray) -> np.ndarray:
     x[0::2] = _solve(rest, new_rhs)
     del new_rhs
     odd_rhs = rhs[1::2] - level.odd_sub[:, None] * x[0:-1:2][:n_odd]
-    odd_rhs[level.has_next] -= level.odd_sup[level.has_next, None] * x[2::2]
+    odd_rhs[: level.with_next] -= level.odd_sup[: level.with_next, None] * x[2::2]
     x[1::2] = odd_rhs / level.odd_diag[:, None]
     return x

@@ -5,7 +5,8 @@ traceback instead of an error naming the file) and is replayed here: DataFlash l
 lacks a field the reader maps (PARM without Value, MULT without Id, XKF1 without VE) or types a
 number as text (FMTU's FmtType, PARM's TimeUS) (found by the fuzzer in mutated prefixes of the real logs, rebuilt small with
 our writer, so no real log is copied here), an anemometer file of one delimiter, and damaged
-datasets (h5py's KeyError, a JSON attribute cut; gzip-compressed). The slice runs each target's
+datasets (h5py's KeyError, a JSON attribute cut, a version-1 dataset whose damaged global heap hung
+libhdf5, a segment whose kind is damaged to ""; gzip-compressed). The slice runs each target's
 atheris fuzzer for a few hundred inputs from a fixed seed (libFuzzer's ``-seed``), so a reader that
 breaks on the first mutations of its seeds fails the suite; the long run is ``tests/fuzz/run.py``
 (documented in ``benchmarks/README.md``).
