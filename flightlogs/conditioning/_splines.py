@@ -75,24 +75,6 @@ class SplineSystem:
         return _solve(self._levels, rhs)
 
 
-def spline_slopes(t: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Slopes of the not-a-knot cubic spline through (t, v) at the knots: ``CubicSpline(t, v).derivative()(t)``.
-
-    Parameters
-    ----------
-    t : ndarray, shape (n,)
-        Strictly increasing knots, s; n >= 3.
-    v : ndarray, shape (n, k)
-        Values at the knots.
-
-    Returns
-    -------
-    ndarray, shape (n, k)
-        d v / d t at the knots, in the unit of `v` per s.
-    """
-    return SplineSystem(t).slopes(v)
-
-
 def pchip_slopes(t: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Slopes of the shape-preserving PCHIP interpolant at the knots, as ``scipy.interpolate.PchipInterpolator``.
 

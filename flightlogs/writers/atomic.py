@@ -103,12 +103,7 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     >>> sorted(p.name for p in target.iterdir())
     ['a.txt']
     """
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise DataError(f"{path}: is a file, not a folder to write into")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise DataError(f"{parent}: the output folder's parent does not exist")
+    path, parent = _output_folder(path)
     tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".part", dir=parent))
     os.chmod(tmp, 0o777 & ~_umask())  # as a folder made by mkdir (mkdtemp's is private)
     try:
@@ -156,12 +151,7 @@ def folder_in_place(path: str | Path) -> Iterator[Path]:
     >>> sorted(p.name for p in target.iterdir())
     ['notes.txt', 'report.html']
     """
-    path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise DataError(f"{path}: is a file, not a folder to write into")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise DataError(f"{parent}: the output folder's parent does not exist")
+    path, parent = _output_folder(path)
     aside = None
     if path.exists():
         aside = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".old", dir=parent))
@@ -182,6 +172,17 @@ def folder_in_place(path: str | Path) -> Iterator[Path]:
     finally:
         if aside is not None:
             shutil.rmtree(aside, ignore_errors=True)
+
+
+def _output_folder(path: str | Path) -> tuple[Path, Path]:
+    """`path` as an output folder and its parent; DataError if it is a file or its parent is missing."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise DataError(f"{path}: is a file, not a folder to write into")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise DataError(f"{parent}: the output folder's parent does not exist")
+    return path, parent
 
 
 @contextlib.contextmanager
