@@ -165,7 +165,8 @@ def open_schema(
     LogFormatError
         If the file is not HDF5, holds another schema, or is of a newer version.
     """
-    _check_global_heaps(path)
+    if not _checksummed(path):
+        _check_global_heaps(path)
     try:
         h5 = h5py.File(path, "r")
     except (OSError, ValueError) as err:
@@ -188,6 +189,23 @@ def open_schema(
             raise LogFormatError(f"{path}: the {what} is damaged ({err}).") from err
         except _DAMAGED as err:  # what h5py raises on a damaged file, and a missing or mistyped member
             raise LogFormatError(f"{path}: the {what} is damaged or incomplete ({type(err).__name__}: {err}).") from err
+
+
+_SIGNATURE = b"\x89HDF\r\n\x1a\n"  # an HDF5 file's first 8 bytes (without a user block), then the superblock version
+
+
+def _checksummed(path: Path) -> bool:
+    """Whether `path` starts with a superblock of version 2 or later: the format this package writes (1.10's).
+
+    Such a file's structure is checksummed, and what this package wrote in it holds no global heap; only
+    older files (version-1 datasets: superblock 0) have their heaps walked, a scan of the whole file.
+    """
+    try:
+        with path.open("rb") as stream:
+            head = stream.read(len(_SIGNATURE) + 1)
+    except OSError:  # h5py's open says so
+        return True
+    return len(head) > len(_SIGNATURE) and head.startswith(_SIGNATURE) and head[-1] >= 2
 
 
 #: A global heap collection's header: signature, version 1, three reserved bytes (HDF5 spec, III.E).
