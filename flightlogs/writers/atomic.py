@@ -126,10 +126,11 @@ def folder_in_place(path: str | Path) -> Iterator[Path]:
     """Yield `path` itself, emptied, to write into; whatever it held comes back if the block fails.
 
     For outputs that record their own paths (a dataset names its logs, a report its files), so
-    cannot be written under a temporary name as in :func:`atomic_folder`. What `path` held is set
-    aside beside it first; if the block raises (an error, Ctrl-C, SIGTERM), what was written is
-    removed and the old contents are put back; on success, the old files the block did not write
-    again are put back beside the new ones.
+    cannot be written under a temporary name as in :func:`atomic_folder`. The folder's entries are
+    set aside in a folder beside it first (the folder itself stays, so ``.`` works); if the block
+    raises (an error, Ctrl-C, SIGTERM), what was written is removed and the old entries are put back
+    (a folder created for the block is removed); on success, the old entries the block did not
+    write again are put back beside the new ones.
 
     Parameters
     ----------
@@ -151,27 +152,32 @@ def folder_in_place(path: str | Path) -> Iterator[Path]:
     >>> sorted(p.name for p in target.iterdir())
     ['notes.txt', 'report.html']
     """
-    path, parent = _output_folder(path)
-    aside = None
-    if path.exists():
-        aside = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".old", dir=parent))
-        os.replace(path, aside / path.name)
+    path, _ = _output_folder(path)
+    created = not path.exists()
+    path.mkdir(exist_ok=True)
+    # beside the folder (inside it for the root folder), never in its place: "." and the like stay where they are
+    aside = Path(tempfile.mkdtemp(prefix=f".{path.resolve().name}.", suffix=".old", dir=path.resolve().parent))
+    for entry in [e for e in path.iterdir() if e.resolve() != aside]:
+        os.replace(entry, aside / entry.name)
     try:
-        path.mkdir()
         yield path
     except BaseException:
-        shutil.rmtree(path, ignore_errors=True)
-        if aside is not None:
-            os.replace(aside / path.name, path)
+        for entry in [e for e in path.iterdir() if e.resolve() != aside]:
+            if entry.is_dir() and not entry.is_symlink():
+                shutil.rmtree(entry)
+            else:
+                entry.unlink()
+        for entry in aside.iterdir():
+            os.replace(entry, path / entry.name)
+        if created:
+            path.rmdir()
         raise
     else:
-        if aside is not None:
-            for entry in sorted((aside / path.name).iterdir()):
-                if not (path / entry.name).exists():
-                    os.replace(entry, path / entry.name)
+        for entry in aside.iterdir():
+            if not (path / entry.name).exists():
+                os.replace(entry, path / entry.name)
     finally:
-        if aside is not None:
-            shutil.rmtree(aside, ignore_errors=True)
+        shutil.rmtree(aside, ignore_errors=True)
 
 
 def _output_folder(path: str | Path) -> tuple[Path, Path]:

@@ -199,3 +199,16 @@ def test_folder_in_place_puts_the_old_folder_back_when_the_block_fails(tmp_path:
         (new / "x").write_text("half")
         raise RuntimeError
     assert not new.exists()
+
+
+def test_folder_in_place_works_on_the_current_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``sysid demo -o .``: the folder the user stands in is not moved; its entries are set aside and put back."""
+    (tmp_path / "notes.txt").write_text("mine")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(RuntimeError), folder_in_place(Path(".")):
+        Path("report.html").write_text("half")
+        raise RuntimeError
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+    with folder_in_place(Path(".")):
+        Path("report.html").write_text("new")
+    assert {p.name: p.read_text() for p in tmp_path.iterdir()} == {"notes.txt": "mine", "report.html": "new"}
