@@ -122,7 +122,7 @@ def main(argv: list[str] | None = None) -> int:
             f"{'peak MB':>8s} {'xfile':>6s} identical"
         )
         for path in files:
-            size_mb = path.stat().st_size / 1e6
+            size_mb = path.stat().st_size / 2**20  # MiB, as the peak (kB / 1024)
             if path.suffix.lower() == ".ulg":
                 baseline, same = pyulog_seconds(path, args.repeat), "-"
             else:

@@ -26,6 +26,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from flightlogs._memory import give_back_freed_memory
 from flightlogs._moving import erode
 from flightlogs.conditioning.align import WindAlignment, estimate_residual_offset, wind_log_time
 from flightlogs.conditioning.lag import TransportDelay, transport_delay
@@ -248,6 +249,7 @@ def _one_pass(log: FlightLog, wind: Any | None, options: ConditioningOptions) ->
             )
             warnings.warn(DataQualityWarning(message), stacklevel=2)
     _derived(values, units, wind_given=bool(wind_signals))
+    give_back_freed_memory()  # the resampler's working arrays: segmentation's are larger
     segments = _segments(log, time_base, values, options)
     records = tuple(
         _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}")

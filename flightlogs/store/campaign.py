@@ -7,6 +7,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from flightlogs._memory import give_back_freed_memory
 from flightlogs.conditioning.align import pair_winds
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions, condition_flight
 from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
@@ -148,6 +149,7 @@ def ingest_campaign(
     for log, wind in zip(logs, paired):
         try:
             conditioned.append(condition_flight(log, wind, options))
+            give_back_freed_memory()  # segmentation's working arrays, before the next log or the writing
             notes.append(())
         except DataError as err:
             if wind is not None:

@@ -102,6 +102,21 @@ def test_gathering_a_block_at_a_time_with_release_copies_the_same_bytes() -> Non
     assert all(a[1] == b[0] for a, b in zip(released, released[1:])) and len(released) > 1
 
 
+def test_a_table_sparse_in_the_file_gives_its_pages_back_every_few_megabytes() -> None:
+    """A message every 64 kB: the kernel maps the pages around each one read, so a block of messages
+    counted (65 536 of them) would hold the whole file; the span of bytes read ends a block too."""
+    from flightlogs.readers._dataflash_frame import _GATHER_SPAN, gather
+
+    buf = np.zeros(96 << 20, np.uint8)
+    offsets = np.arange(0, buf.size - 40, 1 << 16, dtype=np.int64)  # 1536 messages, far fewer than a block
+    buf[offsets] = np.arange(offsets.size) % 251
+    released: list[tuple[int, int]] = []
+    blocks = gather(buf, offsets, 40, lambda lo, hi: released.append((lo, hi)))
+    np.testing.assert_array_equal(blocks[:, 0], np.arange(offsets.size) % 251)
+    assert max(hi - lo for lo, hi in released) <= _GATHER_SPAN + (1 << 16)  # one message past the span at most
+    assert released[0][0] == 0 and released[-1][1] == buf.size and len(released) >= buf.size // _GATHER_SPAN
+
+
 def test_units_and_instance_fields_equal_dfreader(real_data: Path) -> None:
     path = real_data.joinpath(*SAMPLE)
     reader = DFReader_binary(str(path))
