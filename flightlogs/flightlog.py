@@ -136,6 +136,9 @@ class FlightLog:
         Canonical signals found, by name.
     vehicle : str
         Vehicle description (airframe, hardware) as far as the log tells.
+    board_id : str
+        The flight controller's unique id, which tells one vehicle from another: PX4's ``sys_uuid``,
+        ArduPilot's board message (``"fmuv5 00290019 32375118 32363435"``); "" when the log has none.
     parameters : Mapping[str, float]
         Autopilot parameters at the start of the log.
     utc_offset_s : float or None
@@ -153,6 +156,7 @@ class FlightLog:
     autopilot: Autopilot
     signals: Mapping[str, Signal]
     vehicle: str = ""
+    board_id: str = ""
     parameters: Mapping[str, float] = field(default_factory=dict)
     utc_offset_s: float | None = None
     warnings: tuple[str, ...] = ()

@@ -38,6 +38,7 @@ _INTERRUPTED = {KeyboardInterrupt: (130, "SIGINT"), _Terminated: (143, "SIGTERM"
 #: Each command's module and object, imported when the command runs (``sysid --help`` imports them all): a
 #: command loads only what it uses (20 ms of a 0.4 s ingest of a small log went to the other commands' imports).
 _COMMANDS = {
+    "batch": ("sysid_cli.batch", "batch"),
     "demo": ("sysid_cli.demo", "demo"),
     "discrepancy": ("sysid_cli.discrepancy", "discrepancy"),
     "fit": ("sysid_cli.fit", "fit"),

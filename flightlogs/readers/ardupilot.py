@@ -129,6 +129,8 @@ _SYSID_AXES = {
     13: "mixer thrust",
 }
 _FIRMWARE = re.compile(r"^(APM:\w+|Ardu\w+|ArduPilot\w*)\s+V\d")
+#: The board and its 96-bit unique id, as ArduPilot logs them at boot (``"fmuv5 00290019 32375118 32363435"``).
+_BOARD_ID = re.compile(r"^\S+( [0-9A-F]{8}){3}$")
 
 
 def read_dataflash(path: str | Path, *, progress: Callable[[int, int], None] | None = None) -> FlightLog:
@@ -243,6 +245,7 @@ def _flightlog(messages: DataFlashMessages) -> FlightLog:
         autopilot="ardupilot",
         signals=signals,
         vehicle=_vehicle(messages, parameters, n_motors),
+        board_id=next((t for t in _texts(messages) if _BOARD_ID.match(t)), ""),
         parameters=parameters,
         utc_offset_s=_utc_offset(messages),
         system_id_runs=runs,

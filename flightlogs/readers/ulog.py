@@ -156,6 +156,7 @@ def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], No
             autopilot="px4",
             signals=signals,
             vehicle=describe_vehicle(ulog.msg_info_dict, parameters),
+            board_id=str(ulog.msg_info_dict.get("sys_uuid", "")),
             parameters=parameters,
             utc_offset_s=utc_offset_s,
             warnings=caught.messages,

@@ -8,7 +8,7 @@ nonlinear simulator builds on the same outputs.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import cast
@@ -20,7 +20,7 @@ from scipy import signal as sps
 from simulator.autopilot.excitation import Axis, Maneuver, excitation_signal, sweep
 from simulator.vehicle.identified import CALM_HOVER, G
 
-__all__ = ["WindField", "SimulatedFlight", "simulate_hover"]
+__all__ = ["WindField", "SimulatedFlight", "HoverSetup", "simulate_hover", "simulate_hovers"]
 
 _AXES: tuple[Axis, ...] = ("lat", "lon", "yaw", "thr")
 
@@ -133,6 +133,29 @@ def _lqr(a: np.ndarray, b: np.ndarray, weights: np.ndarray) -> np.ndarray:
 _WEIGHTS = {"lat": [2.0, 1.0, 20.0, 0.0], "lon": [2.0, 1.0, 20.0, 0.0], "yaw": [1.0, 5.0], "thr": [1.0, 2.0, 0.0]}
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class HoverSetup:
+    """What differs between flights flown together by :func:`simulate_hovers`.
+
+    Parameters
+    ----------
+    parameters : Mapping[str, float], optional
+        Bare-airframe model (Table 3.3 names); default the calm model.
+    wind : WindField, optional
+        Wind at the vehicle; none for still air.
+    wind_terms : Mapping[str, float], optional
+        ``X_w_lon, Z_w_lon, tau_w_lon, tau_w_thr`` (Table 3.5); none: wind only
+        moves the air the vehicle flies in.
+    seed : int, optional
+        Seed of the gusts and the sensor noise.
+    """
+
+    parameters: Mapping[str, float] = field(default_factory=lambda: CALM_HOVER)
+    wind: WindField | None = None
+    wind_terms: Mapping[str, float] | None = None
+    seed: int = 0
+
+
 def simulate_hover(
     duration_s: float,
     maneuvers: tuple[Maneuver, ...],
@@ -153,13 +176,8 @@ def simulate_hover(
         Flight length, s.
     maneuvers : tuple of Maneuver
         Excitation summed at the mixer input.
-    parameters : Mapping[str, float], optional
-        Bare-airframe model (Table 3.3 names); default the calm model.
-    wind : WindField, optional
-        Wind at the vehicle; none for still air.
-    wind_terms : Mapping[str, float], optional
-        ``X_w_lon, Z_w_lon, tau_w_lon, tau_w_thr`` (Table 3.5); none: wind only
-        moves the air the vehicle flies in.
+    parameters, wind, wind_terms, seed
+        As in :class:`HoverSetup`.
     rate_hz : float, optional
         Log rate, Hz.
     substeps : int, optional
@@ -167,73 +185,167 @@ def simulate_hover(
         steps); the logged mixer input is the command averaged over the log interval.
     hover_height_m : float, optional
         Trim height above ground, m (the dissertation's 4.6 m, out of ground effect).
-    seed : int, optional
-        Seed of the gusts and the sensor noise.
 
     Returns
     -------
     SimulatedFlight
     """
-    rng = np.random.default_rng(seed)
+    setup = HoverSetup(parameters=parameters, wind=wind, wind_terms=wind_terms, seed=seed)
+    return simulate_hovers(
+        duration_s, maneuvers, [setup], rate_hz=rate_hz, substeps=substeps, hover_height_m=hover_height_m
+    )[0]
+
+
+#: Where each axis's states sit in the stacked state of all four loops (:func:`_axis_models`' order).
+_SLICES = {"lat": slice(0, 4), "lon": slice(4, 8), "yaw": slice(8, 10), "thr": slice(10, 13)}
+_N_STATES = 13
+_U, _V, _W = _SLICES["lon"].start, _SLICES["lat"].start, _SLICES["thr"].start  # the velocity states
+
+
+def simulate_hovers(
+    duration_s: float,
+    maneuvers: tuple[Maneuver, ...],
+    setups: Sequence[HoverSetup],
+    *,
+    rate_hz: float = 100.0,
+    substeps: int = 5,
+    hover_height_m: float = 4.6,
+) -> list[SimulatedFlight]:
+    """Fly several hovers with the same excitation at once: one integration loop for all of them.
+
+    Each flight is what :func:`simulate_hover` flies with its setup; flying
+    them together costs about what one costs (the loop's steps, not its
+    arithmetic, take the time), which makes a fleet of hundreds of flights cheap.
+
+    Parameters
+    ----------
+    duration_s : float
+        Flight length, s.
+    maneuvers : tuple of Maneuver
+        Excitation summed at the mixer input, the same in every flight.
+    setups : sequence of HoverSetup
+        One per flight: its airframe, wind and seed.
+    rate_hz, substeps, hover_height_m
+        As in :func:`simulate_hover`.
+
+    Returns
+    -------
+    list of SimulatedFlight
+        In the order of `setups`.
+    """
+    n_flights = len(setups)
+    rngs = [np.random.default_rng(setup.seed) for setup in setups]
     dt = 1.0 / (rate_hz * substeps)
     n_fine = int(round(duration_s / dt))
     t_fine = np.arange(n_fine) * dt
-    wind_ne = wind.sample(t_fine, rng) if wind is not None else np.zeros((n_fine, 2))
-    terms = dict(wind_terms or {})
-    models = _axis_models(parameters)
-    discrete = {axis: sps.cont2discrete((a, b, np.eye(a.shape[0]), 0), dt)[:2] for axis, (a, b) in models.items()}
-    gains: dict[str, np.ndarray] = {axis: _lqr(*models[axis], np.array(_WEIGHTS[axis])) for axis in _AXES}
-    delays = {axis: int(round(parameters.get(f"tau_{axis}", 0.0) / dt)) for axis in _AXES}
-    excitation = {axis: excitation_signal(t_fine, maneuvers, axis) for axis in _AXES}
-    states = _trim_states(models, gains, wind_ne[: max(1, int(round(1.0 / dt)))].mean(axis=0))
-    history = {axis: np.zeros(n_fine) for axis in _AXES}
-    names = ("u", "v", "w", "p", "q", "r", "phi", "theta", "psi", "ax", "ay", "az", "height_agl")
-    log = {name: np.zeros(n_fine) for name in names}
-    w_lon_delay = int(round(terms.get("tau_w_lon", 0.0) / dt))
-    w_thr_delay = int(round(terms.get("tau_w_thr", 0.0) / dt))
+    wind_ne = np.stack(
+        [s.wind.sample(t_fine, rng) if s.wind is not None else np.zeros((n_fine, 2)) for s, rng in zip(setups, rngs)]
+    )
+    terms = [dict(s.wind_terms or {}) for s in setups]
+    x_w, z_w = (np.array([t.get(name, 0.0) for t in terms]) for name in ("X_w_lon", "Z_w_lon"))
+    w_lon_delay, w_thr_delay = (
+        np.array([int(round(t.get(name, 0.0) / dt)) for t in terms]) for name in ("tau_w_lon", "tau_w_thr")
+    )
+    shapes = ((_N_STATES, _N_STATES), (_N_STATES, len(_AXES)), (len(_AXES), _N_STATES), (3, _N_STATES))
+    a_d, b_d, gains, rows = (np.zeros((n_flights, *shape)) for shape in shapes)
+    states = np.zeros((n_flights, _N_STATES))
+    delays = np.zeros((n_flights, len(_AXES)), dtype=np.intp)
+    for f, setup in enumerate(setups):
+        models = _axis_models(setup.parameters)
+        axis_gains: dict[str, np.ndarray] = {axis: _lqr(*models[axis], np.array(_WEIGHTS[axis])) for axis in _AXES}
+        trim = _trim_states(models, axis_gains, wind_ne[f, : max(1, int(round(1.0 / dt)))].mean(axis=0))
+        for j, axis in enumerate(_AXES):
+            at = _SLICES[axis]
+            a, b = models[axis]
+            ad, bd = sps.cont2discrete((a, b, np.eye(a.shape[0]), 0), dt)[:2]
+            a_d[f, at, at], b_d[f, at, j], gains[f, j, at] = ad, bd.ravel(), axis_gains[axis]
+            states[f, at] = trim[axis]
+            delays[f, j] = int(round(setup.parameters.get(f"tau_{axis}", 0.0) / dt))
+        for r, moved in enumerate(("lon", "lat", "thr")):  # the continuous rows of u', v', w' (logged accelerations)
+            rows[f, r, _SLICES[moved]] = models[moved][0][0]
+    excitation = np.stack([excitation_signal(t_fine, maneuvers, axis) for axis in _AXES], axis=1)  # (n_fine, 4)
+    history = np.zeros((n_fine, n_flights, len(_AXES)))
+    n_logged = -(-n_fine // substeps)  # the log's instants: every `substeps`-th step
+    logged = np.zeros((n_logged, n_flights, _N_STATES))
+    accel = np.zeros((n_logged, n_flights, 3))
+    flight, axis_index = np.arange(n_flights)[:, None], np.arange(len(_AXES))[None, :]
+    everyone = np.arange(n_flights)
     for k in range(n_fine):
         # the controller holds ground velocity: airspeed plus the wind along each axis
-        feedback = {axis: states[axis].copy() for axis in _AXES}
-        feedback["lon"][0] += wind_ne[k, 0]
-        feedback["lat"][0] += wind_ne[k, 1]
-        for axis in _AXES:
-            history[axis][k] = -gains[axis] @ feedback[axis] + excitation[axis][k]
-        wind_lon_u = wind_ne[max(k - w_lon_delay, 0), 0]
-        wind_lon_w = wind_ne[max(k - w_thr_delay, 0), 0]
-        derivative_u = models["lon"][0][0] @ states["lon"] + terms.get("X_w_lon", 0.0) * wind_lon_u
-        derivative_v = models["lat"][0][0] @ states["lat"]
-        derivative_w = models["thr"][0][0] @ states["thr"] + terms.get("Z_w_lon", 0.0) * wind_lon_w
-        log["u"][k], log["q"][k], log["theta"][k] = states["lon"][:3]
-        log["v"][k], log["p"][k], log["phi"][k] = states["lat"][:3]
-        log["r"][k], log["psi"][k] = states["yaw"]
-        log["w"][k], log["height_agl"][k] = states["thr"][0], hover_height_m + states["thr"][1]
-        log["ax"][k] = derivative_u + G * states["lon"][2]  # eq. 3.7 at zero trim
-        log["ay"][k] = derivative_v - G * states["lat"][2]
-        log["az"][k] = derivative_w - G
-        for axis in _AXES:
-            ad, bd = discrete[axis]
-            command = history[axis][max(k - delays[axis], 0)]
-            states[axis] = ad @ states[axis] + bd.ravel() * command
-        states["lon"][0] += dt * terms.get("X_w_lon", 0.0) * wind_lon_u
-        states["thr"][0] += dt * terms.get("Z_w_lon", 0.0) * wind_lon_w
-    pick = slice(0, n_fine, substeps)
-    signals = {name: values[pick] for name, values in log.items()}
+        feedback = states.copy()
+        feedback[:, _U] += wind_ne[:, k, 0]
+        feedback[:, _V] += wind_ne[:, k, 1]
+        history[k] = excitation[k] - np.matmul(gains, feedback[:, :, None])[:, :, 0]
+        wind_lon_u = wind_ne[everyone, np.maximum(k - w_lon_delay, 0), 0]
+        wind_lon_w = wind_ne[everyone, np.maximum(k - w_thr_delay, 0), 0]
+        if k % substeps == 0:
+            j = k // substeps
+            logged[j] = states
+            accel[j] = np.matmul(rows, states[:, :, None])[:, :, 0]
+            accel[j, :, 0] += x_w * wind_lon_u
+            accel[j, :, 2] += z_w * wind_lon_w
+        command = history[np.maximum(k - delays, 0), flight, axis_index]
+        states = np.matmul(a_d, states[:, :, None])[:, :, 0] + np.matmul(b_d, command[:, :, None])[:, :, 0]
+        states[:, _U] += dt * x_w * wind_lon_u
+        states[:, _W] += dt * z_w * wind_lon_w
+    return [
+        _flight(
+            t_fine,
+            logged[:, f],
+            accel[:, f],
+            history[:, f],
+            wind_ne[f],
+            maneuvers,
+            dict(setups[f].parameters) | terms[f],
+            substeps,
+            hover_height_m,
+            rngs[f],
+        )
+        for f in range(n_flights)
+    ]
+
+
+def _flight(
+    t_fine: np.ndarray,
+    states: np.ndarray,
+    accel: np.ndarray,
+    history: np.ndarray,
+    wind_ne: np.ndarray,
+    maneuvers: tuple[Maneuver, ...],
+    truth: dict[str, float],
+    substeps: int,
+    hover_height_m: float,
+    rng: np.random.Generator,
+) -> SimulatedFlight:
+    """One flight's log from its states (n_logged, 13) and accelerations (n_logged, 3) at the log's instants
+    and its commands at every integration step (n_fine, 4)."""
+    pick = slice(0, t_fine.size, substeps)
+    lat, lon, yaw, thr = (states[:, _SLICES[axis]] for axis in _AXES)
+    signals = {
+        "u": lon[:, 0], "v": lat[:, 0], "w": thr[:, 0],
+        "p": lat[:, 1], "q": lon[:, 1], "r": yaw[:, 0],
+        "phi": lat[:, 2], "theta": lon[:, 2], "psi": yaw[:, 1],
+        "ax": accel[:, 0] + G * lon[:, 2],  # eq. 3.7 at zero trim
+        "ay": accel[:, 1] - G * lat[:, 2],
+        "az": accel[:, 2] - G,
+        "height_agl": hover_height_m + thr[:, 1],
+    }  # fmt: skip
     # the logger averages the fast command over each log interval, centred on the log instant (a boxcar
     # anti-alias filter, zero phase): picking every `substeps`-th command instead would log the
     # feedback's within-interval change as a timing error of a few ms, which the unstable open-loop
     # pitch and roll modes amplify in any time-domain check
     boxcar = np.ones(substeps) / substeps
-    for axis in _AXES:
-        signals[f"delta_{axis}"] = np.convolve(history[axis], boxcar, mode="same")[pick]
+    for j, axis in enumerate(_AXES):
+        signals[f"delta_{axis}"] = np.convolve(history[:, j], boxcar, mode="same")[pick]
+    signals = {name: np.ascontiguousarray(values) for name, values in signals.items()}
     signals["vn"] = signals["u"] + wind_ne[pick, 0]
     signals["ve"] = signals["v"] + wind_ne[pick, 1]
     signals["vd"] = signals["w"]
     _add_sensor_noise(signals, rng)
-    truth = dict(parameters) | terms
     return SimulatedFlight(
         time_s=t_fine[pick],
         signals=MappingProxyType(signals),
-        wind_at_vehicle=wind_ne[pick],
+        wind_at_vehicle=np.ascontiguousarray(wind_ne[pick]),
         maneuvers=tuple(maneuvers),
         parameters=MappingProxyType(truth),
     )

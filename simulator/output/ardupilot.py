@@ -24,7 +24,7 @@ from scipy import signal as sps
 
 from flightlogs.geo import destination_point, lat_lon_offset
 from flightlogs.writers.atomic import atomic_output
-from flightlogs.writers.dataflash import MessageBlock, standard_block, write_dataflash
+from flightlogs.writers.dataflash import MessageBlock, standard_block, text_block, write_dataflash
 from flightlogs.writers.jsonio import write_json
 from simulator.autopilot.excitation import Maneuver, sweep
 from simulator.flights.linear import SimulatedFlight
@@ -95,6 +95,7 @@ def write_ardupilot_log(
     *,
     utc_start: datetime,
     vehicle_position_deg: tuple[float, float] = VEHICLE_POSITION_DEG,
+    board_id: str | None = None,
 ) -> Path:
     """Write `flight` as an ArduCopter 4.x DataFlash log.
 
@@ -110,6 +111,9 @@ def write_ardupilot_log(
         The point the vehicle hovers over, latitude and longitude, deg; the
         GPS (5 Hz, 3-D fix) logs it plus the path flown (or the position
         hold's wander, see the module notes).
+    board_id : str, optional
+        The board message ArduPilot logs at boot (``"CubeOrange 00340032 30385106 38373332"``),
+        which tells one vehicle from another.
 
     Returns
     -------
@@ -164,6 +168,8 @@ def write_ardupilot_log(
     sweeps = [m for m in flight.maneuvers if m.kind == "sweep"]
     if sweeps:
         blocks += _system_id_blocks(flight, sweeps, us)
+    if board_id:
+        blocks.append(text_block([(int(us[0]), board_id)]))
     parameters = {
         "FRAME_CLASS": 3.0,
         "FRAME_TYPE": 1.0,

@@ -1,0 +1,62 @@
+"""The Dask cluster a batch runs on: a local one sized to the machine, or a scheduler the user runs."""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+from flightlogs.errors import SysidError
+
+__all__ = ["batch_client"]
+
+
+@contextmanager
+def batch_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
+    """A ``distributed.Client``, closed (with its local cluster) on leaving.
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        Address of a running scheduler (``tcp://10.0.0.5:8786``); its workers must see the logs' paths.
+    workers : int, optional
+        Without `scheduler`: the local cluster's worker processes (default: one per core). Each runs
+        one task at a time, single-threaded inside (``FLIGHT_SYSID_THREADS=1``): the cores are the workers'.
+
+    Yields
+    ------
+    distributed.Client
+
+    Raises
+    ------
+    SysidError
+        If the scheduler cannot be reached.
+    """
+    from distributed import Client, LocalCluster
+
+    logging.getLogger("distributed").setLevel(logging.ERROR)  # its INFO lines are no user's business
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="10s")  # type: ignore[no-untyped-call]
+        except (OSError, TimeoutError) as err:
+            raise SysidError(f"cannot reach the Dask scheduler at {scheduler} ({err})") from None
+        try:
+            yield client
+        finally:
+            client.close()  # type: ignore[no-untyped-call]
+        return
+    n = workers or os.cpu_count() or 1
+    with (
+        LocalCluster(  # type: ignore[no-untyped-call]
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+            env={"FLIGHT_SYSID_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
+        ) as cluster,
+        Client(cluster) as client,  # type: ignore[no-untyped-call]
+    ):
+        yield client
