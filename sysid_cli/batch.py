@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
-from ._wind_options import wind_distance_option, wind_option
+from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["batch", "expand_logs"]
 
@@ -42,6 +42,8 @@ def expand_logs(paths: tuple[Path, ...]) -> list[Path]:
 @click.option("--model", "model_name", default="hover", show_default=True, metavar="NAME|FILE", help="Structure.")
 @wind_option("Anemometer CSV or folder (repeatable); each log takes the file overlapping it.")
 @wind_distance_option()
+@wind_offset_option("Anemometer clock minus UTC, s.")
+@click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset of each log by cross-correlation.")
 @click.option(
     "--mapping",
     type=click.Path(exists=True, dir_okay=False, path_type=Path),
@@ -83,6 +85,8 @@ def batch(
     model_name: str,
     wind_paths: tuple[Path, ...],
     wind_distance: float | None,
+    wind_offset: float | None,
+    estimate_wind_offset: bool,
     mapping: Path | None,
     group_by: str,
     against: Path | None,
@@ -124,7 +128,9 @@ def batch(
     settings = BatchSettings(
         structure=str(Path(model_name).resolve()) if Path(model_name).is_file() else model_name,
         structure_text=structure.text,
-        conditioning=ConditioningOptions(wind_distance_m=wind_distance),
+        conditioning=ConditioningOptions(
+            wind_distance_m=wind_distance, wind_offset_s=wind_offset, estimate_wind_offset=estimate_wind_offset
+        ),
         wind_paths=tuple(str(Path(w).resolve()) for w in winds),
         wind_sha256=tuple(file_sha256(w) for w in winds),
     )

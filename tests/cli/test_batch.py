@@ -48,6 +48,22 @@ def local_run(
     return out, json.loads(done.stdout), done
 
 
+def test_the_fleet_is_what_its_plan_says(fleet: Path) -> None:
+    truth = json.loads((fleet / "truth.json").read_text())["logs"]
+    assert len(truth) == 24 and len({e["board_id"] for e in truth}) == 3  # one board per vehicle
+    mapping = pd.read_csv(fleet / "fleet.csv")
+    assert mapping["file"].tolist() == [e["file"] for e in truth] and mapping["vehicle"].nunique() == 3
+    healthy = {e["vehicle"]: e["parameters"]["Z_thr"] for e in truth if e["flight"] == 1}
+    for e in truth:
+        loss = _SMALL.thrust_loss(int(e["vehicle"][1:]), e["flight"])
+        assert e["thrust_loss"] == loss and e["parameters"]["Z_thr"] == pytest.approx(
+            healthy[e["vehicle"]] * (1 - loss)
+        )
+    assert [e["flight"] for e in truth if e["thrust_loss"] > 0] == [5, 6, 7, 8]  # V02 only
+    damaged = (fleet / "V03" / fleet_log_name(3, 2)).read_bytes()
+    assert not any(damaged[: 1 << 16]) and any(damaged[1 << 16 :])
+
+
 def test_the_worn_vehicle_is_flagged_at_its_first_worn_flight_and_no_healthy_one(local_run) -> None:
     _, summary, done = local_run
     flagged = [d for d in summary["drifts"] if d["confirmed"]]
@@ -253,3 +269,27 @@ def test_each_log_is_compared_with_the_reference_as_sysid_discrepancy_compares_i
         effects = ", ".join(f["effect"] for f in found["findings"]) or "none"
         expected = f"{log.name}: {effects} (thrust scale {found['thrust_scale']:.3f})"
         assert table.loc[log.name, "discrepancy"] == expected
+
+
+def test_a_group_with_wind_is_the_model_sysid_fit_makes_of_its_logs(tmp_path: Path) -> None:
+    """The batch's fit is ``sysid fit``'s, wind step included: same logs, same options, same numbers."""
+    from simulator.campaign.demo_flight import write_demo_flight
+
+    files = write_demo_flight(tmp_path / "demo", seed=2)
+    wind = ["--wind", str(files.wind_csv), "--wind-distance", "4.6", "--estimate-wind-offset", "--model", "hover-wind"]
+    done = _batch(files.log, *wind, "-o", tmp_path / "results", "--workers", "1", "--no-group-reports", "-q")
+    assert done.returncode == 0, done.stderr
+    single = subprocess.run(
+        [*_CLI, "fit", str(files.log), *wind, "-o", str(tmp_path / "model.json"), "-q"],
+        capture_output=True,
+        text=True,
+        check=False,
+        env=os.environ | {"PYTHONWARNINGS": "ignore"},
+    )
+    assert single.returncode == 0, single.stderr
+    (folder,) = (tmp_path / "results" / "groups").iterdir()  # no board id: vehicle "unknown", the log's UTC day
+    assert folder.name == "unknown_2024-05-01"
+    batch_model = json.loads((folder / "model.json").read_text())["parameters"]
+    fit_model = json.loads((tmp_path / "model.json").read_text())["parameters"]
+    assert batch_model == fit_model
+    assert batch_model["Z_w_lon"]["value"] == pytest.approx(0.8451, rel=0.05)  # Table 3.5, light wind
