@@ -147,5 +147,19 @@ def render_fleet_report(
 
 
 def write_fleet_report(path: str | Path, result: BatchResult, **kwargs: Any) -> Path:
-    """Render the fleet report (:func:`render_fleet_report`) and write it atomically."""
+    """Render the fleet report and write it atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination HTML file; its folder must exist.
+    result : BatchResult
+        The batch.
+    **kwargs
+        ``title``, ``run`` and ``drift``, as for :func:`render_fleet_report`.
+
+    Returns
+    -------
+    Path
+    """
     return write_html(path, render_fleet_report(result, path=path, **kwargs))

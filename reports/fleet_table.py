@@ -17,7 +17,7 @@ from typing import Any
 from flightlogs.writers.atomic import atomic_output
 from sysid.batch import BatchResult, Drift
 
-__all__ = ["COLUMNS", "results_table", "failures_table", "write_tables"]
+__all__ = ["COLUMNS", "results_table", "drift_text", "failures_table", "write_tables"]
 
 COLUMNS = (
     "group",
@@ -95,7 +95,13 @@ def results_table(result: BatchResult) -> Any:
 
 
 def drift_text(drift: Drift) -> str:
-    """One line: ``"Z_thr -89.9 -> -68.4, magnitude -24.0 % (5.1 combined bounds) at V03 2024-06-07, after V03 2024-06-06"``."""
+    """One line: ``"Z_thr -89.9 -> -68.4, magnitude -24.0 % (5.1 combined bounds) at V03 2024-06-07, after V03 2024-06-06"``.
+
+    Parameters
+    ----------
+    drift : Drift
+        The drift.
+    """
     return (
         f"{drift.parameter} {drift.baseline:.4g} -> {drift.value:.4g}, magnitude {drift.change_percent:+.1f} % "
         f"({abs(drift.sigmas):.1f} combined bounds) at {drift.after}, after {drift.before}"
@@ -104,7 +110,13 @@ def drift_text(drift: Drift) -> str:
 
 
 def failures_table(result: BatchResult) -> Any:
-    """A ``pandas.DataFrame`` of the logs and groups the batch went on without: ``what, stage, reason``."""
+    """A ``pandas.DataFrame`` of the logs and groups the batch went on without: ``what, stage, reason``.
+
+    Parameters
+    ----------
+    result : BatchResult
+        The batch.
+    """
     import pandas as pd
 
     return pd.DataFrame([(f.what, f.stage, f.reason) for f in result.failures], columns=["what", "stage", "reason"])
@@ -112,6 +124,13 @@ def failures_table(result: BatchResult) -> Any:
 
 def write_tables(folder: str | Path, result: BatchResult) -> tuple[Path, Path, Path]:
     """Write ``results.parquet``, ``results.csv`` and ``failures.csv`` into `folder`, each atomically.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The results folder (it exists).
+    result : BatchResult
+        The batch.
 
     Returns
     -------

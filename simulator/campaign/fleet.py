@@ -103,7 +103,13 @@ class FleetFiles:
 
 
 def fleet_log_name(vehicle: int, flight: int) -> str:
-    """The file name of `vehicle`'s `flight` (both 1-based): ``V03_F05.bin``."""
+    """The file name of a vehicle's flight: ``V03_F05.bin``.
+
+    Parameters
+    ----------
+    vehicle, flight : int
+        Both 1-based.
+    """
     return f"V{vehicle:02d}_F{flight:02d}.bin"
 
 

@@ -29,7 +29,18 @@ CACHE_VERSION = 1
 
 
 def cache_key(*parts: str | Iterable[str]) -> str:
-    """SHA-256 of the parts (strings, or sequences of them), the cache's version and the software's."""
+    """SHA-256 of the parts, the cache's version and the software's: the key of a result made from them.
+
+    Parameters
+    ----------
+    *parts : str or iterable of str
+        Texts (file hashes, options), each alone or a sequence of them.
+
+    Returns
+    -------
+    str
+        Hex digest.
+    """
     digest = hashlib.sha256(f"flight-sysid batch cache {CACHE_VERSION} {software_version()}".encode())
     for part in parts:
         for text in [part] if isinstance(part, str) else part:
@@ -38,7 +49,17 @@ def cache_key(*parts: str | Iterable[str]) -> str:
 
 
 def load_survey(cache: Path, sha256: str, path: str) -> LogSurvey | None:
-    """The cached survey of the log with these bytes (under its present path), or None."""
+    """The cached survey of the log with these bytes (under its present path), or None.
+
+    Parameters
+    ----------
+    cache : Path
+        The cache folder.
+    sha256 : str
+        Hex digest of the log's bytes.
+    path : str
+        The log's present path.
+    """
     doc = _read(cache / "survey" / f"{sha256}.json")
     if doc is None:
         return None
@@ -46,12 +67,28 @@ def load_survey(cache: Path, sha256: str, path: str) -> LogSurvey | None:
 
 
 def save_survey(cache: Path, survey: LogSurvey) -> None:
-    """Keep `survey` under its log's hash."""
+    """Keep `survey` under its log's hash.
+
+    Parameters
+    ----------
+    cache : Path
+        The cache folder.
+    survey : LogSurvey
+        What to keep (its reason too, when the log cannot be read).
+    """
     _write(cache / "survey" / f"{survey.sha256}.json", dataclasses.asdict(survey) | {"cached": False})
 
 
 def load_fit(cache: Path, key: str) -> GroupFit | None:
-    """The cached fit under `key`, or None (also when a file it names has gone)."""
+    """The cached fit under `key`, or None (also when a file it names has gone).
+
+    Parameters
+    ----------
+    cache : Path
+        The cache folder.
+    key : str
+        From :func:`cache_key`.
+    """
     doc = _read(cache / "fit" / f"{key}.json")
     if doc is None:
         return None
@@ -76,7 +113,17 @@ def load_fit(cache: Path, key: str) -> GroupFit | None:
 
 
 def save_fit(cache: Path, key: str, fit: GroupFit) -> None:
-    """Keep `fit` under `key`."""
+    """Keep `fit` under `key`.
+
+    Parameters
+    ----------
+    cache : Path
+        The cache folder.
+    key : str
+        From :func:`cache_key`.
+    fit : GroupFit
+        What to keep.
+    """
     _write(cache / "fit" / f"{key}.json", dataclasses.asdict(fit) | {"cached": False})
 
 

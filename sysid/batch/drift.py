@@ -58,7 +58,20 @@ class DriftOptions:
 def parameter_series(groups: Sequence[GroupFit], vehicle: str, parameter: str) -> list[tuple[GroupFit, float, float]]:
     """``(group, value, Cramér–Rao bound)`` of `parameter` over `vehicle`'s fitted groups, by date.
 
-    Groups where the parameter was not estimated (fixed, dropped, unidentified) or has no bound are left out.
+    Parameters
+    ----------
+    groups : sequence of GroupFit
+        The batch's groups.
+    vehicle : str
+        The vehicle.
+    parameter : str
+        The parameter's name.
+
+    Returns
+    -------
+    list of (GroupFit, float, float)
+        The bound in the parameter's unit. Groups where the parameter was not estimated (fixed,
+        dropped, unidentified) or has no bound are left out.
     """
     found = []
     for group in sorted((g for g in groups if g.vehicle == vehicle and g.error is None), key=_order):

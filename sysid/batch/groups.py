@@ -69,7 +69,20 @@ def log_keys(survey: LogSurvey, mapping: LogMapping | None = None) -> dict[str, 
 
 
 def check_keys(by: Sequence[str], mapping: LogMapping | None = None) -> None:
-    """Raise DataError unless every key of `by` is built in or a column of the mapping file (and there is one)."""
+    """Refuse grouping keys that are neither built in nor a column of the mapping file.
+
+    Parameters
+    ----------
+    by : sequence of str
+        The keys.
+    mapping : LogMapping, optional
+        The operator's mapping file.
+
+    Raises
+    ------
+    DataError
+        Naming the unknown keys (or none given) and what a key may be.
+    """
     known = (*BUILTIN_KEYS, *(mapping.columns if mapping is not None else ()))
     unknown = [key for key in by if key not in known]
     if unknown or not by:

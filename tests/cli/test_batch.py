@@ -219,7 +219,7 @@ def test_an_unreachable_scheduler_and_an_unknown_key_are_one_sentence(fleet: Pat
     assert done.returncode == 2 and "--workers sizes the local cluster" in done.stderr
 
 
-@pytest.mark.slow
+@pytest.mark.long
 @pytest.mark.timeout(1200)
 def test_two_hundred_logs_in_one_command(tmp_path: Path) -> None:
     """The issue's campaign: 20 vehicles, 10 flights each, V03's motors wearing from its 5th flight, V12's 3rd log damaged."""
@@ -252,7 +252,7 @@ def test_two_hundred_logs_in_one_command(tmp_path: Path) -> None:
 def test_each_log_is_compared_with_the_reference_as_sysid_discrepancy_compares_it(fleet: Path, tmp_path: Path) -> None:
     """``--against``: the table's discrepancy column is, log by log, what ``sysid discrepancy REF LOG`` finds."""
     out = tmp_path / "results"
-    logs = [fleet / "V02" / fleet_log_name(2, f) for f in (3, 7)]
+    logs = [fleet / "V02" / fleet_log_name(2, 7)]
     reference = fleet / "V02" / fleet_log_name(2, 1)
     done = _batch(*logs, "-o", out, "--against", reference, "--group-by", "file", "--no-group-reports", "-q")
     assert done.returncode == 0, done.stderr

@@ -19,7 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # t
 from bench_dataflash import synthetic_log
 
 pytestmark = [
-    pytest.mark.slow,  # about 35 s: the log takes 20 s (and 5.6 GB) to write
+    pytest.mark.long,  # about 35 s: the log takes 20 s (and 5.6 GB) to write
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/status"),
 ]
 
