@@ -293,3 +293,53 @@ def test_a_group_with_wind_is_the_model_sysid_fit_makes_of_its_logs(tmp_path: Pa
     fit_model = json.loads((tmp_path / "model.json").read_text())["parameters"]
     assert batch_model == fit_model
     assert batch_model["Z_w_lon"]["value"] == pytest.approx(0.8451, rel=0.05)  # Table 3.5, light wind
+
+
+@pytest.mark.parametrize(("signum", "code", "name"), [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")])
+def test_a_batch_interrupted_leaves_its_earlier_table_and_no_worker(
+    fleet: Path, tmp_path: Path, signum: int, code: int, name: str
+) -> None:
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "results.csv").write_text("earlier run")
+    process = subprocess.Popen(
+        [*_CLI, "batch", str(fleet), "-o", str(out), "--workers", "2", "--no-group-reports", "-q"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=os.environ | {"PYTHONWARNINGS": "ignore"},
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as from a shell
+    )
+    time.sleep(6)  # the cluster started, logs being read or fitted: 24 logs take 15 s or more
+    assert process.poll() is None, "the batch ended before the signal"
+    workers = _descendants(process.pid)
+    assert len(workers) >= 2  # the local cluster's worker processes (and what they started)
+    process.send_signal(signum)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == code and "Traceback" not in err, err
+    assert [line for line in err.splitlines() if line.strip()] == [
+        f"interrupted ({name}): no file was left half-written"
+    ]
+    assert (out / "results.csv").read_text() == "earlier run"  # the table of the earlier run, as it was
+    assert not (out / "results.parquet").exists()
+    time.sleep(1)
+    assert [pid for pid in workers if Path(f"/proc/{pid}").exists() and _state(pid) != "Z"] == []  # none left
+
+
+def _descendants(pid: int) -> list[int]:
+    """Every process started by `pid`, and by those, ..."""
+    found, todo = [], [pid]
+    while todo:
+        children = Path(f"/proc/{todo.pop()}/task")
+        for task in children.iterdir() if children.exists() else ():
+            listed = (task / "children").read_text().split() if (task / "children").exists() else []
+            found += [int(c) for c in listed]
+            todo += [int(c) for c in listed]
+    return found
+
+
+def _state(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return "Z"
