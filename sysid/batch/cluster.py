@@ -39,7 +39,7 @@ def batch_client(scheduler: str | None = None, workers: int | None = None) -> It
     logging.getLogger("distributed").setLevel(logging.ERROR)  # its INFO lines are no user's business
     if scheduler is not None:
         try:
-            client = Client(scheduler, timeout="10s")  # type: ignore[no-untyped-call]
+            client = Client(scheduler, timeout="5s")  # type: ignore[no-untyped-call]
         except (OSError, TimeoutError) as err:
             raise SysidError(f"cannot reach the Dask scheduler at {scheduler} ({err})") from None
         try:

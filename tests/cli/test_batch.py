@@ -42,7 +42,18 @@ def local_run(
     out = tmp_path_factory.mktemp("local") / "results"
     report = out.parent / "fleet.html"
     done = _batch(
-        fleet, "--mapping", fleet / "fleet.csv", "-o", out, "--workers", "2", "--report", report, "--json", "-"
+        fleet,
+        "--mapping",
+        fleet / "fleet.csv",
+        "-o",
+        out,
+        "--workers",
+        "2",
+        "--report",
+        report,
+        "--no-group-reports",
+        "--json",
+        "-",
     )
     assert done.returncode == 0, done.stderr
     return out, json.loads(done.stdout), done
@@ -119,7 +130,7 @@ def test_the_fleet_report_shows_the_drift_and_the_failure(local_run, fleet: Path
     assert "1 parameter flagged on 1 vehicle" in html
     assert "V02 2024-06-07" in html and "not a PX4 ULog" in html
     assert html.count("<svg") == 3  # a trend figure per vehicle
-    assert 'href="results/groups/V01_2024-06-03/report.html"' in html
+    assert "report.html" not in html  # --no-group-reports: none made, none linked
 
 
 def test_a_rerun_takes_everything_from_the_cache_and_writes_the_same_table(
@@ -128,7 +139,9 @@ def test_a_rerun_takes_everything_from_the_cache_and_writes_the_same_table(
     out, summary, _ = local_run
     before = pd.read_parquet(out / "results.parquet")
     started = time.perf_counter()
-    done = _batch(fleet, "--mapping", fleet / "fleet.csv", "-o", out, "--workers", "1", "--json", "-", "-q")
+    done = _batch(
+        fleet, "--mapping", fleet / "fleet.csv", "-o", out, "--workers", "1", "--no-group-reports", "--json", "-", "-q"
+    )
     assert done.returncode == 0, done.stderr
     again = json.loads(done.stdout)
     assert again["cached"] == 24 + 23  # every log's survey (the damaged one's reason too) and every group
@@ -179,8 +192,9 @@ def test_a_scheduler_and_two_workers_started_apart_give_the_local_runs_results(
             client.wait_for_workers(2, timeout=60)
             assert len(client.scheduler_info()["workers"]) == 2
         remote = tmp_path / "remote"
-        done = _batch(
-            fleet,
+        done = _batch(  # two vehicles of the local run, every flight: the same groups and trends
+            fleet / "V01",
+            fleet / "V02",
             "--mapping",
             fleet / "fleet.csv",
             "-o",
@@ -195,6 +209,8 @@ def test_a_scheduler_and_two_workers_started_apart_give_the_local_runs_results(
         assert done.returncode == 0, done.stderr
         assert json.loads(done.stdout)["workers"] == 2 and json.loads(done.stdout)["cached"] == 0
         local, far = pd.read_parquet(out / "results.parquet"), pd.read_parquet(remote / "results.parquet")
+        local = local[local["vehicle"].isin(["V01", "V02"])].reset_index(drop=True)
+        assert len(far) == len(local) > 16 * 13
         pd.testing.assert_frame_equal(far, local)  # every value, bit for bit
     finally:
         for process in reversed(processes):
@@ -277,7 +293,8 @@ def test_a_group_with_wind_is_the_model_sysid_fit_makes_of_its_logs(tmp_path: Pa
 
     files = write_demo_flight(tmp_path / "demo", seed=2)
     wind = ["--wind", str(files.wind_csv), "--wind-distance", "4.6", "--estimate-wind-offset", "--model", "hover-wind"]
-    done = _batch(files.log, *wind, "-o", tmp_path / "results", "--workers", "1", "--no-group-reports", "-q")
+    fleet_report = tmp_path / "fleet.html"
+    done = _batch(files.log, *wind, "-o", tmp_path / "results", "--workers", "1", "--report", fleet_report, "-q")
     assert done.returncode == 0, done.stderr
     single = subprocess.run(
         [*_CLI, "fit", str(files.log), *wind, "-o", str(tmp_path / "model.json"), "-q"],
@@ -293,12 +310,14 @@ def test_a_group_with_wind_is_the_model_sysid_fit_makes_of_its_logs(tmp_path: Pa
     fit_model = json.loads((tmp_path / "model.json").read_text())["parameters"]
     assert batch_model == fit_model
     assert batch_model["Z_w_lon"]["value"] == pytest.approx(0.8451, rel=0.05)  # Table 3.5, light wind
+    # the group's own report beside its model, linked from the fleet report
+    assert "hover-wind" in (folder / "report.html").read_text()
+    assert 'href="results/groups/unknown_2024-05-01/report.html"' in fleet_report.read_text()
 
 
-@pytest.mark.parametrize(("signum", "code", "name"), [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")])
-def test_a_batch_interrupted_leaves_its_earlier_table_and_no_worker(
-    fleet: Path, tmp_path: Path, signum: int, code: int, name: str
-) -> None:
+def test_a_batch_interrupted_leaves_its_earlier_table_and_no_worker(fleet: Path, tmp_path: Path) -> None:
+    """Ctrl-C; SIGTERM takes the same path (tests/cli/test_interrupts.py)."""
+    signum, code, name = signal.SIGINT, 130, "SIGINT"
     out = tmp_path / "results"
     out.mkdir()
     (out / "results.csv").write_text("earlier run")
