@@ -4,6 +4,7 @@ Layout (schema version 2; version 1 held variable-length strings, still read)::
 
     /                               attrs: schema, schema_version, software, created_utc
     /logs/<key>/                    attrs: path, sha256, log_format, autopilot, vehicle,
+                                           board_id (absent in files written before it: ""),
                                            utc_offset_s (NaN when unknown), warnings (JSON)
     /logs/<key>/parameters          compound dataset (name, value)
     /logs/<key>/system_id_runs      compound dataset, one row per ArduPilot SIDS run (fields of SystemIdRun)
@@ -198,6 +199,7 @@ def _write_log(group: h5py.Group, log: FlightLog) -> None:
         ("log_format", log.log_format),
         ("autopilot", log.autopilot),
         ("vehicle", log.vehicle),
+        ("board_id", log.board_id),
         ("warnings", json.dumps(list(log.warnings))),
     ):
         put_text(group.attrs, name, value)
@@ -258,6 +260,7 @@ def _read_log(group: h5py.Group) -> FlightLog:
         autopilot=text(group.attrs["autopilot"]),  # type: ignore[arg-type]
         signals=signals,
         vehicle=text(group.attrs["vehicle"]),
+        board_id=text(group.attrs["board_id"]) if "board_id" in group.attrs else "",
         parameters=parameters,
         utc_offset_s=None if np.isnan(offset) else offset,
         warnings=tuple(json.loads(group.attrs["warnings"])),

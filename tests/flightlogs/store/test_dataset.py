@@ -41,7 +41,7 @@ def _log(path: Path) -> FlightLog:
 def test_round_trip_keeps_every_value(tmp_path: Path) -> None:
     source = tmp_path / "flight.ulg"
     source.write_bytes(b"raw bytes")
-    log = _log(source)
+    log = dataclasses.replace(_log(source), board_id="fmuv5 00290019 32375118 32363435")
     out = tmp_path / "set.h5"
     write_dataset(out, [log, log])
     dataset = read_dataset(out)
@@ -49,6 +49,7 @@ def test_round_trip_keeps_every_value(tmp_path: Path) -> None:
     assert len(dataset.logs) == 2
     back = dataset.logs[0]
     assert (back.path, back.log_format, back.autopilot, back.vehicle) == (source, "ulog", "px4", "quad ∅ <x>")
+    assert back.board_id == "fmuv5 00290019 32375118 32363435"
     assert back.utc_offset_s == log.utc_offset_s
     assert dict(back.parameters) == dict(log.parameters)
     assert back.warnings == log.warnings
@@ -57,8 +58,10 @@ def test_round_trip_keeps_every_value(tmp_path: Path) -> None:
         np.testing.assert_array_equal(back[name].values, signal.values)
         assert (back[name].unit, back[name].source) == (signal.unit, signal.source)
     assert dataset.sha256[str(source)] == hashlib.sha256(b"raw bytes").hexdigest()
-    with h5py.File(out) as h5:
+    with h5py.File(out, "r+") as h5:
         assert sorted(h5["logs"]) == ["flight", "flight_2"]
+        del h5["logs/flight"].attrs["board_id"]  # as a file written before board ids were kept
+    assert read_dataset(out).logs[0].board_id == ""
 
 
 def test_values_a_log_held_in_float32_are_stored_in_float32_and_read_back_in_float64(tmp_path: Path) -> None:
