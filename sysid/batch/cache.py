@@ -25,7 +25,7 @@ from sysid.fit.result import ParameterEstimate
 __all__ = ["CACHE_VERSION", "cache_key", "load_survey", "save_survey", "load_fit", "save_fit"]
 
 #: Bumped when what an entry holds changes.
-CACHE_VERSION = 1
+CACHE_VERSION = 2
 
 
 def cache_key(*parts: str | Iterable[str]) -> str:
@@ -63,7 +63,7 @@ def load_survey(cache: Path, sha256: str, path: str) -> LogSurvey | None:
     doc = _read(cache / "survey" / f"{sha256}.json")
     if doc is None:
         return None
-    return LogSurvey(**(doc | {"path": path, "duration_s": _float(doc["duration_s"]), "cached": True}))
+    return LogSurvey(**(doc | {"path": path, "cached": True}))
 
 
 def save_survey(cache: Path, survey: LogSurvey) -> None:

@@ -28,8 +28,6 @@ class LogSurvey:
         The flight controller's unique id ("" when the log has none).
     utc_start : str or None
         UTC of its first sample, ISO 8601; None when it holds no GPS time.
-    duration_s : float
-        Span of its samples, s (NaN when unreadable).
     error : str or None
         One sentence when the log cannot be read; then the rest is empty.
     cached : bool
@@ -40,7 +38,6 @@ class LogSurvey:
     sha256: str
     board_id: str = ""
     utc_start: str | None = None
-    duration_s: float = math.nan
     error: str | None = None
     cached: bool = False
 

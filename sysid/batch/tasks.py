@@ -15,6 +15,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -73,7 +74,7 @@ class BatchSettings:
 
 
 def survey_log(path: str, cache: str) -> LogSurvey:
-    """Hash and read one log: its vehicle's id, its start in UTC and its length, or why it cannot be read.
+    """Hash and read one log: its vehicle's id and its start in UTC, or why it cannot be read.
 
     Parameters
     ----------
@@ -104,18 +105,10 @@ def survey_log(path: str, cache: str) -> LogSurvey:
         survey = LogSurvey(path=path, sha256=sha256, error=str(err))
     else:
         starts = [float(s.time_s[0]) for s in log.signals.values() if s.time_s.size]
-        ends = [float(s.time_s[-1]) for s in log.signals.values() if s.time_s.size]
-        start = min(starts) if starts else math.nan
         utc = None
         if log.utc_offset_s is not None and starts:
-            utc = datetime.fromtimestamp(start + log.utc_offset_s, UTC).isoformat(timespec="seconds")
-        survey = LogSurvey(
-            path=path,
-            sha256=sha256,
-            board_id=log.board_id,
-            utc_start=utc,
-            duration_s=max(ends) - start if starts else math.nan,
-        )
+            utc = datetime.fromtimestamp(min(starts) + log.utc_offset_s, UTC).isoformat(timespec="seconds")
+        survey = LogSurvey(path=path, sha256=sha256, board_id=log.board_id, utc_start=utc)
     save_survey(Path(cache), survey)
     return survey
 
@@ -231,25 +224,39 @@ def compare_log(reference: str, log: LogSurvey) -> LogComparison:
     """
     from flightlogs.store.campaign import ingest_campaign
     from sysid.discrepancy import DiscrepancyOptions, discover, flight_series, model_flight
-    from sysid.fit.model_file import read_model
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SysidWarning)
-            none = ConditioningOptions(segments=())  # the search needs no maneuvers
-            real = ingest_campaign([Path(log.path)], options=none).require_flights()
+            real = ingest_campaign([Path(log.path)], options=_NO_MANEUVERS).require_flights()
             real_series = [flight_series(f.source.name, f.records) for f in real]
-            if reference.lower().endswith(".json"):
-                model = read_model(reference).linear_model(include_wind=False)
-                sim_series = [model_flight(model, s, source=Path(reference).name) for s in real_series]
+            kind, simulation = _reference(reference, Path(reference).stat().st_mtime_ns)
+            if kind == "model":
+                sim_series = [model_flight(simulation, s, source=Path(reference).name) for s in real_series]
             else:
-                sim = ingest_campaign([Path(reference)], options=none).require_flights()
-                sim_series = [flight_series(f.source.name, f.records) for f in sim]
+                sim_series = list(simulation)
             result = discover(sim_series, real_series, DiscrepancyOptions())
     except SysidError as err:
         return LogComparison(path=log.path, error=str(err))
     effects = tuple(finding.effect for finding in result.findings)
     return LogComparison(path=log.path, verdict=result.verdict, effects=effects, thrust_scale=result.thrust_scale)
+
+
+#: The discrepancy search needs no maneuvers found.
+_NO_MANEUVERS = ConditioningOptions(segments=())
+
+
+@lru_cache(maxsize=2)
+def _reference(reference: str, _mtime_ns: int) -> tuple[str, Any]:
+    """The reference read once per worker (keyed by its modification time too): a model, or the simulated flights' series."""
+    from flightlogs.store.campaign import ingest_campaign
+    from sysid.discrepancy import flight_series
+    from sysid.fit.model_file import read_model
+
+    if reference.lower().endswith(".json"):
+        return "model", read_model(reference).linear_model(include_wind=False)
+    sim = ingest_campaign([Path(reference)], options=_NO_MANEUVERS).require_flights()
+    return "flights", tuple(flight_series(f.source.name, f.records) for f in sim)
 
 
 def _folder_name(key: str) -> str:
