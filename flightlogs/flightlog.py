@@ -15,11 +15,18 @@ from flightlogs.signals import LOGGED_SIGNALS, is_canonical
 
 __all__ = ["Signal", "SystemIdRun", "FlightLog", "Autopilot", "LogFormat"]
 
+
+def _held_dtype(dtype: np.dtype) -> type[np.floating]:
+    """float32 for float32 and for integers of up to 16 bits (exact in it), float64 for anything else."""
+    exact_in_single = dtype == np.float32 or (dtype.kind in "iub" and dtype.itemsize <= 2)
+    return np.float32 if exact_in_single else np.float64
+
+
 Autopilot = Literal["px4", "ardupilot"]
 LogFormat = Literal["ulog", "dataflash", "tlog"]
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@dataclass(frozen=True, slots=True, init=False)
 class Signal:
     """One canonical signal as logged, on its own time base.
 
@@ -31,33 +38,62 @@ class Signal:
         Sample times, s, on the log's own clock (autopilot boot time).
         Non-decreasing.
     values : ndarray, shape (n_samples,)
-        Sample values in `unit`.
+        Sample values in `unit`. Held as given when float32 (a log's
+        float32 field: half the memory) or as float32 when an integer type
+        of up to 16 bits (a PWM, exactly); as float64 otherwise.
     unit : str
         Unit of `values` (SI, or the autopilot's unit for mixer inputs).
     source : str
         Where the values came from, ``"topic[instance].field"`` or
         ``"MESSAGE[instance].Field"``, with the conversion applied if any.
+
+    Attributes
+    ----------
+    stored_values : ndarray, shape (n_samples,)
+        The values as held, float32 or float64 (read-only); :attr:`values`
+        gives them in float64.
+
+    Notes
+    -----
+    A 400 Hz log keeps most of its signals as the float32 it logged them
+    in; the resampler and the dataset take :attr:`stored_values` and widen
+    a column at a time, so a log in memory is about its size in the file.
     """
 
     name: str
     time_s: np.ndarray
-    values: np.ndarray
+    stored_values: np.ndarray = field(init=False)  # so ``dataclasses.replace(signal, values=...)`` works
     unit: str
     source: str
 
-    def __post_init__(self) -> None:
-        time_s = np.ascontiguousarray(self.time_s, dtype=np.float64)
-        values = np.ascontiguousarray(self.values, dtype=np.float64)
-        if time_s.ndim != 1 or values.shape != time_s.shape:
+    def __init__(self, *, name: str, time_s: np.ndarray, values: np.ndarray, unit: str, source: str) -> None:
+        time_s = np.ascontiguousarray(time_s, dtype=np.float64)
+        stored = np.ascontiguousarray(values, dtype=_held_dtype(np.asarray(values).dtype))
+        if time_s.ndim != 1 or stored.shape != time_s.shape:
             raise ValueError(
-                f"signal {self.name!r}: time_s {time_s.shape} and values {values.shape} must be 1-D of equal length"
+                f"signal {name!r}: time_s {time_s.shape} and values {stored.shape} must be 1-D of equal length"
             )
-        if not is_canonical(self.name):
-            raise ValueError(f"{self.name!r} is not a canonical signal name")
+        if not is_canonical(name):
+            raise ValueError(f"{name!r} is not a canonical signal name")
         time_s.setflags(write=False)
-        values.setflags(write=False)
-        object.__setattr__(self, "time_s", time_s)
-        object.__setattr__(self, "values", values)
+        stored.setflags(write=False)
+        for attribute, value in (
+            ("name", name),
+            ("time_s", time_s),
+            ("stored_values", stored),
+            ("unit", unit),
+            ("source", source),
+        ):
+            object.__setattr__(self, attribute, value)
+
+    @property
+    def values(self) -> np.ndarray:
+        """Sample values in `unit`, float64, shape (n_samples,), read-only (a new array when held as float32)."""
+        if self.stored_values.dtype == np.float64:
+            return self.stored_values
+        widened = self.stored_values.astype(np.float64)
+        widened.setflags(write=False)
+        return widened
 
     @property
     def samples(self) -> int:

@@ -35,7 +35,7 @@ from flightlogs.errors import DataError, DataQualityWarning, SysidWarning, colle
 from flightlogs.flightlog import FlightLog, Signal
 from flightlogs.frames import air_velocity_body, wind_to_body_axes
 from flightlogs.geo import bearing_and_distance, local_north_east
-from flightlogs.maneuvers.excitation_recovery import estimate_excitation
+from flightlogs.maneuvers.excitation_recovery import ExcitationRecovery
 from flightlogs.maneuvers.segments import Segment, SegmentDetector, segments_from_sid
 from flightlogs.masks import true_runs
 from flightlogs.record import Record
@@ -233,9 +233,9 @@ def _one_pass(log: FlightLog, wind: Any | None, options: ConditioningOptions) ->
         )
     values = resample_signals(cut_by | others, time_base, max_gap_samples=options.max_gap_samples)
     for name, signal in others.items():
-        values[name] = _hold_edges(values[name], time_base, 1.5 / signal.rate_hz if signal.rate_hz > 0 else 0.0)
+        _hold_edges(values[name], time_base, 1.5 / signal.rate_hz if signal.rate_hz > 0 else 0.0)
     if "excitation" in values:  # logged only while a System ID run injects it: zero elsewhere
-        values["excitation"] = np.nan_to_num(values["excitation"], nan=0.0)
+        np.nan_to_num(values["excitation"], nan=0.0, copy=False)
     units = {name: sig.unit for name, sig in (cut_by | others).items()}
     if alignment is not None:
         alignment = _residual(alignment, time_base, values, rate_hz)
@@ -280,29 +280,35 @@ def _say_wind_cut(log: FlightLog, core: dict[str, Signal], time_base: np.ndarray
         warnings.warn(DataQualityWarning(message), stacklevel=3)
 
 
-def _hold_edges(column: np.ndarray, time_base: np.ndarray, max_hold_s: float) -> np.ndarray:
-    """Hold the first and last value of a slower signal over the few core samples it stops short of.
+def _hold_edges(column: np.ndarray, time_base: np.ndarray, max_hold_s: float) -> None:
+    """Hold the first and last value of a slower signal over the few core samples it stops short of, in place.
 
     A 25 Hz estimate that ends 30 ms before the 100 Hz core signals would
-    otherwise leave NaNs at the record's edge and be left out of it.
+    otherwise leave NaNs at the record's edge and be left out of it. In
+    place: the column is a view into the resampler's block of its message,
+    which a copy would keep alive beside it.
     """
     finite = np.flatnonzero(np.isfinite(column))
     if finite.size == 0:
-        return column
+        return
     first, last = finite[0], finite[-1]
-    held = column.copy()
     if time_base[first] - time_base[0] <= max_hold_s:
-        held[:first] = column[first]
+        column[:first] = column[first]
     if time_base[-1] - time_base[last] <= max_hold_s:
-        held[last + 1 :] = column[last]
-    return held
+        column[last + 1 :] = column[last]
 
 
 def _unwrapped(signal: Signal) -> Signal:
     """Heading and its setpoint made continuous before they are interpolated (no jumps at ±π)."""
     if signal.name not in ("psi", "psi_ref"):
         return signal
-    return replace(signal, values=np.unwrap(signal.values), source=f"{signal.source}, unwrapped")
+    return Signal(
+        name=signal.name,
+        time_s=signal.time_s,
+        values=np.unwrap(signal.values),
+        unit=signal.unit,
+        source=f"{signal.source}, unwrapped",
+    )
 
 
 def _wind_signals(log: FlightLog, wind: Any, options: ConditioningOptions) -> tuple[WindAlignment, dict[str, Signal]]:
@@ -541,12 +547,13 @@ def _segments(
 
     detected: list[Segment] = []
     fitted_on: np.ndarray | None = None
+    recovery = ExcitationRecovery(inputs, values, time_s=time_base)
     for _ in range(2):  # fit the feedback where nothing is excited, detect, refit without the maneuvers flown
         unexcited = quiet & ~_near(time_base, flown(detected), 2.0)
         if fitted_on is not None and np.array_equal(unexcited, fitted_on):
             break  # nothing flown to leave out: the refit would repeat the first pass exactly
         fitted_on = unexcited
-        excitation = estimate_excitation(inputs, values, unexcited, time_s=time_base)
+        excitation = recovery.estimate(unexcited)
         detected = [
             segment
             for start, stop, detector in detectors

@@ -354,7 +354,7 @@ def _resample_columns(
         knots = pt if low is None else low.grid
         at = Interpolant(knots, np.clip(tb[first:stop], knots[0], knots[-1]), method)
         for k, column in enumerate(columns):
-            piece = column[i0:i1]
+            piece = column[i0:i1].astype(np.float64, copy=False)
             at(piece if low is None else low(piece), out[first:stop, k])
     return out
 
@@ -492,7 +492,7 @@ def _series_list(signals: Mapping[str, Signal] | Iterable[SeriesLike]) -> list[t
 def _as_series(signal: SeriesLike, default_name: str = "signal") -> tuple[str, np.ndarray, np.ndarray]:
     """Validate a Signal or (time_s, values) pair and return (name, time_s, values)."""
     if isinstance(signal, Signal):
-        name, t, v = signal.name, signal.time_s, signal.values
+        name, t, v = signal.name, signal.time_s, signal.stored_values  # float32 widened a piece at a time
     else:
         try:
             t, v = signal
@@ -500,7 +500,9 @@ def _as_series(signal: SeriesLike, default_name: str = "signal") -> tuple[str, n
             raise DataError(f"{default_name}: expected a Signal or a (time_s, values) pair") from err
         name = default_name
     t = check_times(t, name)
-    v = np.asarray(v, dtype=np.float64)
+    v = np.asarray(v)
+    if v.dtype != np.float32:
+        v = v.astype(np.float64, copy=False)
     if v.shape != t.shape:
         raise DataError(f"{name}: {t.size} times but values of shape {v.shape}")
     if not np.isfinite(v).all():

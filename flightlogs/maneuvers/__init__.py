@@ -5,7 +5,7 @@ The public names of :mod:`~flightlogs.maneuvers.excitation_recovery` and
 name``. Modules with a leading underscore are private.
 """
 
-from flightlogs.maneuvers.excitation_recovery import FEEDBACK_STATES, estimate_excitation
+from flightlogs.maneuvers.excitation_recovery import FEEDBACK_STATES, ExcitationRecovery, estimate_excitation
 from flightlogs.maneuvers.segments import (
     AXES,
     SID_AXES,
@@ -21,6 +21,7 @@ from flightlogs.maneuvers.segments import (
 
 __all__ = [
     "FEEDBACK_STATES",
+    "ExcitationRecovery",
     "estimate_excitation",
     "Axis",
     "Kind",

@@ -18,7 +18,6 @@ excitation there is the input minus that joint fit of the feedback.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import cast
 
 import numpy as np
 
@@ -27,7 +26,7 @@ from flightlogs.maneuvers._detection import _activity, _bursts
 from flightlogs.maneuvers._doublet_fit import fit_doublet
 from flightlogs.masks import true_runs
 
-__all__ = ["FEEDBACK_STATES", "estimate_excitation"]
+__all__ = ["FEEDBACK_STATES", "ExcitationRecovery", "estimate_excitation"]
 
 #: States each axis's controller feeds back (FRD/NED canonical names).
 FEEDBACK_STATES: Mapping[str, tuple[str, ...]] = {
@@ -116,22 +115,72 @@ def estimate_excitation(
     >>> bool(np.allclose(out, e, atol=1e-9))
     True
     """
-    dt = None if time_s is None else _interval(time_s, quiet.size)
-    estimated = {}
-    for axis, values in inputs.items():
-        u = np.asarray(values, dtype=np.float64)
-        names = FEEDBACK_STATES.get(axis, ())
-        if not names or not all(name in states for name in names):
-            estimated[axis] = np.nan_to_num(u)
-            continue
-        x = np.column_stack([np.asarray(states[name], dtype=np.float64) for name in names])
-        finite = np.isfinite(u) & np.all(np.isfinite(x), axis=1)
-        out = _quiet_fit(u, x, quiet & finite)
-        if dt is not None:
-            trusted = bool(np.count_nonzero(quiet & finite) * dt >= _TRUSTED_QUIET_S)
-            out = _with_doublets(u, x, out, trusted, finite, dt, [name in _ANGLES for name in names])
-        estimated[axis] = out
-    return estimated
+    return ExcitationRecovery(inputs, states, time_s=time_s).estimate(quiet)
+
+
+class ExcitationRecovery:
+    """:func:`estimate_excitation` of one record's inputs for one quiet mask after another.
+
+    Segmentation fits the feedback twice (the second time without the
+    maneuvers the first found); the bursts of activity in each raw input do
+    not depend on the mask, so they are found once, on first use.
+
+    Parameters
+    ----------
+    inputs : Mapping[str, ndarray], each shape (n_samples,)
+        Mixer input by axis, as :func:`estimate_excitation`'s.
+    states : Mapping[str, ndarray], each shape (n_samples,)
+        Canonical signals on the same time base.
+    time_s : ndarray, shape (n_samples,), optional
+        Uniform sample times, s (without them, only the quiet-sample fit).
+    """
+
+    def __init__(
+        self, inputs: Mapping[str, np.ndarray], states: Mapping[str, np.ndarray], *, time_s: np.ndarray | None = None
+    ) -> None:
+        self._inputs, self._states, self._time_s = inputs, states, time_s
+        self._raw: dict[str, tuple[float, list[tuple[int, int]]]] = {}  # by axis: the input's median and bursts
+
+    def estimate(self, quiet: np.ndarray) -> dict[str, np.ndarray]:
+        """The inputs with the feedback fitted on `quiet` removed.
+
+        Parameters
+        ----------
+        quiet : ndarray of bool, shape (n_samples,)
+            Samples with no excitation, where the feedback law is fitted.
+
+        Returns
+        -------
+        dict of ndarray
+            As :func:`estimate_excitation`.
+
+        Raises
+        ------
+        DataError
+            If `time_s` does not match the inputs or is not uniform.
+        """
+        dt = None if self._time_s is None else _interval(self._time_s, quiet.size)
+        estimated = {}
+        for axis, values in self._inputs.items():
+            u = np.asarray(values, dtype=np.float64)
+            names = FEEDBACK_STATES.get(axis, ())
+            if not names or not all(name in self._states for name in names):
+                estimated[axis] = np.nan_to_num(u)
+                continue
+            # the states as columns, not an (n, 3) copy: the regressors are built where fitted, a block at a time
+            x = [np.asarray(self._states[name], dtype=np.float64) for name in names]
+            finite = np.isfinite(u)
+            for column in x:
+                finite &= np.isfinite(column)
+            out = _quiet_fit(u, x, quiet & finite)
+            if dt is not None:
+                if axis not in self._raw:
+                    self._raw[axis] = _raw_bursts(u, finite, dt)
+                trusted = bool(np.count_nonzero(quiet & finite) * dt >= _TRUSTED_QUIET_S)
+                angles = [name in _ANGLES for name in names]
+                out = _with_doublets(u, x, out, trusted, finite, dt, angles, self._raw[axis])
+            estimated[axis] = out
+        return estimated
 
 
 def _interval(time_s: np.ndarray, n: int) -> float:
@@ -145,18 +194,42 @@ def _interval(time_s: np.ndarray, n: int) -> float:
     return dt
 
 
-def _quiet_fit(u: np.ndarray, x: np.ndarray, usable: np.ndarray) -> np.ndarray:
-    """Input minus ``K x + c0`` fitted on the usable quiet samples, or minus its median if too few (NaN as 0)."""
+def _quiet_fit(u: np.ndarray, x: list[np.ndarray], usable: np.ndarray) -> np.ndarray:
+    """Input minus ``K x + c0`` fitted on the usable quiet samples, or minus its median if too few (NaN as 0).
+
+    `x` holds the states, each shape (n,). The feedback is subtracted
+    `_BLOCK` samples at a time: an (n, 4) matrix of regressors would be the
+    largest array of the whole segmentation on a long log.
+    """
     if usable.sum() < _MIN_FIT_SAMPLES:
         finite = np.isfinite(u)
         return np.nan_to_num(u - (np.median(u[finite]) if finite.any() else 0.0))
-    regressors = np.column_stack([x, np.ones(u.size)])
-    gains, *_ = np.linalg.lstsq(regressors[usable], u[usable], rcond=None)
-    return cast(np.ndarray, np.nan_to_num(u - regressors @ gains))
+    gains, *_ = np.linalg.lstsq(_regressors(x, usable), u[usable], rcond=None)
+    out = np.empty(u.size)
+    for start in range(0, u.size, _BLOCK):
+        rows = slice(start, start + _BLOCK)
+        np.subtract(u[rows], _regressors(x, rows) @ gains, out=out[rows])
+    return np.nan_to_num(out, copy=False)
+
+
+_BLOCK = 65_536  # samples of regressors built at once
+
+
+def _regressors(x: list[np.ndarray], rows: np.ndarray | slice) -> np.ndarray:
+    """The states at `rows` and a column of ones, shape (n_rows, len(x) + 1)."""
+    columns = [column[rows] for column in x]
+    return np.column_stack([*columns, np.ones(columns[0].size)])
 
 
 def _with_doublets(
-    u: np.ndarray, x: np.ndarray, base: np.ndarray, trusted: bool, finite: np.ndarray, dt: float, angles: list[bool]
+    u: np.ndarray,
+    x: list[np.ndarray],
+    base: np.ndarray,
+    trusted: bool,
+    finite: np.ndarray,
+    dt: float,
+    angles: list[bool],
+    raw: tuple[float, list[tuple[int, int]]],
 ) -> np.ndarray:
     """`base` with the joint fit of feedback and doublet (or 3-2-1-1) put in around the bursts one explains.
 
@@ -165,7 +238,7 @@ def _with_doublets(
     long quiet fit averages the feedback better than a few seconds around
     one burst.
     """
-    bursts = _candidates(base, u, finite, dt)
+    bursts = _candidates(base, u, finite, dt, raw)
     pad = int(round((_PAD_S if trusted else _WIDE_PAD_S) / dt))
     gap, out = int(round(_GAP_S / dt)), base.copy()
     pieces = [(start, stop - 1) for start, stop in true_runs(finite)]  # inclusive, as the bursts
@@ -178,7 +251,7 @@ def _with_doublets(
         burst = (a - lo, b - lo)
         if trusted and fit_doublet(base[lo : hi + 1], np.zeros((hi - lo + 1, 0)), dt, burst) is not None:
             continue  # the quiet-sample fit shows the doublet on its own
-        window = x[lo : hi + 1].copy()
+        window = np.column_stack([column[lo : hi + 1] for column in x])
         window[:, angles] = np.unwrap(window[:, angles], axis=0)
         fit = fit_doublet(u[lo : hi + 1], window, dt, burst)
         if fit is None:
@@ -188,22 +261,32 @@ def _with_doublets(
     return out
 
 
-def _candidates(base: np.ndarray, u: np.ndarray, finite: np.ndarray, dt: float) -> list[tuple[int, int]]:
+def _raw_bursts(u: np.ndarray, finite: np.ndarray, dt: float) -> tuple[float, list[tuple[int, int]]]:
+    """The median of the input where finite, and the first and last sample of each burst of activity in it."""
+    median = float(np.median(u[finite])) if finite.any() else 0.0
+    return median, _bursts_in(np.where(finite, u - median, 0.0), dt)
+
+
+def _bursts_in(trace: np.ndarray, dt: float) -> list[tuple[int, int]]:
+    activity = _activity(trace, dt, _THRESHOLD, _TREND_S)
+    return [(b.first, b.last) for b in _bursts("", activity, dt, _THRESHOLD, _MERGE_S, _MIN_ACTIVE_S)]
+
+
+def _candidates(
+    base: np.ndarray, u: np.ndarray, finite: np.ndarray, dt: float, raw: tuple[float, list[tuple[int, int]]]
+) -> list[tuple[int, int]]:
     """First and last sample of the bursts of activity in `base` or in the raw input, merged when closer than the pad.
 
     The raw closed-loop input shows every doublet (the loop's reaction is
     loud); `base` may show it where a poor fit of the feedback hides it.
     Bursts less than `_PAD_S` apart are fitted together, so a doublet is
     only accepted where nothing else happens within that distance (the
-    pulses of a 3-2-1-1 are one burst that no doublet explains).
+    pulses of a 3-2-1-1 are one burst that no doublet explains). `raw` is
+    the input's median and bursts (:func:`_raw_bursts`).
     """
-    raw = np.where(finite, u - (np.median(u[finite]) if finite.any() else 0.0), 0.0)
-    traces = (raw,) if np.array_equal(raw, base) else (base, raw)
-    found = sorted(
-        (b.first, b.last)
-        for trace in traces
-        for b in _bursts("", _activity(trace, dt, _THRESHOLD, _TREND_S), dt, _THRESHOLD, _MERGE_S, _MIN_ACTIVE_S)
-    )
+    median, raw_bursts = raw
+    same = np.array_equal(np.where(finite, u - median, 0.0), base)
+    found = sorted(raw_bursts if same else [*_bursts_in(base, dt), *raw_bursts])
     merged: list[tuple[int, int]] = []
     for a, b in found:
         if merged and (a - merged[-1][1]) * dt < _PAD_S:

@@ -31,7 +31,7 @@ HEAD1, HEAD2, FMT_TYPE = 0xA3, 0x95, 0x80
 LISTED = 8  # gaps or resets spelled out in warnings before summarising
 _SCAN_BLOCK = 1 << 22  # bytes compared at a time in the header scan
 _GATHER_BLOCK = 1 << 16  # messages copied at a time when the pages read are given back
-_GATHER_SPAN = 8 << 20  # bytes of the file read at most before they are given back
+GATHER_SPAN = 8 << 20  # bytes of the file read at most before they are given back
 _FMT = DFFormat(FMT_TYPE, "FMT", 89, "BBnNZ", "Type,Length,Name,Format,Columns")  # as DFReader
 _NUMPY_CODE = {
     "b": "i1",
@@ -326,7 +326,7 @@ def gather(buf: np.ndarray, offsets: np.ndarray, length: int, release: Release |
     if release is None:
         return cast(np.ndarray, windows[offsets])
     out = np.empty((offsets.size, length), np.uint8)
-    spans = np.searchsorted(offsets, np.arange(_GATHER_SPAN, int(offsets[-1]) + 1, _GATHER_SPAN))
+    spans = np.searchsorted(offsets, np.arange(GATHER_SPAN, int(offsets[-1]) + 1, GATHER_SPAN))
     # a table sparse in the file touches every page in one block of messages (the kernel maps
     # the pages around each one read): blocks end every span of bytes as well
     ends = np.union1d(spans, np.arange(_GATHER_BLOCK, offsets.size, _GATHER_BLOCK)).tolist() + [offsets.size]

@@ -19,7 +19,9 @@ def make_signal(name: str, time_s: np.ndarray, values: np.ndarray, unit: str, so
     signal with no sample left is omitted (it will be reported missing).
     """
     time_s = np.asarray(time_s, dtype=np.float64)
-    values = np.asarray(values, dtype=np.float64)
+    values = np.asarray(values)  # a float32 field stays float32 in the Signal (exact, half the memory)
+    if values.dtype.kind not in "fiub":
+        values = values.astype(np.float64)
     keep = np.isfinite(time_s) & np.isfinite(values)
     if time_s.size:
         # keep only samples that move time forward (drop duplicates and jumps back)

@@ -76,6 +76,23 @@ _TYPES = (
     "MSG",
     "RCIN",
 )
+_MOTOR_CHANNELS = tuple(f"{prefix}{k}" for prefix in ("C", "Ch") for k in range(1, 13))  # up to DODECAHEXA's 12
+#: The columns the mapping reads, decoded in one pass over the file (a column not listed is decoded when read).
+_COLUMNS: dict[str, tuple[str, ...]] = {
+    "IMU": ("GyrX", "GyrY", "GyrZ", "AccX", "AccY", "AccZ"),
+    "ATT": ("Roll", "Pitch", "Yaw", "DesRoll", "DesPitch", "DesYaw"),
+    "RATE": ("ROut", "POut", "YOut", "AOut", "RDes", "PDes", "YDes"),
+    "CTUN": ("ThO", "ThrOut", "Alt"),
+    "RCOU": _MOTOR_CHANNELS,
+    "RCIN": tuple(f"C{k}" for k in range(1, 17)),
+    "BAT": ("Volt",),
+    "CURR": ("Volt",),
+    "RFND": ("Dist", "Dist1"),
+    **{name: ("VN", "VE", "VD") for name in ("XKF1", "NKF1", "EKF1")},
+    **{name: ("VWN", "VWE") for name in ("XKF2", "NKF2", "EKF2")},
+    "GPS": ("Status", "Lat", "Lng", "GWk", "GMS", "Week"),
+    "SIDD": ("Targ",),
+}
 _GPS_FIX_3D = 3  # GPS.Status: 3 = 3-D fix, 4-6 DGPS and RTK
 _GPS_EPOCH_UNIX = 315964800  # 1980-01-06T00:00:00Z
 _LEAP_DATES = (
@@ -162,7 +179,7 @@ def read_dataflash(path: str | Path, *, progress: Callable[[int, int], None] | N
         As :func:`~flightlogs.readers.dataflash.decode_messages` and
         :func:`flightlog_from_messages`.
     """
-    return flightlog_from_messages(read_messages(path, types=_TYPES, progress=progress))
+    return flightlog_from_messages(read_messages(path, types=_TYPES, columns=_COLUMNS, progress=progress))
 
 
 def flightlog_from_messages(messages: DataFlashMessages) -> FlightLog:
@@ -223,10 +240,10 @@ def _flightlog(messages: DataFlashMessages) -> FlightLog:
             return
         if id(table) not in times:
             times[id(table)] = (table, table.time_s)
-        time_s, values = times[id(table)][1], table[column].astype(np.float64)
+        time_s, values = times[id(table)][1], table[column]  # a float32 field is kept so (Signal)
         if time_s is None:
             return
-        signal = make_signal(name, time_s, convert(values) if convert else values, unit, source)
+        signal = make_signal(name, time_s, convert(values.astype(np.float64)) if convert else values, unit, source)
         if signal is not None:
             signals[name] = signal
 

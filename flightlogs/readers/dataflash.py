@@ -49,6 +49,7 @@ from pymavlink.DFReader import FORMAT_TO_STRUCT, MULT_TO_PREFIX
 from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogFormatError, collected_warnings
 from flightlogs.readers._dataflash_frame import (  # noqa: F401  (kept importable from here)
     FMT_TYPE,
+    GATHER_SPAN,
     HEAD1,
     HEAD2,
     LISTED,
@@ -132,8 +133,8 @@ class MessageTable:
             return cols["TimeMS"].astype(np.float64) / 1e3
         return None
 
-    def select(self, rows: np.ndarray) -> MessageTable:
-        """Return the messages picked by a boolean mask or index array."""
+    def select(self, rows: np.ndarray | slice) -> MessageTable:
+        """Return the messages picked by a boolean mask, an index array or a slice."""
         if isinstance(self.columns, _LazyColumns):
             return MessageTable(format=self.format, columns=self.columns.select(rows), offsets=self.offsets[rows])
         return MessageTable(
@@ -220,6 +221,7 @@ def read_messages(
     path: str | Path,
     *,
     types: Collection[str] | None = None,
+    columns: Mapping[str, Collection[str]] | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> DataFlashMessages:
     """Read and decode a DataFlash ``.bin`` log.
@@ -230,6 +232,12 @@ def read_messages(
         The log file.
     types : collection of str, optional
         Names to decode (all when None); FMTU, UNIT and MULT are always read.
+    columns : Mapping[str, collection of str], optional
+        Columns by message name to decode at once, in one pass over the
+        file with every table's clock (``TimeUS``, ``TimeMS``, ``T``) and
+        instance column; the others are decoded when first read, a table's
+        messages copied out of the file each time. A reader that knows what
+        it maps reads each page of the file once this way.
     progress : callable, optional
         ``progress(done, total)`` in bytes while decoding.
 
@@ -250,7 +258,7 @@ def read_messages(
         raise LogFormatError(
             f"{path}: cannot be read ({getattr(err, 'strerror', None) or err}) at byte offset 0."
         ) from err
-    return _decode(data, path, types, progress, release)
+    return _decode(data, path, types, progress, release, columns)
 
 
 def decode_messages(
@@ -314,6 +322,7 @@ def _decode(
     types: Collection[str] | None,
     progress: Callable[[int, int], None] | None,
     release: Release | None,
+    columns: Mapping[str, Collection[str]] | None = None,
 ) -> DataFlashMessages:
     """:func:`decode_messages` of bytes in memory or (with `release`) memory-mapped from `path`."""
     size = int(buf.size)
@@ -352,6 +361,8 @@ def _decode(
                 done += offsets.size * fmt.length
                 if progress is not None:
                     progress(min(done, size), size)
+        if columns is not None:
+            _prefetch(buf, tables, columns, release)
         for message in _time_resets(tables):
             warnings.warn(DataQualityWarning(message), stacklevel=2)
         if progress is not None:
@@ -434,6 +445,7 @@ class _LazyColumns(Mapping[str, np.ndarray]):
         self._fmt, self._offsets, self._dtype, self._chars = fmt, offsets, dtype, chars
         self._field = {name: i for i, name in enumerate(fmt.columns[: len(chars)])}  # a repeated name: its last
         self._decoded = decoded if decoded is not None else {}
+        self._from_held: set[str] = set()  # columns converted from the held copy: they go with it
 
     def __getitem__(self, name: str) -> np.ndarray:
         column = self._decoded.get(name)
@@ -441,7 +453,7 @@ class _LazyColumns(Mapping[str, np.ndarray]):
             held = self._held
             if held.owner is not self:
                 if held.owner is not None:  # the previous table's copy and columns go before this one's are made
-                    held.owner._decoded.clear()
+                    held.owner._drop_held()
                 held.owner, held.messages = None, np.empty(0)
                 held.messages = (
                     gather(self._buf, self._offsets, self._fmt.length, self._release).view(self._dtype).ravel()
@@ -451,7 +463,38 @@ class _LazyColumns(Mapping[str, np.ndarray]):
             column = _column(held.messages[f"f{i}"], self._chars[i], self._fmt.name)
             column.flags.writeable = False
             self._decoded[name] = column
+            self._from_held.add(name)
         return column
+
+    @property
+    def dtype(self) -> np.dtype:
+        """Structured dtype of one whole message of this layout (:func:`message_dtype`)."""
+        return self._dtype
+
+    def _drop_held(self) -> None:
+        for name in self._from_held:
+            self._decoded.pop(name, None)
+        self._from_held.clear()
+
+    def prefetched(self, name: str, raw: np.ndarray) -> None:
+        """Keep column `name` converted from its raw field values `raw` (shape (n_messages,)), gathered elsewhere."""
+        column = _column(raw, self._chars[self._field[name]], self._fmt.name)
+        column.flags.writeable = False
+        self._decoded[name] = column
+
+    def wanted_fields(self, names: Collection[str]) -> list[tuple[str, str, np.dtype]]:
+        """``(column, field, raw dtype)`` of the numeric columns among `names` not decoded yet."""
+        fields = self._dtype.fields
+        assert fields is not None  # a structured dtype (layout)
+        found = []
+        for name in names:
+            i = self._field.get(name)
+            if i is None or name in self._decoded or self._chars[i] in _TEXT_FORMATS:
+                continue
+            field = fields[f"f{i}"][0]
+            if field.subdtype is None:
+                found.append((name, f"f{i}", field))
+        return found
 
     def __contains__(self, name: object) -> bool:  # Mapping's would decode the column to answer
         return name in self._field
@@ -482,12 +525,58 @@ class _LazyColumns(Mapping[str, np.ndarray]):
     def __len__(self) -> int:
         return len(self._field)
 
-    def select(self, rows: np.ndarray) -> _LazyColumns:
-        """The same columns for the messages picked by `rows` (a mask or indices)."""
+    def select(self, rows: np.ndarray | slice) -> _LazyColumns:
+        """The same columns for the messages picked by `rows` (a mask or indices); all of them: shared, not copied."""
+        if isinstance(rows, np.ndarray) and rows.dtype == bool and rows.size == self._offsets.size and rows.all():
+            return _LazyColumns(self._buf, self._fmt, self._offsets, self._release, self._held, dict(self._decoded))
         decoded = {name: column[rows] for name, column in self._decoded.items()}
         for column in decoded.values():
             column.flags.writeable = False
         return _LazyColumns(self._buf, self._fmt, self._offsets[rows], self._release, self._held, decoded)
+
+
+_CLOCK_COLUMNS = ("TimeUS", "TimeMS", "T")
+
+
+def _prefetch(
+    buf: np.ndarray, tables: Mapping[str, MessageTable], columns: Mapping[str, Collection[str]], release: Release | None
+) -> None:
+    """Decode the `columns` of each table, with its clock and instance columns, in one pass over `buf`.
+
+    A span of the file at a time (8 MB): each table's messages in it are
+    copied out, their wanted fields kept, and the span's pages given back;
+    each page is read once, where reading one table after another read
+    every page once per table (a sparse table touches them all).
+    """
+    jobs = []
+    for table in tables.values():
+        lazy = table.columns
+        if not isinstance(lazy, _LazyColumns) or not len(table):
+            continue
+        names = {*columns.get(table.format.name, ()), *_CLOCK_COLUMNS, *_INSTANCE_COLUMNS}
+        fields = lazy.wanted_fields(sorted(names))
+        if fields:
+            raw = {name: np.empty(len(table), dtype) for name, _, dtype in fields}
+            jobs.append((lazy, table.offsets, table.format.length, fields, raw))
+    if not jobs:
+        return
+    ends = np.arange(GATHER_SPAN, buf.size + GATHER_SPAN, GATHER_SPAN)
+    cuts = [np.searchsorted(offsets, ends).tolist() for _, offsets, *_ in jobs]
+    done, starts = 0, [0] * len(jobs)
+    for s, end in enumerate(ends.tolist()):
+        for j, (lazy, offsets, length, fields, raw) in enumerate(jobs):
+            lo, hi = starts[j], cuts[j][s]
+            if hi > lo:
+                messages = gather(buf, offsets[lo:hi], length).view(lazy.dtype).ravel()
+                for name, field, _ in fields:
+                    raw[name][lo:hi] = messages[field]
+                starts[j] = hi
+        if release is not None:
+            release(done, end)
+        done = end
+    for lazy, _, _, fields, raw in jobs:
+        for name, _, _ in fields:
+            lazy.prefetched(name, raw.pop(name))
 
 
 def _column(raw: np.ndarray, char: str, message: str) -> np.ndarray:
@@ -568,9 +657,12 @@ def _time_resets(tables: dict[str, MessageTable]) -> list[str]:
     last_time: dict[str, float] = {}
     for key, table in tables.items():
         column = next((c for c in ("TimeUS", "TimeMS") if c in table.columns and _numeric(table.format, c)), None)
-        if column is None or not len(table) or key.startswith("GPS") or table.time_s is None:
-            continue
-        name, stamp = key.split("@")[0], table[column].astype(np.int64)
+        if column is None or not len(table) or key.startswith("GPS"):
+            continue  # (with a numeric TimeUS or TimeMS, a table other than GPS has its time_s)
+        lazy = table.columns
+        # the clock's bytes alone: the whole messages are copied only for the tables a reader maps
+        stamp = (lazy.peek(column) if isinstance(lazy, _LazyColumns) else table[column]).astype(np.int64)
+        name = key.split("@")[0]
         drops = np.flatnonzero(np.diff(stamp) < -(10**6 if column == "TimeUS" else 10**3))
         if not drops.size and name not in last_time:
             last_time[name] = stamp[-1] / (1e6 if column == "TimeUS" else 1e3)

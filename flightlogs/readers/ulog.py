@@ -538,15 +538,15 @@ def _usable(
 
 def _convert(source: TopicSource, data: Mapping[str, np.ndarray]) -> tuple[list[np.ndarray], np.ndarray]:
     """Apply the source's conversion; return one column per signal and a mask of usable samples."""
-    columns = [np.asarray(data[field], dtype=np.float64) for field in source.fields]
+    columns = [np.asarray(data[field]) for field in source.fields]  # as logged: a float32 field stays so (Signal)
     usable = np.ones(columns[0].shape, dtype=bool)
     if source.conversion == "negate":
-        columns = [-column for column in columns]
+        columns = [-column.astype(np.float64) if column.dtype.kind in "iub" else -column for column in columns]
     elif source.conversion in ("degrees", "degrees_e7"):
         scale = 1e-7 if source.conversion == "degrees_e7" else 1.0
-        columns = [np.deg2rad(column * scale) for column in columns]
+        columns = [np.deg2rad(column.astype(np.float64) * scale) for column in columns]
     elif source.conversion == "quaternion_to_euler":
-        quaternion = np.column_stack(columns)
+        quaternion = np.column_stack(columns).astype(np.float64)
         norm = np.linalg.norm(quaternion, axis=1)
         usable = np.isfinite(norm) & (norm > 0.5)  # an all-zero quaternion is "not set"
         quaternion[~usable] = np.nan

@@ -215,7 +215,7 @@ def _write_log(group: h5py.Group, log: FlightLog) -> None:
         put_text(sub.attrs, "unit", signal.unit)
         put_text(sub.attrs, "source", signal.source)
         sub["time_s"] = times.dataset(signal.time_s)
-        sub.create_dataset("values", data=_narrowed(signal.values))
+        sub.create_dataset("values", data=_narrowed(signal.stored_values))
 
 
 def _table(fields: Sequence[tuple[str, str]], rows: Sequence[tuple[Any, ...]]) -> np.ndarray:
@@ -244,7 +244,7 @@ def _read_log(group: h5py.Group) -> FlightLog:
         name: Signal(
             name=name,
             time_s=sub["time_s"][()],
-            values=sub["values"][()].astype(np.float64, copy=False),
+            values=sub["values"][()],  # float32 where the log logged float32: held so (Signal)
             unit=text(sub.attrs["unit"]),
             source=text(sub.attrs["source"]),
         )

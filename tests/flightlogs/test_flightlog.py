@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -29,6 +30,37 @@ def test_signal_arrays_are_read_only() -> None:
     signal = _signal("p")
     with pytest.raises(ValueError):
         signal.values[0] = 1.0
+
+
+@pytest.mark.parametrize(
+    ("given", "held"),
+    [
+        (np.float32, np.float32),  # a log's float32 field: half the memory, every value exact
+        (np.uint16, np.float32),  # a PWM: exact in float32
+        (np.int16, np.float32),
+        (np.bool_, np.float32),
+        (np.int32, np.float64),  # 2**24 + 1 is not a float32
+        (np.float64, np.float64),
+    ],
+)
+def test_signal_holds_a_narrow_field_narrow_and_gives_float64(given: type, held: type) -> None:
+    raw = np.array([0, 1, 7, 100], dtype=given) if given is not np.bool_ else np.array([0, 1, 1, 0], dtype=bool)
+    if given is np.float32:
+        raw = np.array([0.1, -2.5e-7, 3.4e38, 1 / 3], dtype=np.float32)
+    if given is np.int32:
+        raw = np.array([0, 2**24 + 1, -(2**31), 2**31 - 1], dtype=np.int32)
+    signal = Signal(name="q", time_s=np.arange(4.0), values=raw, unit="rad/s", source="test")
+    assert signal.stored_values.dtype == held
+    assert signal.values.dtype == np.float64
+    assert np.array_equal(signal.values, raw.astype(np.float64))  # exact: nothing rounded either way
+    assert not signal.values.flags.writeable and not signal.stored_values.flags.writeable
+
+
+def test_a_signal_replaced_with_new_values_holds_them() -> None:
+    signal = Signal(name="psi", time_s=np.arange(3.0), values=np.float32([3.0, -3.0, 3.0]), unit="rad", source="t")
+    unwrapped = replace(signal, values=np.unwrap(signal.values), source="t, unwrapped")
+    assert unwrapped.stored_values.dtype == np.float64 and unwrapped.source == "t, unwrapped"
+    assert np.allclose(unwrapped.values, [3.0, 2 * np.pi - 3.0, 3.0])
 
 
 @pytest.mark.parametrize(

@@ -65,6 +65,19 @@ def test_signal_equals_dfreader_field_sample_for_sample(real_data: Path, where, 
     np.testing.assert_array_equal(log[name].values, convert(values) if convert else values)
 
 
+def test_float32_and_pwm_fields_are_held_in_float32_converted_ones_in_float64(real_data: Path) -> None:
+    log = read_warned(read_dataflash, real_data.joinpath(*SAMPLE))
+    held = {name: log[name].stored_values.dtype for name in ("p", "az", "delta_lat", "motor_3", "phi", "psi")}
+    # IMU and RATE fields are float32, RCOU uint16; the angles are converted from degrees
+    assert held == {"p": np.float32, "az": np.float32, "delta_lat": np.float32, "motor_3": np.float32} | {
+        "phi": np.float64,
+        "psi": np.float64,
+    }
+    signals = log.signals.values()
+    held_bytes = sum(s.stored_values.nbytes for s in signals)
+    assert held_bytes < 0.7 * sum(s.values.nbytes for s in signals)  # what float64 would hold
+
+
 @pytest.mark.parametrize("where", [SAMPLE, LOG171], ids=lambda w: w[1])
 def test_yaw_is_wrapped_to_minus_pi_pi(real_data: Path, where) -> None:
     path = real_data.joinpath(*where)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import array
 import functools
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -105,7 +106,7 @@ def test_gathering_a_block_at_a_time_with_release_copies_the_same_bytes() -> Non
 def test_a_table_sparse_in_the_file_gives_its_pages_back_every_few_megabytes() -> None:
     """A message every 64 kB: the kernel maps the pages around each one read, so a block of messages
     counted (65 536 of them) would hold the whole file; the span of bytes read ends a block too."""
-    from flightlogs.readers._dataflash_frame import _GATHER_SPAN, gather
+    from flightlogs.readers._dataflash_frame import GATHER_SPAN, gather
 
     buf = np.zeros(96 << 20, np.uint8)
     offsets = np.arange(0, buf.size - 40, 1 << 16, dtype=np.int64)  # 1536 messages, far fewer than a block
@@ -113,8 +114,8 @@ def test_a_table_sparse_in_the_file_gives_its_pages_back_every_few_megabytes() -
     released: list[tuple[int, int]] = []
     blocks = gather(buf, offsets, 40, lambda lo, hi: released.append((lo, hi)))
     np.testing.assert_array_equal(blocks[:, 0], np.arange(offsets.size) % 251)
-    assert max(hi - lo for lo, hi in released) <= _GATHER_SPAN + (1 << 16)  # one message past the span at most
-    assert released[0][0] == 0 and released[-1][1] == buf.size and len(released) >= buf.size // _GATHER_SPAN
+    assert max(hi - lo for lo, hi in released) <= GATHER_SPAN + (1 << 16)  # one message past the span at most
+    assert released[0][0] == 0 and released[-1][1] == buf.size and len(released) >= buf.size // GATHER_SPAN
 
 
 def test_units_and_instance_fields_equal_dfreader(real_data: Path) -> None:
@@ -309,3 +310,55 @@ def test_message_dtype_follows_pymavlink_struct_sizes() -> None:
     assert message_dtype("a").itemsize == 3 + 64 and message_dtype("a")["f0"].shape == (32,)
     block = MessageBlock(standard_block("RCOU", TimeUS=[1]).spec, standard_block("RCOU", TimeUS=[1]).data)
     assert len(decode_messages(encode_dataflash([block]))["RCOU"]) == 1
+
+
+def _every_column(messages: DataFlashMessages) -> dict[str, tuple[str, ...]]:
+    return {table.format.name: table.format.columns for table in messages.tables.values()}
+
+
+@pytest.mark.parametrize("where", [SAMPLE, LOG171], ids=lambda w: w[1])
+def test_columns_decoded_in_one_pass_equal_those_decoded_table_by_table(real_data: Path, where) -> None:
+    path = real_data.joinpath(*where)
+    one_by_one = read_messages(path)
+    for columns in (_every_column(one_by_one), {"IMU": ("GyrX",)}, {}):  # every column; one; only the clocks
+        in_one_pass = read_messages(path, columns=columns)
+        assert list(in_one_pass.tables) == list(one_by_one.tables)
+        for name in one_by_one.tables:
+            split, whole = in_one_pass.instances(name), one_by_one.instances(name)
+            assert split.keys() == whole.keys()
+            for instance, table in split.items():
+                for column, values in whole[instance].columns.items():
+                    np.testing.assert_array_equal(table[column], values, err_msg=f"{name}[{instance}].{column}")
+        assert_tables_equal(in_one_pass, one_by_one)
+        assert in_one_pass.warnings == one_by_one.warnings
+
+
+@pytest.mark.parametrize("which", ["synthetic System ID", "sample"])
+def test_the_ardupilot_mapping_reads_every_page_of_the_file_once(
+    real_data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, which: str
+) -> None:
+    """The columns it maps are decoded in the one pass: no table's messages are copied out again after it."""
+    import sys
+
+    import flightlogs.readers.dataflash as dataflash
+    from flightlogs.readers.ardupilot import _COLUMNS, _TYPES, flightlog_from_messages
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "benchmarks"))
+    from bench_dataflash import synthetic_log
+
+    path = synthetic_log(tmp_path / "sysid.bin", 20.0) if which != "sample" else real_data.joinpath(*SAMPLE)
+    messages = read_messages(path, types=_TYPES, columns=_COLUMNS)
+    first = {int(t.offsets[0]): t.format.name for t in messages.tables.values() if len(t)}
+    copied: list[str] = []
+    original = dataflash.gather
+
+    def counting(buf: np.ndarray, offsets: np.ndarray, *args: object, **kwargs: object) -> np.ndarray:
+        copied.append(first.get(int(offsets[0]), "?") if offsets.size else "")
+        return original(buf, offsets, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(dataflash, "gather", counting)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataQualityWarning)  # the sample's EKF wind is zero throughout
+        log = flightlog_from_messages(messages)
+    assert {"p", "phi", "delta_lat", "motor_1"} <= set(log.signals)
+    assert [name for name in copied if name in _COLUMNS] == []  # PARM, MSG (text) are read as they come

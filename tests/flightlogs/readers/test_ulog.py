@@ -158,6 +158,8 @@ def test_modern_log_matches_pyulog_sample_for_sample(real_data: Path) -> None:
     for name, (topic, field, sign) in pairs.items():
         np.testing.assert_array_equal(log[name].time_s, _seconds(raw[topic]["timestamp"]), err_msg=name)
         np.testing.assert_array_equal(log[name].values, sign * raw[topic][field].astype(np.float64), err_msg=name)
+    held = {name: log[name].stored_values.dtype for name in ("p", "vd", "height_agl", "phi")}
+    assert held == {"p": np.float32, "vd": np.float32, "height_agl": np.float32, "phi": np.float64}  # phi: from q
     # facts of the flight (README): 28.5-31.0 V pack, hover thrust ~0.62-0.66 (positive = more thrust)
     assert 28.0 < log["battery_v"].values.min() and log["battery_v"].values.max() < 31.5
     airborne = (log["delta_thr"].time_s > 110) & (log["delta_thr"].time_s < 190)

@@ -64,7 +64,7 @@ def test_round_trip_keeps_every_value(tmp_path: Path) -> None:
     assert read_dataset(out).logs[0].board_id == ""
 
 
-def test_values_a_log_held_in_float32_are_stored_in_float32_and_read_back_in_float64(tmp_path: Path) -> None:
+def test_values_a_log_held_in_float32_are_stored_and_held_in_float32_and_given_in_float64(tmp_path: Path) -> None:
     log = _log(tmp_path / "flight.ulg")
     single = np.float32(np.random.default_rng(3).normal(size=250)).astype(np.float64)  # float32 values, in float64
     signals = dict(log.signals) | {
@@ -76,6 +76,7 @@ def test_values_a_log_held_in_float32_are_stored_in_float32_and_read_back_in_flo
         stored = {name: h5[f"logs/flight/signals/{name}/values"].dtype for name in ("p", "q", "motor_1")}
     assert stored == {"p": np.float32, "q": np.float64, "motor_1": np.float64}  # q and motor_1 need float64
     back = read_dataset(out).logs[0]
+    assert back["p"].stored_values.dtype == np.float32 and back["q"].stored_values.dtype == np.float64
     for name, signal in signals.items():
         assert back[name].values.dtype == np.float64
         np.testing.assert_array_equal(back[name].values, signal.values)
