@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from flightlogs.errors import DataError
-from flightlogs.maneuvers.excitation_recovery import estimate_excitation
+from flightlogs.maneuvers.excitation_recovery import ExcitationRecovery, estimate_excitation
 from flightlogs.maneuvers.segments import detect_segments
 
 from builders import (
@@ -86,6 +86,31 @@ def test_in_a_long_record_the_quiet_fit_finds_the_doublet() -> None:
     (found,) = _maneuvers(t, _excitation(log, quiet, t))
     assert (found.axis, found.kind) == ("lat", "doublet")
     assert abs(found.start_s - 20.0) <= ONE_SAMPLE_S and abs(found.end_s - 22.0) <= ONE_SAMPLE_S
+
+
+@pytest.mark.parametrize("seed", [0, 7])
+def test_one_recovery_for_both_passes_gives_what_two_fresh_estimates_give(seed: int, monkeypatch) -> None:
+    """Segmentation's two passes share an ExcitationRecovery: the raw input's bursts, found in the first pass,
+    are not searched for again in the second; each pass's excitation is bitwise what a fresh estimate gives."""
+    import flightlogs.maneuvers.excitation_recovery as recovery_module
+
+    t = np.arange(2000) * DT
+    injected = doublet_input(t, 3.0, 1.0) + doublet_input(t, 10.0, 0.5)
+    log = closed_loop_roll_hold(injected, seed, GUST["strong"])
+    states = {name: log[name] for name in ("p", "phi", "ve")}
+    traces: list[int] = []
+    original = recovery_module._activity
+    monkeypatch.setattr(recovery_module, "_activity", lambda x, *a: traces.append(x.size) or original(x, *a))
+    recovery = ExcitationRecovery({"lat": log["u"]}, states, time_s=t)
+    searched = []  # activities computed by the shared recovery, then by a fresh estimate, in each pass
+    for quiet in (np.ones(t.size, dtype=bool), (t < 2.0) | ((t > 6.0) & (t < 9.0)) | (t > 12.0)):
+        traces.clear()
+        shared = recovery.estimate(quiet)["lat"]
+        searched.append(len(traces))
+        traces.clear()
+        np.testing.assert_array_equal(shared, estimate_excitation({"lat": log["u"]}, states, quiet, time_s=t)["lat"])
+        searched.append(len(traces))
+    assert searched[0] == searched[1] and searched[2] == searched[3] - 1  # the raw input's, once
 
 
 def test_units_do_not_matter() -> None:
