@@ -105,11 +105,7 @@ def render_discrepancy_report(
         The model file in the simulation's place, if it was one.
     """
     findings: list[dict[str, Any]] = [{"finding": f, "svg": finding_figure(f)} for f in result.findings]
-    screened = [
-        {"effect": effect, "score": score, "threshold": result.screened.get(f"{effect}_threshold")}
-        for effect, score in result.screened.items()
-        if not effect.endswith("_threshold")
-    ]
+    screened = [{"effect": t.effect, "score": t.score, "threshold": t.threshold} for t in result.screened]
     return render_html(
         "discrepancy.html",
         title=title,

@@ -6,16 +6,25 @@ import functools
 import os
 import sys
 from collections.abc import Callable, Iterator
-from contextlib import ExitStack, contextmanager
+from contextlib import ExitStack, contextmanager, redirect_stdout
+from contextvars import ContextVar
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, TextIO
 
 import click
 
 from flightlogs.errors import DataError
 from flightlogs.writers.jsonio import json_text, write_json
 
-__all__ = ["OutputPath", "SysidCommand", "json_option", "emit_json", "progress_bar", "staged_progress"]
+__all__ = [
+    "OutputPath",
+    "SysidCommand",
+    "json_option",
+    "json_owns_stdout",
+    "emit_json",
+    "progress_bar",
+    "staged_progress",
+]
 
 
 class OutputPath(click.Path):
@@ -68,7 +77,7 @@ class OutputPath(click.Path):
 
 
 class SysidCommand(click.Command):
-    """A command whose file outputs are checked before it runs.
+    """A command whose file outputs are checked before it runs, and whose ``--json -`` owns stdout.
 
     An output that is one of the command's input files is refused (it would
     be destroyed); with ``--no-clobber``, added to every command that writes
@@ -76,6 +85,11 @@ class SysidCommand(click.Command):
     sentence and exit code 1, before any work. Otherwise an existing output
     is replaced only once the new one is complete (see
     :func:`flightlogs.writers.atomic.atomic_output`).
+
+    With ``--json -`` the command runs with ``sys.stdout`` pointing at
+    stderr, so its human lines (``click.echo``, ``print``) go there and
+    stdout carries the JSON of :func:`emit_json` alone (see
+    :func:`json_owns_stdout`).
     """
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
@@ -116,7 +130,8 @@ class SysidCommand(click.Command):
                     raise DataError(
                         f"{out}: exists, and --no-clobber leaves it as it is; give another {param.opts[-1]}"
                     )
-        return super().invoke(ctx)
+        with json_owns_stdout(ctx.params.get("json_path")):
+            return super().invoke(ctx)
 
 
 def _is_input(param: click.Parameter) -> bool:
@@ -138,12 +153,52 @@ json_option = click.option(
 )
 
 
+#: The real stdout while a command runs under :func:`json_owns_stdout` (``sys.stdout`` is then stderr).
+_JSON_STDOUT: ContextVar[TextIO | None] = ContextVar("sysid_json_stdout", default=None)
+
+
+@contextmanager
+def json_owns_stdout(json_path: str | None) -> Iterator[None]:
+    """With `json_path` ``-``, send every human line of the block to stderr: stdout is kept for the JSON.
+
+    ``sys.stdout`` is stderr inside the block, so ``click.echo``, ``print``
+    and anything else that writes to ``sys.stdout`` lands on stderr; only
+    :func:`emit_json` writes to the real stdout. Any other `json_path`
+    changes nothing. :class:`SysidCommand` runs every command in this block.
+
+    Parameters
+    ----------
+    json_path : str or None
+        The command's ``--json`` value.
+
+    Examples
+    --------
+    >>> with json_owns_stdout("-"):
+    ...     print("1 log, 2 segments")  # on stderr
+    ...     emit_json({"segments": 2}, "-")
+    {
+      "segments": 2
+    }
+    """
+    if json_path != "-":
+        yield
+        return
+    token = _JSON_STDOUT.set(sys.stdout)
+    try:
+        with redirect_stdout(sys.stderr):
+            yield
+    finally:
+        _JSON_STDOUT.reset(token)
+
+
 def emit_json(summary: dict[str, Any], json_path: str | None) -> None:
-    """Write `summary` as JSON (NaN as null) to a file (atomically) or to stdout for ``-``."""
+    """Write `summary` as JSON (NaN as null) to a file (atomically) or, for ``-``, to the real stdout."""
     if json_path is None:
         return
     if json_path == "-":
-        sys.stdout.write(json_text(summary, indent=2))
+        stdout = _JSON_STDOUT.get() or sys.stdout
+        stdout.write(json_text(summary, indent=2))
+        stdout.flush()
         return
     write_json(json_path, summary, indent=2)
 

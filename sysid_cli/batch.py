@@ -170,7 +170,7 @@ def batch(
         write_fleet_report(report, result, run=run, drift=drift)
     summary = _summary(result, tables, report, seconds, n_workers)
     if not quiet:
-        _print(summary, to_stderr=json_path == "-")
+        _print(summary)
     emit_json(summary, json_path)
 
 
@@ -207,10 +207,8 @@ def _summary(
     }
 
 
-def _print(summary: dict[str, Any], *, to_stderr: bool) -> None:
-    def say(text: str = "") -> None:
-        click.echo(text, err=to_stderr)
-
+def _print(summary: dict[str, Any]) -> None:
+    say = click.echo
     say(
         f"{summary['logs']} logs, {summary['groups']} groups ({summary['fitted']} fitted, {summary['cached']} logs "
         f"and groups from the cache) in {summary['seconds']:.1f} s on {summary['workers']} workers"

@@ -264,7 +264,7 @@ def fit(
         "report": str(report) if report else None,
     }
     if not quiet:
-        _print_fit(summary, model.guidelines, to_stderr=json_path == "-")
+        _print_fit(summary, model.guidelines)
     emit_json(summary, json_path)
 
 
@@ -289,10 +289,8 @@ def print_modes(rows: list[dict[str, Any]], say: Any) -> None:
         )
 
 
-def _print_fit(summary: dict[str, Any], guidelines: Guidelines, *, to_stderr: bool) -> None:
-    def say(text: str = "") -> None:
-        click.echo(text, err=to_stderr)
-
+def _print_fit(summary: dict[str, Any], guidelines: Guidelines) -> None:
+    say = click.echo
     say(
         f"model {summary['model']}: J_ave = {summary['cost']['average']:.2f} (guideline <= {guidelines.j_average_good:g})"
     )

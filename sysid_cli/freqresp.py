@@ -228,7 +228,7 @@ def freqresp(
         "notes": list(computed.notes)
     }
     if not quiet:
-        _print_summary(summary, to_stderr=json_path == "-")
+        _print_summary(summary)
     emit_json(summary, json_path)
 
 
@@ -282,10 +282,8 @@ def _summary(
     }
 
 
-def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
-    def say(text: str) -> None:
-        click.echo(text, err=to_stderr)
-
+def _print_summary(summary: dict[str, Any]) -> None:
+    say = click.echo
     for axis, count in summary["pieces"].items():
         say(f"{axis}: {count} maneuver piece(s)")
     for note in summary["notes"]:

@@ -214,7 +214,7 @@ def fit(data: Path, out: Path | None, report: Path | None, json_path: str | None
     summary = fit_summary(result)
     summary["outputs"] = {"model": str(out) if out else None, "report": str(report) if report else None}
     if not quiet:
-        _print_fit(summary, to_stderr=json_path == "-")
+        _print_fit(summary)
     emit_json(summary, json_path)
 
 
@@ -266,7 +266,7 @@ def spacing(
     summary = spacing_summary(study)
     summary["outputs"] = {"report": str(report) if report else None}
     if not quiet:
-        _print_spacing(summary, to_stderr=json_path == "-")
+        _print_spacing(summary)
     emit_json(summary, json_path)
 
 
@@ -287,10 +287,8 @@ def _check_spacings(spacing_mm: list[float], data: tuple[Path, ...]) -> None:
         )
 
 
-def _print_fit(summary: dict[str, Any], *, to_stderr: bool) -> None:
-    def say(text: str = "") -> None:
-        click.echo(text, err=to_stderr)
-
+def _print_fit(summary: dict[str, Any]) -> None:
+    say = click.echo
     say(f"{summary['source']}: {summary['n_points']} points, F0 {summary['f0_source']}")
     criterion = {"aicc": "AICc", "bic": "BIC"}[summary["criterion"]]
     say(f"  {'model':<18} {'RMSE':>8} {'R2':>8} {'d' + criterion:>8}  parameters")
@@ -307,10 +305,8 @@ def _print_fit(summary: dict[str, Any], *, to_stderr: bool) -> None:
             say(f"wrote {key} {path}")
 
 
-def _print_spacing(summary: dict[str, Any], *, to_stderr: bool) -> None:
-    def say(text: str = "") -> None:
-        click.echo(text, err=to_stderr)
-
+def _print_spacing(summary: dict[str, Any]) -> None:
+    say = click.echo
     families = summary["families"]
     say(f"{'spacing mm':>10}  " + "  ".join(f"{'R2 ' + f:>20}" for f in families) + "  chosen")
     for entry in summary["sets"]:

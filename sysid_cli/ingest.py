@@ -156,7 +156,7 @@ def ingest(
         write_dataset(out, campaign.logs, campaign.winds, list(campaign.flights))
     summary = _summary(campaign, out)
     if not quiet:
-        _print_summary(summary, to_stderr=json_path == "-")
+        _print_summary(summary)
     emit_json(summary, json_path)
 
 
@@ -178,10 +178,8 @@ def _summary(campaign: Any, out: Path | None) -> dict[str, Any]:
     return summary
 
 
-def _print_summary(summary: dict[str, Any], *, to_stderr: bool) -> None:
-    def say(text: str = "") -> None:
-        click.echo(text, err=to_stderr)
-
+def _print_summary(summary: dict[str, Any]) -> None:
+    say = click.echo
     for entry in summary["logs"]:
         say(
             f"{entry['path']}: {entry['autopilot']} {entry['log_format']}, "

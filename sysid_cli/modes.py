@@ -81,12 +81,10 @@ def modes(
         "unidentified_axes": unidentified,
     }
     if not quiet:
-
-        def say(text: str = "") -> None:
-            click.echo(text, err=json_path == "-")
-
-        say(f"modes of {source}" + (f" (not set, taken as dropped: {', '.join(unset)})" if unset else ""))
+        click.echo(f"modes of {source}" + (f" (not set, taken as dropped: {', '.join(unset)})" if unset else ""))
         if unidentified:
-            say(f"  the {', '.join(unidentified)} axes are unidentified: their modes are not known and not listed")
-        print_modes(summary["eigenvalues"], say)
+            click.echo(
+                f"  the {', '.join(unidentified)} axes are unidentified: their modes are not known and not listed"
+            )
+        print_modes(summary["eigenvalues"], click.echo)
     emit_json(summary, json_path)

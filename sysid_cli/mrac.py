@@ -133,18 +133,20 @@ def compare(
     with progress_bar("flying", quiet=quiet) as bar:
         comparison = compare_controllers(config, ground_effect=law, ground_effect_label=label, progress=bar)
     if out_path is not None:
-        emit_json(comparison_json(comparison, per_trial=True), str(out_path))  # written atomically
+        from flightlogs.writers.jsonio import write_json
+
+        write_json(out_path, comparison_json(comparison, per_trial=True), indent=2)  # written atomically
     if report_path is not None:
         from reports.mrac_report import write_mrac_report
 
         write_mrac_report(report_path, comparison)
     summary = comparison_json(comparison)
     if not quiet:
-        _echo(summary, err=json_path == "-")
+        _echo(summary)
     emit_json(summary, json_path)
 
 
-def _echo(summary: dict[str, Any], *, err: bool) -> None:
+def _echo(summary: dict[str, Any]) -> None:
     """Rise times per case and phase, and the MRAC/PID ratios."""
     for case in summary["cases"]:
         for phase, entry in case["phases"].items():
@@ -158,4 +160,4 @@ def _echo(summary: dict[str, Any], *, err: bool) -> None:
                 if ratios
                 else ""
             )
-            click.echo(f"Z/R {case['height_ratio']:g} {phase}: rise {rises}{extra}", err=err)
+            click.echo(f"Z/R {case['height_ratio']:g} {phase}: rise {rises}{extra}")

@@ -132,8 +132,8 @@ def report(
     )
     target = write_html(out if out is not None else model_path.with_suffix(".html"), text)
     if not quiet:
-        click.echo(verdict.sentence, err=json_path == "-")
-        click.echo(f"wrote {target}", err=json_path == "-")
+        click.echo(verdict.sentence)
+        click.echo(f"wrote {target}")
     emit_json(
         {
             "report": str(target),

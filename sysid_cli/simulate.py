@@ -76,8 +76,10 @@ def simulate(
     from simulator.campaign.scenario import builtin_scenarios, load_builtin, read_scenario
 
     if list_only:
-        for name, path in sorted(builtin_scenarios().items()):
-            click.echo(f"{name:<24} {read_scenario(path).description}")
+        listed = {name: read_scenario(path).description for name, path in sorted(builtin_scenarios().items())}
+        for name, description in listed.items():
+            click.echo(f"{name:<24} {description}")
+        emit_json({"scenarios": [{"name": n, "description": d} for n, d in listed.items()]}, json_path)
         return
     if scenario is None:
         raise click.UsageError("give a SCENARIO (a built-in name or a .toml file), or --list")
@@ -100,8 +102,5 @@ def simulate(
         ],
     }
     if not quiet:
-        click.echo(
-            f"{plan.name}: {len(written)} trials written to {folder}/ (index: {folder / 'campaign.json'})",
-            err=json_path == "-",
-        )
+        click.echo(f"{plan.name}: {len(written)} trials written to {folder}/ (index: {folder / 'campaign.json'})")
     emit_json(summary, json_path)

@@ -138,7 +138,7 @@ def validate(
         write_model_report(report, identified, verification=verification, verification_options=saved)
     summary = _summary(verification, model_path, logs, report, notes) | {"output": str(out) if out else None}
     if not quiet:
-        _print(summary, to_stderr=json_path == "-")
+        _print(summary)
     emit_json(summary, json_path)
 
 
@@ -287,10 +287,8 @@ def _summary(
     return summary
 
 
-def _print(summary: dict[str, Any], *, to_stderr: bool) -> None:
-    def say(text: str = "") -> None:
-        click.echo(text, err=to_stderr)
-
+def _print(summary: dict[str, Any]) -> None:
+    say = click.echo
     say(f"{summary['model']}: {len(summary['records'])} records, each judged on the outputs of its axis")
     wind = summary.get("wind_correction", {})
     header = f"  {'output':<8} {'unit':<8} {'RMS error':>10} {'TIC':>6}"

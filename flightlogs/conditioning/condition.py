@@ -19,7 +19,7 @@ The steps, in order (chapter 3 of the dissertation, section 3.3.3):
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -251,8 +251,9 @@ def _one_pass(log: FlightLog, wind: Any | None, options: ConditioningOptions) ->
     _derived(values, units, wind_given=bool(wind_signals))
     give_back_freed_memory()  # the resampler's working arrays: segmentation's are larger
     segments = _segments(log, time_base, values, options)
+    holds = {name: 1.5 / signal.rate_hz for name, signal in others.items() if signal.rate_hz > 0}
     records = tuple(
-        _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}")
+        _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}", holds)
         for k, span in enumerate(spans.spans)
     )
     return ConditionedFlight(source=log.path, records=records, segments=segments, rate_hz=rate_hz, wind=alignment)
@@ -681,7 +682,15 @@ def _record(
     span: tuple[float, float],
     segments: Sequence[Segment],
     label: str,
+    holds: Mapping[str, float] | None = None,
 ) -> Record:
+    """One record: the conditioned values over `span`, trim removed.
+
+    A slower signal whose samples stop short of a piece's edges (the core signals resume a sample after
+    a logging dropout; a 10 Hz estimate a tenth of a second later) has its first and last value held
+    over those edges, up to `holds` seconds (1.5 of its periods), as at the log's own edges; a signal
+    not logged through the rest of the piece is left out of the record, with a warning.
+    """
     first = int(np.searchsorted(time_base, span[0] - 1e-9, side="left"))
     stop = int(np.searchsorted(time_base, span[1] + 1e-9, side="right"))
     columns, taken = {}, set()
@@ -689,6 +698,9 @@ def _record(
         # the record takes its piece of the conditioned values, not a copy: they are not used after it
         piece = column[first:stop] if id(column) not in taken else column[first:stop].copy()
         taken.add(id(column))
+        if holds and name in holds and not np.all(np.isfinite(piece)):
+            piece = piece.copy()  # the hold is this record's: the column's NaNs stay for the neighbouring piece
+            _hold_edges(piece, time_base[first:stop], holds[name])
         if np.all(np.isfinite(piece)):
             columns[name] = piece
         else:

@@ -5,16 +5,20 @@ from a conditioned flight's records) and returns a :class:`DiscrepancyResult`. A
 takes the simulation's place through :func:`model_flight`.
 """
 
+from sysid.discrepancy.catalogue import CATALOGUE, EFFECTS, Term
 from sysid.discrepancy.describe import FAR_FROM_FLOOR
 from sysid.discrepancy.fitted_model import model_flight, model_outputs
 from sysid.discrepancy.responses import RATE_PAIRS, ResponseComparison, compare_model_responses, compare_responses
-from sysid.discrepancy.result import DiscrepancyResult, Finding, FittedParameter, Regime
+from sysid.discrepancy.result import Alternative, DiscrepancyResult, Finding, FittedParameter, Regime, Screening
 from sysid.discrepancy.search import DiscrepancyOptions, discover
 from sysid.discrepancy.series import FlightSeries, flight_series
-from sysid.discrepancy.terms import EFFECTS
 
 __all__ = [
+    "Alternative",
+    "CATALOGUE",
     "EFFECTS",
+    "Screening",
+    "Term",
     "FAR_FROM_FLOOR",
     "DiscrepancyOptions",
     "DiscrepancyResult",

@@ -18,7 +18,7 @@ which was first read as a CG offset (found on another generator's flights).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -81,6 +81,67 @@ class BaselineModel:
         for k, name in enumerate(self.squared):
             first = n_in * n_lags + k * n_squares
             total += _lagged(series, np.asarray(inputs[name]) ** 2, square_lags) @ weights[first : first + n_squares]
+        return {o: total[:, j] for j, o in enumerate(self.coefficients)}
+
+    def recentred(self, thrust_shift: float) -> BaselineModel:
+        """The model with the thrust command read `thrust_shift` lower by every output but az.
+
+        A real vehicle that hovers at another thrust command (worn motors, another mass) sends the
+        simulation's model outside the thrust range it was fitted on: the small cross-couplings it
+        learned from the thrust command to the moments and side forces (noise, within SIM's range) then
+        add constant moments no vehicle makes, which were named a CG offset. Those outputs read the
+        thrust command about the real vehicle's own hover; az reads it as logged, and the thrust level
+        is the trim's. Exact: the shift is folded into the coefficients (``(x - s)² = x² - 2 s x + s²``).
+
+        Parameters
+        ----------
+        thrust_shift : float
+            Real less simulated mean thrust command, as logged.
+        """
+        k = COMMANDS.index("delta_thr")
+        square_lags = _square_lags(self.lags)
+        n_lags, n_squares = self.lags.size, square_lags.size
+        linear = slice(k * n_lags, (k + 1) * n_lags)
+        out = {}
+        for o, weights in self.coefficients.items():
+            w = np.array(weights, dtype=float)
+            if o != "az":
+                constant = w[linear].sum() * -thrust_shift
+                if "delta_thr" in self.squared:
+                    first = len(COMMANDS) * n_lags + self.squared.index("delta_thr") * n_squares
+                    squares = w[first : first + n_squares]
+                    w[k * n_lags + np.searchsorted(self.lags, square_lags)] += -2.0 * thrust_shift * squares
+                    constant += thrust_shift**2 * squares.sum()
+                w[-1] += constant
+            out[o] = w
+        return replace(self, coefficients=out)
+
+    def command_part(
+        self, series: FlightSeries, command: str, values: np.ndarray | None = None
+    ) -> dict[str, np.ndarray]:
+        """The part of each output's prediction that one mixer input makes (its lags and square), shape (n,) each.
+
+        What the simulation's vehicle produces per command on that axis: a moment or thrust that the real
+        one makes more or less of (worn motors) is this part scaled.
+
+        Parameters
+        ----------
+        series : FlightSeries
+            A flight with the same signals.
+        command : str
+            One of ``delta_lat delta_lon delta_yaw delta_thr``.
+        values : ndarray, shape (n,), optional
+            The input to use instead of the logged one (clipped at a ceiling, say).
+        """
+        x = np.asarray(series[command] if values is None else values)
+        k = COMMANDS.index(command)
+        square_lags = _square_lags(self.lags)
+        n_lags, n_squares = self.lags.size, square_lags.size
+        weights = np.column_stack(list(self.coefficients.values()))
+        total = _lagged(series, x, self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
+        if command in self.squared:
+            first = len(COMMANDS) * n_lags + self.squared.index(command) * n_squares
+            total += _lagged(series, x**2, square_lags) @ weights[first : first + n_squares]
         return {o: total[:, j] for j, o in enumerate(self.coefficients)}
 
 

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FittedParameter", "Regime", "FindingTraces", "Finding", "DiscrepancyResult"]
+__all__ = ["Alternative", "FittedParameter", "Regime", "FindingTraces", "Finding", "Screening", "DiscrepancyResult"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -71,13 +71,57 @@ class Regime:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class Alternative:
+    """Another explanation of a finding's residual, as good within its uncertainty.
+
+    Parameters
+    ----------
+    effect : str
+        The other term (a catalogue name, or ``unexplained``).
+    explained_variance : float
+        Its held-out score on the finding's outputs, 0-1.
+    """
+
+    effect: str
+    explained_variance: float
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Screening:
+    """One term as the search screened it at the first step.
+
+    Parameters
+    ----------
+    effect : str
+        The term.
+    score : float
+        Share of the noise-weighted held-out residual of its outputs it removes (0-1, can be negative).
+    threshold : float
+        The score it had to pass (a floor, or a multiple of what it gains on held-out simulated flight).
+    where_it_acts : float
+        Share of the residual it removes on the samples holding 80 % of its contribution.
+    """
+
+    effect: str
+    score: float
+    threshold: float
+    where_it_acts: float
+
+    @property
+    def passed(self) -> bool:
+        """Whether its score passed the threshold."""
+        return self.score > self.threshold
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Finding:
     """One effect the simulation leaves out, modelled and proven on held-out data.
 
     Parameters
     ----------
     effect : str
-        One of :data:`~sysid.discrepancy.terms.EFFECTS`.
+        One of :data:`~sysid.discrepancy.catalogue.EFFECTS`, or ``unexplained``: a residual no term of the
+        catalogue explains, modelled by a sparse combination of the flight's states and inputs.
     outputs : tuple of str
         Outputs it acts on.
     band_rad_s : tuple of float
@@ -94,6 +138,8 @@ class Finding:
         Held-out cut of the residual RMS of its outputs, %.
     evidence : str
         One sentence.
+    alternatives : tuple of Alternative
+        Other terms that explain the same residual about as well (then the finding is ambiguous).
     traces : FindingTraces or None
         What the report draws (not in the JSON).
     """
@@ -108,6 +154,7 @@ class Finding:
     rmse_after: dict[str, float]
     improvement_percent: float
     evidence: str
+    alternatives: tuple[Alternative, ...] = ()
     traces: FindingTraces | None = field(default=None, repr=False, compare=False)
 
 
@@ -123,9 +170,8 @@ class DiscrepancyResult:
         By importance (held-out improvement).
     summary : str
         Plain-language sentences, the first naming the verdict.
-    screened : dict of str to float
-        Every effect tried and its held-out improvement on its outputs at the first step (0-1), and the
-        threshold it had to pass (``<effect>_threshold``).
+    screened : tuple of Screening
+        Every term tried at the first step, its held-out score and the threshold it had to pass.
     noise_floor : dict of str to float
         RMS of each output's residual on held-out SIM data (model error and noise alone).
     sim, real : tuple of str
@@ -141,7 +187,7 @@ class DiscrepancyResult:
     verdict: str
     findings: tuple[Finding, ...]
     summary: str
-    screened: dict[str, float]
+    screened: tuple[Screening, ...]
     noise_floor: dict[str, float]
     sim: tuple[str, ...]
     real: tuple[str, ...]
@@ -171,10 +217,16 @@ class DiscrepancyResult:
                     "rmse_after": f.rmse_after,
                     "improvement_percent": f.improvement_percent,
                     "evidence": f.evidence,
+                    "alternatives": [
+                        {"effect": a.effect, "explained_variance": a.explained_variance} for a in f.alternatives
+                    ],
                 }
                 for f in self.findings
             ],
-            "screened": self.screened,
+            "screened": {
+                t.effect: {"score": t.score, "threshold": t.threshold, "where_it_acts": t.where_it_acts}
+                for t in self.screened
+            },
             "noise_floor": self.noise_floor,
             "sim": list(self.sim),
             "real": list(self.real),

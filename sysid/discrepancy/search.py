@@ -18,6 +18,15 @@
    counted) is kept; its contribution joins the model and the others are
    screened again (forward selection), until none passes. A delay and a lag compete:
    once one is kept the other is not tried.
+   Every term of the catalogue (:mod:`.catalogue`) is judged so; the best is named only when it explains
+   about as much of its outputs' residual as the model of the unknown (:mod:`.generic`) does, else the
+   finding is ``unexplained`` (and the term an alternative); terms whose scores come close to the named
+   one's are listed as its alternatives. When nothing is named, the model of the unknown is tried on
+   every output; a later term must cut its outputs' residual RMS by 10 %; an output whose residual
+   stays 2.5 times over its floor with every finding modelled is ``unexplained`` (weak names on it are
+   dropped). A trim of the thrust per input beyond 5 %, with nothing else on az, is a control
+   effectiveness. The folds are 4 s blocks dealt in turn to six (a manoeuvre's regime lives in one
+   stretch of the flight), and a sensor's constant bias is a nuisance, never a finding.
 3. **Model, locate and show.** Each kept term is fitted on all of REAL with
    its uncertainties; its band is where its contribution's power lies, its
    regime the flight variable its contribution follows; the residual RMS
@@ -33,8 +42,18 @@ import numpy as np
 from scipy.signal import welch
 
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
+from sysid.discrepancy.catalogue import Candidate, Derivation, FlightContext, Term, candidate_terms, term_of
+from sysid.discrepancy.catalogue._air import air_velocity, climb_rate
 from sysid.discrepancy.describe import describe_finding, parameters_of, summary_of
-from sysid.discrepancy.result import DiscrepancyResult, Finding, FindingTraces, Regime
+from sysid.discrepancy.generic import GenericFit, Regressor, fit_generic, generic_library, generic_term
+from sysid.discrepancy.result import (
+    Alternative,
+    DiscrepancyResult,
+    Finding,
+    FindingTraces,
+    Regime,
+    Screening,
+)
 from sysid.discrepancy.selection import (
     TermFit,
     blocks,
@@ -46,14 +65,14 @@ from sysid.discrepancy.selection import (
     split_joined,
 )
 from sysid.discrepancy.series import OUTPUTS, FlightSeries
-from sysid.discrepancy.terms import Candidate, candidate_terms
 
 __all__ = ["DiscrepancyOptions", "discover"]
 
-_TRANSFORMS = ("time_delay", "actuator_lag")
 _REGIMES = (
     ("height_agl", "m"),
     ("ground_speed", "m/s"),
+    ("airspeed", "m/s"),
+    ("climb_rate", "m/s"),
     ("wind_speed", "m/s"),
     ("delta_thr", "as logged"),
     ("battery_v", "V"),
@@ -65,6 +84,14 @@ _SUPPORT_SHARE = 0.8  # a term's support: the samples that hold this share of it
 _MIN_SUPPORT_S = 2.0  # ... must span this much flight (a touchdown's spike: 0.3 s; a 15 m reposition's drag: 5 s),
 _EPISODE_S = 0.25  # ... or recur: episodes of at least this long ...
 _APART_S = 10.0  # ... this far apart (a ground effect at take-off and at landing, 1.1-1.9 s in all)
+
+_AMBIGUOUS_SCORE = 0.02  # another term within this held-out score of the winner's (or this share of it) ...
+_AMBIGUOUS_SHARE = 0.1  # ... explains the same residual as well: the finding is ambiguous
+_LEVEL_CHANGE = 0.05  # a trim further than this from 1, with nothing else on az, is a change of thrust per command
+_LATE_SCORE = 0.19  # held-out share a later term must remove of its outputs' residual (a 10 % cut of their RMS)
+_FAR_LEFT = 2.5  # an output's held-out residual this many times its floor with every finding modelled is unexplained
+_WEAK = 0.15  # a term that removed less of the residual of its outputs, one of them that far, is no finding
+_NAMED_SHARE = 0.8  # a catalogue term explaining under this share of what the model of the unknown does is no name
 
 Progress = Callable[[str, int, int], None]
 
@@ -85,6 +112,9 @@ class DiscrepancyOptions:
         ... and this many times its score on held-out simulation data.
     max_findings : int
         Most effects reported.
+    generic_margin : float
+        Held-out score by which the model of the unknown must beat the best catalogue term on that term's
+        outputs (and the term explain under 80 % of what it does) for the term not to be named.
     rotor_radius_m : float or None
         Propeller radius, m, if known: the ground effect's end is also given as Z/R.
     """
@@ -93,6 +123,7 @@ class DiscrepancyOptions:
     min_share: float = 0.01
     null_margin: float = 3.0
     max_findings: int = 3
+    generic_margin: float = 0.10
     rotor_radius_m: float | None = None
 
 
@@ -121,7 +152,9 @@ def discover(
     simulated = simulated.without([s for s in simulated.signals if s not in flown])  # a model of what both logged
     scale, null = _noise_floor(simulated)
     _report(progress, "simulation model", 1, 3)
-    baseline = fit_baseline(simulated)
+    # the moments and side forces read the thrust command about the real vehicle's own hover (see recentred)
+    shift = float(np.mean(flown["delta_thr"]) - np.mean(simulated["delta_thr"]))
+    baseline = fit_baseline(simulated).recentred(shift)
     y = {o: flown[o] for o in OUTPUTS}
     base = baseline.predict(flown)
     additions = {o: np.zeros(flown.n) for o in OUTPUTS}
@@ -129,20 +162,25 @@ def discover(
     gain = float(np.dot(thrust, base["az"] - y["az"]) / max(float(np.dot(thrust, thrust)), 1e-300))
     additions["az"] = -gain * thrust  # the real thrust per input may differ by a constant factor: a trim
     trim = additions["az"]
-    kept: list[tuple[TermFit, float, dict[str, np.ndarray], dict[str, np.ndarray]]] = []
-    screened: dict[str, float] = {}
+    kept: list[_Kept] = []
+    screened: list[Screening] = []
+    terms: dict[int, Term] = {}
     held_out = combined(base, additions)  # the baseline is fitted on SIM: on REAL its prediction is held out already
+    library = generic_library(FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim)))
+    generic_null = options.null_margin * max(null.get("unexplained", 0.0), 0.0)
     while len(kept) < options.max_findings:
-        found = {t.candidate.effect for t, *_ in kept}
-        exclude = tuple(found | (set(_TRANSFORMS) if found & set(_TRANSFORMS) else set()))
-        scores = []
-        linear = [fit for fit, *_ in kept if fit.candidate.kind == "linear"]
+        found = {k.fit.candidate.effect for k in kept}
+        exclude = found | {r for e in found if e != "unexplained" for r in term_of(e).rivals}
+        if "unexplained" in found:
+            break  # what is left is the model of the unknown's: no catalogue term is named after it
+        scores: list[_Scored] = []
+        linear = [k.fit for k in kept if k.fit.candidate.kind == "linear"]
         without = _without(additions, linear)  # the kept linear terms refit with each linear newcomer
         current = combined(base, additions)
         # every term reads one thrust, the model's with the trim: two terms' thrust gains are then one column, whose
         # sum is measured, and not two near copies whose difference (the first term's contribution) a fit would use
-        trimmed = {**current, "az": base["az"] + trim}
-        for candidate in candidate_terms(flown, baseline, trimmed, exclude=exclude):
+        context = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
+        for candidate in candidate_terms(context, exclude=tuple(exclude)):
             together = candidate.kind == "linear" and bool(linear)
             trial, adds = (joined(candidate, linear), without) if together else (candidate, additions)
             reference = held_out if together else None  # judged against the kept terms' held-out prediction
@@ -152,12 +190,19 @@ def discover(
             # remove a share of the whole flight's residual
             least = options.min_improvement if kept else options.min_share
             threshold = max(least, options.null_margin * max(null.get(candidate.effect, 0.0), 0.0))
+            if kept:  # a later term takes up what the first one's shape left: it must cut its outputs' RMS by 10 %
+                threshold = max(threshold, _LATE_SCORE)
             against = reference if reference is not None else current
             local = _local_score(y, predicted, against, scale, candidate.outputs)
             if not kept:
-                screened[candidate.effect] = round(score, 4)
-                screened[f"{candidate.effect}_threshold"] = round(threshold, 4)
-                screened[f"{candidate.effect}_where_it_acts"] = round(local, 4)
+                screened.append(
+                    Screening(
+                        effect=candidate.effect,
+                        score=round(score, 4),
+                        threshold=round(threshold, 4),
+                        where_it_acts=round(local, 4),
+                    )
+                )
             if score > threshold and local > options.min_improvement:
                 fit = fit_term(trial, y, base, adds, scale)
                 if candidate.kind == "transform" and fit.value >= candidate.grid[-1]:
@@ -166,57 +211,248 @@ def discover(
                 if not _sustained(_support(prediction, current, scale), flown["t_flight"]):
                     continue  # a moment of flight (a touchdown, a spike) is no physical effect
                 change = _bic_change(fit, y, prediction, current, len(candidate.coefficients))
-                scores.append((change, score, fit, predicted, candidate, adds))
+                scores.append(_Scored(change, score, fit, predicted, candidate, adds))
         _report(progress, "screening terms", len(kept) + 1, options.max_findings + 1)
         if not scores:
             break
-        _, score, fit, predicted, candidate, adds = min(scores, key=lambda s: s[0])
+        best = min(scores, key=lambda s: s.bic_change)
+        rivals = _alternatives(best, scores)
+        generic = fit_generic(context, y, current, scale, outputs=best.candidate.outputs, library=library)
+        if _generic_wins(best, generic, options):
+            # the best name explains clearly less than a generic model of the same outputs: it is not the answer;
+            # after a named effect the model of the unknown must also be substantial (else the rest is its shape's)
+            # after a named effect what is left holds its shape's error (a lag's first order against the real one):
+            # only a residual that stays far above the floor is then unexplained (see _far_left)
+            if not kept:
+                rivals = (Alternative(effect=best.candidate.effect, explained_variance=round(best.score, 4)), *rivals)
+                kept.append(_unexplained(generic, y, base, additions, scale, held_out, rivals, terms))
+            break
         before = dict(held_out)
-        for o in fit.candidate.outputs:
-            held_out[o] = predicted[o]
-        if candidate.kind == "transform":
-            base = dict(candidate.build(fit.value))
-            kept.append((fit, score, before, dict(held_out)))
+        for o in best.fit.candidate.outputs:
+            held_out[o] = best.predicted[o]
+        if best.candidate.kind == "transform":
+            base = dict(best.candidate.build(best.fit.value))
+            kept.append(_Kept(best.fit, best.score, before, dict(held_out), rivals))
             continue
-        own, *refit = split_joined(fit, candidate, linear) if fit.candidate is not candidate else [fit]
-        kept = [(refit.pop(0) if k.candidate.kind == "linear" and refit else k, sc, b, a) for k, sc, b, a in kept]
-        kept.append((own, score, before, dict(held_out)))
-        additions = dict(adds)
-        built = fit.candidate.build(fit.value)
-        for o, coefficients in fit.coefficients.items():
+        own, *refit = (
+            split_joined(best.fit, best.candidate, linear) if best.fit.candidate is not best.candidate else [best.fit]
+        )
+        kept = [
+            _Kept(refit.pop(0), k.score, k.before, k.after, k.alternatives)
+            if k.fit.candidate.kind == "linear" and refit
+            else k
+            for k in kept
+        ]
+        kept.append(_Kept(own, best.score, before, dict(held_out), rivals))
+        additions = dict(best.adds)
+        built = best.fit.candidate.build(best.fit.value)
+        for o, coefficients in best.fit.coefficients.items():
             additions[o] = additions[o] + built[o] @ coefficients
-    gains = {id(fit): _thrust_gain(fit) for fit, *_ in kept}
+    if not kept:
+        current = combined(base, additions)
+        context = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
+        generic = fit_generic(context, y, current, scale, library=library)
+        threshold = max(options.min_share, generic_null)
+        if generic.chosen and generic.score > threshold:
+            rows = _support(generic.predicted, current, scale)
+            local = _local_score(y, generic.predicted, current, scale, generic.outputs)
+            if local > options.min_improvement and _sustained(rows, flown["t_flight"]):
+                kept.append(_unexplained(generic, y, base, additions, scale, held_out, (), terms))
+    kept = _far_left(kept, y, base, additions, scale, held_out, library, flown, baseline, trim, terms)
+    level = _thrust_level(kept, gain, thrust, y["az"] - combined(base, additions)["az"], base, additions, y, scale)
+    if level is not None and len(kept) < options.max_findings:
+        kept.append(level)
+    _report(progress, "done", 3, 3)
+    gains = {id(k.fit): _thrust_gain(k.fit) for k in kept}
     findings = sorted(
         (  # each term's thrust level: the trim and the other terms' gains (collinear: only their sum is known)
             _finding(
-                fit,
-                score,
-                before,
-                after,
+                k,
                 y,
                 flown,
                 scale,
-                1.0 + gain + sum(gains.values()) - gains[id(fit)],
-                options.rotor_radius_m,
+                terms.get(id(k.fit)) or term_of(k.fit.candidate.effect),
+                Derivation(
+                    thrust_scale=1.0 + gain + sum(gains.values()) - gains[id(k.fit)],
+                    rotor_radius_m=options.rotor_radius_m,
+                ),
             )
-            for fit, score, before, after in kept
+            for k in kept
         ),
         key=lambda f: -f.improvement_percent,
     )
-    _report(progress, "done", 3, 3)
     floor = {o: float(np.sqrt(scale[o])) for o in OUTPUTS}
-    unexplained = {o: round(float(np.sqrt(np.mean((y[o] - held_out[o]) ** 2))) / floor[o], 2) for o in OUTPUTS}
+    unexplained = {o: round(_spread(y[o] - held_out[o]) / floor[o], 2) for o in OUTPUTS}
     return DiscrepancyResult(
         verdict=findings[0].effect if findings else "none",
         findings=tuple(findings),
         summary=summary_of(findings, floor, unexplained),
         unexplained=unexplained,
-        screened=screened,
+        screened=tuple(screened),
         noise_floor=floor,
         sim=tuple(s.name for s in sim),
         real=tuple(s.name for s in real),
         thrust_scale=round(1.0 + gain, 5),
     )
+
+
+def _far_left(
+    kept: list[_Kept],
+    y: Mapping[str, np.ndarray],
+    base: Mapping[str, np.ndarray],
+    additions: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+    held_out: dict[str, np.ndarray],
+    library: list[Regressor],
+    flown: FlightSeries,
+    baseline: BaselineModel,
+    trim: np.ndarray,
+    terms: dict[int, Term],
+) -> list[_Kept]:
+    """`kept`, with what stays far above the noise floor reported as ``unexplained`` and the weak names on it dropped.
+
+    An output whose held-out residual stays over :data:`_FAR_LEFT` times its floor with every finding
+    modelled holds something no term and no static model of the flight explains (a load swinging under
+    the vehicle: dynamics of its own). A catalogue term that removed under :data:`_WEAK` of the residual of
+    such an output took up a sliver of it: a guess, not a finding. The rest is located as ``unexplained``
+    on those outputs, with what the model of the unknown can say of it (perhaps nothing).
+    """
+    floor = {o: float(np.sqrt(scale[o])) for o in OUTPUTS}
+    far = tuple(o for o in OUTPUTS if _spread(y[o] - held_out[o]) > _FAR_LEFT * floor[o])
+    if not far or any(k.fit.candidate.effect == "unexplained" for k in kept):
+        return kept
+    weak = [k for k in kept if k.score < _WEAK and set(k.fit.candidate.outputs) & set(far)]
+    kept = [k for k in kept if not any(k is w for w in weak)]
+    if weak:
+        held_out.update(weak[0].before)  # the weak terms' share goes back to the residual
+    current = {o: held_out[o] for o in OUTPUTS}
+    context = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
+    generic = fit_generic(context, y, current, scale, outputs=far, library=library)
+    kept.append(_unexplained(generic, y, base, additions, scale, held_out, (), terms, outputs=far))
+    return kept
+
+
+def _spread(residual: np.ndarray) -> float:
+    """RMS of a residual about its mean: a sensor's constant bias is a nuisance, not something left unexplained."""
+    return float(np.std(residual))
+
+
+def _thrust_level(
+    kept: Sequence[_Kept],
+    gain: float,
+    thrust: np.ndarray,
+    residual: np.ndarray,
+    base: Mapping[str, np.ndarray],
+    additions: Mapping[str, np.ndarray],
+    y: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+) -> _Kept | None:
+    """The thrust per command's change as a finding (``control_effectiveness``), when the trim itself is one.
+
+    The trim fitted before any term is the real thrust per input over the simulated one: a trim while it is
+    within :data:`_LEVEL_CHANGE` of 1, or while a term on az (a mass, the battery, the ground) holds its own
+    level; beyond it, with nothing else on az, the real motors make another thrust per command (worn
+    motors or props; a vehicle heavier by the same share needs the same command: a hover cannot tell them
+    apart, and the sentence says so). Its uncertainty is the trim's least-squares spread, the residual's
+    correlation counted.
+    """
+    if abs(gain) <= _LEVEL_CHANGE or any("az" in k.fit.candidate.outputs for k in kept):
+        return None
+    inflation = residual.size / max(effective_samples(residual), 1.0)
+    sigma = float(np.sqrt(np.mean(residual**2) * inflation / max(float(np.dot(thrust, thrust)), 1e-300)))
+    column = -thrust[:, None]
+    candidate = Candidate(
+        effect="control_effectiveness",
+        outputs=("az",),
+        kind="linear",
+        grid=(float("nan"),),
+        grid_parameter="",
+        build=lambda _value: {"az": column},
+        coefficients=("k_thrust",),
+    )
+    fit = TermFit(
+        candidate=candidate,
+        value=float("nan"),
+        coefficients={"az": np.array([gain])},
+        covariance={"az": np.array([[sigma**2]])},
+        value_uncertainty=float("nan"),
+    )
+    after = combined(base, additions)
+    before = {**after, "az": np.asarray(base["az"])}
+    removed = 1.0 - float(np.sum((y["az"] - after["az"]) ** 2)) / max(
+        float(np.sum((y["az"] - before["az"]) ** 2)), 1e-300
+    )
+    return _Kept(fit, removed, before, after, (Alternative(effect="mass", explained_variance=round(removed, 4)),))
+
+
+@dataclass(frozen=True, slots=True)
+class _Kept:
+    """A kept term: its fit, held-out score, the held-out prediction before and after it, its rivals."""
+
+    fit: TermFit
+    score: float
+    before: dict[str, np.ndarray]
+    after: dict[str, np.ndarray]
+    alternatives: tuple[Alternative, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class _Scored:
+    """A candidate that passed the screen at one step."""
+
+    bic_change: float
+    score: float
+    fit: TermFit
+    predicted: dict[str, np.ndarray]
+    candidate: Candidate
+    adds: Mapping[str, np.ndarray]
+
+
+def _alternatives(best: _Scored, scores: Sequence[_Scored]) -> tuple[Alternative, ...]:
+    """The other passing terms that explain the winner's residual within its uncertainty (same outputs, close score)."""
+    out = []
+    for other in scores:
+        if other is best or not set(other.candidate.outputs) & set(best.candidate.outputs):
+            continue
+        if other.score >= best.score - max(_AMBIGUOUS_SCORE, _AMBIGUOUS_SHARE * best.score):
+            out.append(Alternative(effect=other.candidate.effect, explained_variance=round(other.score, 4)))
+    return tuple(sorted(out, key=lambda a: -a.explained_variance))
+
+
+def _generic_wins(best: _Scored, generic: GenericFit, options: DiscrepancyOptions) -> bool:
+    """Whether the model of the unknown explains the best term's outputs clearly better than the term does."""
+    return generic.score - best.score > options.generic_margin and best.score < _NAMED_SHARE * generic.score
+
+
+def _unexplained(
+    generic: GenericFit,
+    y: Mapping[str, np.ndarray],
+    base: Mapping[str, np.ndarray],
+    additions: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+    held_out: dict[str, np.ndarray],
+    alternatives: tuple[Alternative, ...],
+    terms: dict[int, Term],
+    *,
+    outputs: tuple[str, ...] = (),
+) -> _Kept:
+    """The model of the unknown as a kept term (fitted on all samples), `held_out` updated with its prediction.
+
+    `outputs`: where it is located when the model of the unknown keeps no regressor there (it is then a
+    residual located, not modelled).
+    """
+    candidate = generic.candidate(outputs)
+    if generic.chosen:
+        fit = fit_term(candidate, y, base, additions, scale)
+    else:
+        fit = TermFit(
+            candidate=candidate, value=float("nan"), coefficients={}, covariance={}, value_uncertainty=float("nan")
+        )
+    terms[id(fit)] = generic_term(generic, outputs)
+    before = dict(held_out)
+    for o in generic.outputs:
+        held_out[o] = generic.predicted[o]
+    return _Kept(fit, generic.score, before, dict(held_out), alternatives)
 
 
 def _thrust_gain(fit: TermFit) -> float:
@@ -333,8 +569,11 @@ def _noise_floor(sim: FlightSeries) -> tuple[dict[str, float], dict[str, float]]
         zeros = {o: np.zeros(held.size) for o in OUTPUTS}
         scales.append(scale)
         # the terms are built on the whole flight (a delay's inputs reach back across the blocks) and judged on the half
-        terms = [_on_rows(c, held) for c in candidate_terms(sim, model, prediction)]
+        context = FlightContext(series=sim, baseline=model, thrust=-prediction["az"])
+        terms = [_on_rows(c, held) for c in candidate_terms(context)]
         nulls.append({c.effect: cross_validated(c, y, base, zeros, scale)[0] for c in terms})
+        library = [replace(r, values=r.values[held]) for r in generic_library(context)]
+        nulls[-1]["unexplained"] = fit_generic(context, y, base, scale, library=library).score
     scale = {o: float(np.mean([s[o] for s in scales])) for o in OUTPUTS}
     null = {e: float(np.mean([n.get(e, 0.0) for n in nulls])) for e in set().union(*nulls)}
     return scale, null
@@ -368,16 +607,14 @@ def _joined(flights: Sequence[FlightSeries]) -> FlightSeries:
 
 
 def _finding(
-    fit: TermFit,
-    score: float,
-    before: Mapping[str, np.ndarray],
-    after: Mapping[str, np.ndarray],
+    kept: _Kept,
     y: Mapping[str, np.ndarray],
     flown: FlightSeries,
     scale: Mapping[str, float],
-    thrust_scale: float,
-    rotor_radius_m: float | None,
+    term: Term,
+    derivation: Derivation,
 ) -> Finding:
+    fit, before, after = kept.fit, kept.before, kept.after
     outputs = fit.candidate.outputs
     rms_before = {o: float(np.sqrt(np.mean((y[o] - before[o]) ** 2))) for o in outputs}
     rms_after = {o: float(np.sqrt(np.mean((y[o] - after[o]) ** 2))) for o in outputs}
@@ -385,6 +622,8 @@ def _finding(
     weighted_after = sum(rms_after[o] ** 2 / scale[o] for o in outputs)
     improvement = 100.0 * (1.0 - np.sqrt(weighted_after / weighted_before)) if weighted_before > 0 else 0.0
     contribution = {o: after[o] - before[o] for o in outputs}
+    if not any(np.any(c) for c in contribution.values()):  # located, not modelled: the residual says where
+        contribution = {o: y[o] - before[o] for o in outputs}
     regime = _regime(contribution, flown, fit.candidate.regime)
     if fit.candidate.grid_parameter == "time_s":  # a change at an instant acts from then on
         regime = Regime(variable="time", unit="s", low=round(fit.value, 3), high=round(float(flown["t_flight"][-1]), 3))
@@ -393,15 +632,16 @@ def _finding(
         outputs=outputs,
         band_rad_s=_band(contribution, flown.rate_hz),
         regime=regime,
-        explained_variance=round(max(score, 0.0), 4),
-        parameters=parameters_of(fit, thrust_scale, rotor_radius_m),
+        explained_variance=round(max(kept.score, 0.0), 4),
+        parameters=parameters_of(fit, term, derivation),
         rmse_before=rms_before,
         rmse_after=rms_after,
         improvement_percent=round(float(improvement), 2),
         evidence="",
+        alternatives=kept.alternatives,
         traces=_traces(flown, regime, {o: y[o] - before[o] for o in outputs}, {o: y[o] - after[o] for o in outputs}),
     )
-    return _with_evidence(finding, fit.candidate)
+    return replace(finding, evidence=describe_finding(finding, term))
 
 
 _MAX_POINTS = 1500  # samples kept for the report's figures (4000 took 3.5 s to draw as SVG)
@@ -419,10 +659,6 @@ def _traces(
         before={o: v[::step] for o, v in before.items()},
         after={o: v[::step] for o, v in after.items()},
     )
-
-
-def _with_evidence(finding: Finding, candidate: Candidate) -> Finding:
-    return replace(finding, evidence=describe_finding(finding, candidate))
 
 
 def _band(contribution: Mapping[str, np.ndarray], rate_hz: float) -> tuple[float, float]:
@@ -443,6 +679,12 @@ def _regime_variables(flown: FlightSeries) -> dict[str, np.ndarray]:
     variables = {name: flown[name] for name, _ in _REGIMES if name in flown and name != "t_flight"}
     if "u" in flown and "v" in flown:
         variables["ground_speed"] = np.hypot(flown["u"], flown["v"])
+    air = air_velocity(flown)
+    if air is not None:
+        variables["airspeed"] = np.hypot(air[0], air[1])
+    climb = climb_rate(flown)
+    if climb is not None:
+        variables["climb_rate"] = climb
     if "wind_lon" in flown and "wind_lat" in flown:
         variables["wind_speed"] = np.hypot(flown["wind_lon"], flown["wind_lat"])
     return variables

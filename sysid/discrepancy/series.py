@@ -22,7 +22,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import savgol_filter
+from scipy.signal import butter, savgol_filter, sosfiltfilt
 
 from flightlogs.errors import DataError
 from flightlogs.frames import earth_to_body, wind_to_body_axes
@@ -41,6 +41,7 @@ _THRUST_ON = 1.0 / 3.0  # flying: thrust above this fraction of its 95th percent
 _LIFT_OFF = 0.85  # and above this fraction of its median there (a take-off ramp on the ground is not flight)
 _ON_GROUND_M = 0.05  # and, where a height is logged, above this
 _WIND = ("wind_lon", "wind_lat")
+_FILTER_PAD = 60  # samples the anti-alias filter pads each record's ends with
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -135,9 +136,10 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
             continue
         grid = np.arange(t[0], t[-1], 1.0 / rate_hz)
         window = max(5, int(round(_SMOOTH_S * record.rate_hz)) | 1)
-        values = {s: np.interp(grid, t, record.absolute(s)) for s in record.signals}
+        absolute = {s: _anti_aliased(record.absolute(s), record.rate_hz, rate_hz) for s in record.signals}
+        values = {s: np.interp(grid, t, x) for s, x in absolute.items()}
         for rate in ("p", "q", "r"):
-            derivative = savgol_filter(record.absolute(rate), window, 2, deriv=1, delta=1.0 / record.rate_hz)
+            derivative = savgol_filter(absolute[rate], window, 2, deriv=1, delta=1.0 / record.rate_hz)
             values[f"{rate}_dot"] = np.interp(grid, t, derivative)
         times.append(grid)
         pieces.append(np.full(grid.size, k))
@@ -158,6 +160,19 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
     if not all(np.all(np.isfinite(series[w])) for w in _WIND if w in series):
         return series.without(_WIND)  # a wind with holes is no regressor
     return series
+
+
+def _anti_aliased(x: np.ndarray, from_hz: float, to_hz: float) -> np.ndarray:
+    """`x` low-passed (zero-phase, 4th order) at 40 % of `to_hz` before it is sampled at `to_hz`, shape (n,).
+
+    A real accelerometer's log holds the rotors' vibration (100-200 Hz, aliased by the log's own rate to
+    tens of Hz, often m/s² in size); sampled again at the search's rate it would alias once more into the
+    band the physics lives in. Records already slower than 2.5 times the search's rate are left as they are.
+    """
+    if from_hz < 2.5 * to_hz or x.size <= _FILTER_PAD:
+        return x
+    sos = butter(4, 0.4 * to_hz, fs=from_hz, output="sos")
+    return np.asarray(sosfiltfilt(sos, x, padlen=min(_FILTER_PAD, x.size - 1)))
 
 
 def smoothed_as_derivative(series: FlightSeries, x: np.ndarray) -> np.ndarray:

@@ -25,7 +25,14 @@ pyulog and pymavlink):
   upstream (20 Hz, ±0.3 m/s, a CSV the workbench reads);
 * physics outside the linear plant (:mod:`.effects`), for discrepancy pairs
   (:mod:`.pairs`): a ground cushion, battery fade, a payload picked up, a CG
-  off the thrust axis, and the calm airframe in a steady wind;
+  off the thrust axis, and the calm airframe in a steady wind; more of the
+  search's catalogue with laws of our own (:mod:`.effects_more`: worn motors,
+  quadratic drag, climb inflow, translational lift, a thrust ceiling, gyro and
+  accelerometer scale errors); physics outside that catalogue, whose right
+  answer is ``unexplained`` (:mod:`.effects_outside`: a swinging payload, mixer
+  cross-coupling, a speed pitch moment); all forced step by step (:mod:`.forcing`);
+* real sensors' nuisances (:mod:`.nuisances`): rotor vibration aliased into
+  the accelerometers, drifting gyro biases, logging dropouts in every topic;
 * logs (:mod:`.px4_log`, :mod:`.ardupilot_log`): realistic topics and rates;
 * corpus (:mod:`.corpus`, :mod:`.catalogue`): :func:`write_case` and the
   named :data:`TUNING_CASES` / :data:`HELDOUT_CASES`;
@@ -42,6 +49,16 @@ Examples
 
 from independent_sim.catalogue import ALL_CASES, HELDOUT_CASES, TUNING_CASES, case_named
 from independent_sim.corpus import PARAMETER_UNITS, CaseFiles, Truth, truth_of, write_case
+from independent_sim.effects_more import (
+    AccelScale,
+    AirframeDrag,
+    ClimbInflow,
+    GyroScale,
+    MotorWear,
+    ThrustCeiling,
+    TranslationalLift,
+)
+from independent_sim.effects_outside import MixerCrossCoupling, SpeedPitchMoment, SwingingPayload
 from independent_sim.excitation import (
     Excitation,
     chirp,
@@ -51,7 +68,10 @@ from independent_sim.excitation import (
     three_two_one_one,
 )
 from independent_sim.flight import Flight, ManeuverTruth
+from independent_sim.forcing import AnyEffect
 from independent_sim.maneuvers import Chirp, Doublet, Maneuver, Multisine, PilotedSweep, ThreeTwoOneOne
+from independent_sim.nuisances import DEFAULT_NUISANCES, Nuisances
+from independent_sim.pairs import open_pair_case
 from independent_sim.plant import HoverPlant, Trim, hover_plant, linear_plant
 from independent_sim.scenario import Case, FlightPlan, NoiseModel, Reposition
 from independent_sim.simulate import simulate
@@ -91,4 +111,18 @@ __all__ = [
     "ManeuverTruth",
     "simulate",
     "WindModel",
+    "AnyEffect",
+    "MotorWear",
+    "AirframeDrag",
+    "ClimbInflow",
+    "TranslationalLift",
+    "ThrustCeiling",
+    "GyroScale",
+    "AccelScale",
+    "SwingingPayload",
+    "MixerCrossCoupling",
+    "SpeedPitchMoment",
+    "Nuisances",
+    "DEFAULT_NUISANCES",
+    "open_pair_case",
 ]

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from independent_sim._mixer import PITCH_ARM, ROLL_ARM, YAW_SPIN
 from independent_sim.effects import pack_current, pack_voltage
 from independent_sim.flight import Flight
 
@@ -23,11 +24,6 @@ __all__ = [
 #: Take-off point (a field in Nebraska), degrees, and its altitude above mean sea level, m.
 HOME_LAT_DEG, HOME_LON_DEG, HOME_ALT_M = 40.849120, -96.470310, 362.0
 _EARTH_RADIUS_M = 6_371_000.0
-# Octocopter X: motor k at 22.5° + 45° k clockwise from the nose, alternating spin.
-_ANGLES = np.radians(22.5 + 45.0 * np.arange(8))
-_ROLL = -np.sin(_ANGLES)
-_PITCH = np.cos(_ANGLES)
-_YAW = np.array([1.0, -1.0] * 4)
 
 
 def sample_indices(flight: Flight, rate_hz: float, offset_s: float = 0.0) -> np.ndarray:
@@ -72,8 +68,8 @@ def motor_commands(flight: Flight, index: np.ndarray) -> np.ndarray:
     t = flight.truth
     motors = (
         t["delta_thr"][index, None]
-        + 0.5 * (t["delta_lat"][index, None] * _ROLL + t["delta_lon"][index, None] * _PITCH)
-        + 0.3 * t["delta_yaw"][index, None] * _YAW
+        + 0.5 * (t["delta_lat"][index, None] * ROLL_ARM + t["delta_lon"][index, None] * PITCH_ARM)
+        + 0.3 * t["delta_yaw"][index, None] * YAW_SPIN
     )
     idle = np.where(flight.armed[index], 0.05, 0.0)
     return np.clip(np.maximum(motors, idle[:, None]), 0.0, 1.0)

@@ -14,7 +14,8 @@ Messages and rates (400 Hz grid and loop)::
     PARM, MSG (firmware, frame), MODE (Loiter), EV (armed, take-off, landed, disarmed)
 
 The mixer outputs are RATE's ROut, POut, YOut (-1..1) and AOut (0..1), as
-Copter ≥ 3.4 logs them with ``TimeUS``.
+Copter ≥ 3.4 logs them with ``TimeUS``. A flight's logging gaps
+(``Flight.dropouts_s``) leave out every message inside them.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import numpy as np
 from flightlogs.writers import MessageBlock, MessageSpec, standard_block, write_dataflash
 from independent_sim._common import HOME_ALT_M, battery, geodetic, motor_commands, sample_indices
 from independent_sim.flight import Flight
+from independent_sim.nuisances import keep_mask
 
 __all__ = ["ARDUPILOT_RATES", "write_ardupilot"]
 
@@ -302,6 +304,24 @@ def _parameters(flight: Flight) -> dict[str, float]:
     }
 
 
+def _without_gaps(
+    blocks: list[MessageBlock], expected: Expected, spans_s: tuple[tuple[float, float], ...]
+) -> tuple[list[MessageBlock], Expected]:
+    """Every message, and what the reader must return, less those inside the logging gaps."""
+    kept = []
+    for block in blocks:
+        if "TimeUS" not in block.data:
+            kept.append(block)
+            continue
+        keep = keep_mask(np.asarray(block.data["TimeUS"], np.int64), spans_s)
+        kept.append(MessageBlock(block.spec, {k: np.asarray(v)[keep] for k, v in block.data.items()}))
+    out = {}
+    for name, (time_s, values) in expected.items():
+        keep = keep_mask(np.rint(time_s * 1e6).astype(np.int64), spans_s)
+        out[name] = (time_s[keep], values[keep])
+    return kept, out
+
+
 def write_ardupilot(flight: Flight, path: Path) -> Expected:
     """Write `flight` as a DataFlash log at `path`.
 
@@ -323,6 +343,8 @@ def write_ardupilot(flight: Flight, path: Path) -> Expected:
     expected: Expected = {}
     blocks = _inertial(flight, expected) + _navigation(flight, expected) + _outputs(flight, expected)
     blocks += [_sticks(flight, expected), *_events(flight)]
+    if flight.dropouts_s:
+        blocks, expected = _without_gaps(blocks, expected, flight.dropouts_s)
     frame = standard_block("MSG", TimeUS=[flight.time_us[0]], Message=np.array(["Frame: OCTA/X"], dtype=object))
     write_dataflash(
         path,

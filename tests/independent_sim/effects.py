@@ -8,8 +8,10 @@ inverse square, a fade of the control moments with the voltage that the search d
 
 Each effect is a force or moment that the closed loop feels at every control step, computed from
 the state the loop has reached (height, thrust, time) and added to the plant's unmeasured
-disturbance inputs ``dist_w``, ``dist_p``, ``dist_q`` (m/s², rad/s²). The accelerometers read the
-state derivative (eq. 3.7), so they feel it as a real force would be felt.
+disturbance inputs ``dist_w``, ``dist_p``, ``dist_q`` (m/s², rad/s²) by :mod:`.forcing`. The
+accelerometers read the state derivative (eq. 3.7), so they feel it as a real force would be felt.
+More effects: :mod:`.effects_more` (the search's newer catalogue entries, our own laws) and
+:mod:`.effects_outside` (physics outside the search's catalogue).
 
 The specific thrust of the linear plant, ``T = g - Z_thr d_thr`` (m/s², up; ``d_thr`` the lagged
 thrust command about trim), scales every effect on thrust:
@@ -26,13 +28,11 @@ OffsetCentre       rolling and pitching moments ``(k_roll, k_pitch) T``
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = [
-    "FORCED",
     "GroundCushion",
     "BatteryFade",
     "PayloadPickUp",
@@ -40,12 +40,7 @@ __all__ = [
     "Effect",
     "pack_voltage",
     "pack_current",
-    "EffectForcing",
-    "effect_forcing",
 ]
-
-#: Effects act through these plant inputs (unmeasured disturbance accelerations), in this order.
-FORCED = ("dist_w", "dist_p", "dist_q")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -141,80 +136,3 @@ def pack_voltage(thrust: np.ndarray, airborne_s: np.ndarray) -> np.ndarray:
 def pack_current(thrust: np.ndarray) -> np.ndarray:
     """Current drawn by the motors at a thrust command (0..1), A."""
     return 0.8 + 95.0 * np.abs(thrust) ** 1.5
-
-
-@dataclass(frozen=True, slots=True)
-class EffectForcing:
-    """The effects of one flight as disturbance accelerations, step by step.
-
-    Parameters
-    ----------
-    effects : tuple of Effect
-        What acts.
-    gravity, z_thr, l_lat, m_lon : float
-        g (m/s²), Z_thr (m/s² per unit), L_lat and M_lon (rad/s² per unit) of the plant.
-    trim_thrust : float
-        Logged thrust at trim (normalised).
-    hover_height_m : float
-        Height at which ``z_d`` is zero, m.
-    """
-
-    effects: tuple[Effect, ...]
-    gravity: float
-    z_thr: float
-    l_lat: float
-    m_lon: float
-    trim_thrust: float
-    hover_height_m: float
-
-    def at(self, t_s: float, state: dict[str, float], thrust_command: float) -> np.ndarray:
-        """Disturbance accelerations ``dist_w, dist_p, dist_q`` (m/s², rad/s²) at one control step.
-
-        Parameters
-        ----------
-        t_s : float
-            Time after take-off, s.
-        state : dict of str to float
-            Plant states (perturbations): ``z_d``, ``d_thr``, ``d_lat``, ``d_lon``.
-        thrust_command : float
-            Thrust command as logged (trim included), normalised.
-
-        Returns
-        -------
-        ndarray, shape (3,)
-        """
-        thrust = self.gravity - self.z_thr * state["d_thr"]  # specific thrust, m/s², up
-        force, roll, pitch = 0.0, 0.0, 0.0
-        for effect in self.effects:
-            if isinstance(effect, GroundCushion):
-                z = max(self.hover_height_m - state["z_d"], 0.0) + effect.rotor_above_m
-                force += thrust * effect.gain * np.exp(-z / effect.decay_m)
-            elif isinstance(effect, BatteryFade):
-                volts = pack_voltage(np.array([thrust_command]), np.array([t_s]))[0]
-                fade = (volts / effect.full_v) ** effect.exponent - 1.0
-                force += thrust * fade
-                roll += fade * self.l_lat * state["d_lat"]
-                pitch += fade * self.m_lon * state["d_lon"]
-            elif isinstance(effect, PayloadPickUp):
-                if t_s >= effect.at_s:
-                    force -= thrust * effect.ratio / (1.0 + effect.ratio)
-            else:
-                roll += effect.roll_rad_m * thrust
-                pitch += effect.pitch_rad_m * thrust
-        return np.array([-force, roll, pitch])  # more thrust: w (down) decelerates
-
-
-def effect_forcing(
-    effects: Sequence[Effect],
-    *,
-    gravity: float,
-    z_thr: float,
-    l_lat: float,
-    m_lon: float,
-    trim_thrust: float,
-    hover_height_m: float,
-) -> EffectForcing | None:
-    """The step-by-step forcing of `effects`, or None when there are none."""
-    if not effects:
-        return None
-    return EffectForcing(tuple(effects), gravity, z_thr, l_lat, m_lon, trim_thrust, hover_height_m)

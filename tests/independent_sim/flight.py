@@ -75,7 +75,9 @@ class Flight:
         ``vn_sp ve_sp vd_sp``, ``height_sp`` m, ``stick_lat stick_lon stick_yaw
         stick_thr`` (-1..1: right, back, right, climb; centred unless a pilot
         flies the maneuver), ``wind_n wind_e`` m/s,
-        and ``exc_mixer_<axis>``, the excitation injected at the mixer (never logged).
+        ``exc_mixer_<axis>``, the excitation injected at the mixer, and ``effect_u effect_v effect_w
+        effect_p effect_q effect_r``, the accelerations the case's effects added (m/s², rad/s²), and ``actuator_lat actuator_lon
+        actuator_thr``, the lagged mixer inputs of eq. 3.2 (what the rotors produce; never logged).
     measured : Mapping[str, ndarray]
         Sensor and estimator outputs: ``p q r ax ay az phi theta psi vn ve vd x_n y_e height``.
     armed, airborne : ndarray of bool, shape (n,)
@@ -92,6 +94,8 @@ class Flight:
         The wind at the anemometer.
     utc_offset_s : float
         UTC minus log clock, s.
+    dropouts_s : tuple of (float, float)
+        Logging gaps ``[start_s, end_s)`` on the log clock: the writers leave out every sample inside them.
     """
 
     case: Case
@@ -109,6 +113,7 @@ class Flight:
     loop: ClosedLoop = field(repr=False)
     wind: WindField | None = field(repr=False)
     utc_offset_s: float
+    dropouts_s: tuple[tuple[float, float], ...] = ()
 
     @property
     def time_us(self) -> np.ndarray:

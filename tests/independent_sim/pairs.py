@@ -7,17 +7,33 @@ a slower actuator, more speed damping); nothing in the log says which.
 
 :func:`physics_pair_case` flies a longer plan (240 s) that adds a low hover (0.35 m for 20 s) after
 the repositions, for physics outside the plant (:mod:`independent_sim.effects`) or a wind.
+
+:func:`open_pair_case` flies a 250 s plan that also shows the newer physics (:mod:`independent_sim.effects_more`,
+:mod:`independent_sim.effects_outside`): faster repositions (20 m in 5 s, over 5 m/s), a climb and a descent of
+4 m at 2 m/s, and the real sensors' nuisances (:mod:`independent_sim.nuisances`) on SIM and REAL alike.
 """
 
 from __future__ import annotations
 
 from independent_sim.effects import Effect
+from independent_sim.forcing import AnyEffect
 from independent_sim.maneuvers import Chirp, Maneuver
+from independent_sim.nuisances import DEFAULT_NUISANCES, Nuisances
 from independent_sim.plant import hover_plant
 from independent_sim.scenario import Case, FlightPlan, HeightChange, Reposition
 from independent_sim.wind import WindModel
 
-__all__ = ["PLANT", "Changes", "delayed", "scaled", "pair_case", "physics_pair_case", "LOW_HOVER_M"]
+__all__ = [
+    "PLANT",
+    "Changes",
+    "delayed",
+    "scaled",
+    "pair_case",
+    "physics_pair_case",
+    "open_pair_case",
+    "OPEN_PLAN",
+    "LOW_HOVER_M",
+]
 
 #: The plant both flights start from (Table 3.3, calm).
 PLANT = hover_plant("calm")
@@ -94,4 +110,70 @@ def physics_pair_case(
         plant_changes=changes,
         wind=wind,
         effects=effects,
+    )
+
+
+_DOWN = 4.6 - LOW_HOVER_M
+#: The plan of :func:`open_pair_case` (times after take-off): chirps on lon (10-50 s), lat (56-96 s) and yaw
+#: (102-142 s); 20 m north in 5 s at 146 s and back at 160 s (peak 5.3 m/s); up 4 m in 3 s at 174 s and down
+#: at 183 s (2 m/s); down to 0.35 m at 192 s, 20 s there, up at 217 s; landing from 243 s; 250 s in all.
+OPEN_PLAN = FlightPlan(
+    duration_s=250.0,
+    repositions=(Reposition(start_s=146.0, north_m=20.0), Reposition(start_s=160.0, north_m=-20.0)),
+    height_changes=(
+        HeightChange(start_s=174.0, down_m=-4.0, duration_s=3.0),
+        HeightChange(start_s=183.0, down_m=4.0, duration_s=3.0),
+        HeightChange(start_s=192.0, down_m=_DOWN),
+        HeightChange(start_s=217.0, down_m=-_DOWN),
+    ),
+)
+
+
+def open_pair_case(
+    name: str,
+    seed: int,
+    *,
+    effects: tuple[AnyEffect, ...] = (),
+    nuisances: Nuisances | None = DEFAULT_NUISANCES,
+    changes: Changes = (),
+    wind: WindModel | None = None,
+) -> Case:
+    """One flight of the open plan (:data:`OPEN_PLAN`): sweeps, fast repositions, a climb, a low hover; PX4 ULog.
+
+    Parameters
+    ----------
+    name : str
+        Case name.
+    seed : int
+        Noise seed (the nuisances draw from it too).
+    effects : tuple of AnyEffect
+        Physics acting on this vehicle, in or outside the search's catalogue (none for SIM).
+    nuisances : Nuisances or None
+        Vibration, gyro drift and logging gaps, on SIM and REAL alike; None switches them off.
+    changes : Changes
+        Plant fields set to other values (none for SIM).
+    wind : WindModel or None
+        A wind for the calm airframe (the anemometer's CSV is written with the log).
+
+    Returns
+    -------
+    Case
+
+    Examples
+    --------
+    >>> from independent_sim.effects_outside import MixerCrossCoupling
+    >>> case = open_pair_case("real", 3, effects=(MixerCrossCoupling(),))
+    >>> case.plan.duration_s, case.nuisances is not None
+    (250.0, True)
+    """
+    return Case(
+        name=name,
+        fmt="ulog",
+        plan=OPEN_PLAN,
+        maneuvers=_sweeps(),
+        seed=seed,
+        plant_changes=changes,
+        wind=wind,
+        effects=effects,
+        nuisances=nuisances,
     )

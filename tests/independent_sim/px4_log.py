@@ -20,7 +20,9 @@ Topics, rates and phases (1 kHz grid, rate loop at 250 Hz)::
 
 Nothing records the excitation itself (no chirp or system-identification
 topic): the torque and thrust setpoints carry controller output plus
-excitation, as in an ordinary flight log.
+excitation, as in an ordinary flight log. A flight's logging gaps
+(``Flight.dropouts_s``, an SD card stalling) leave out every topic's samples
+inside them.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ import numpy as np
 from flightlogs.writers import TopicData, write_ulog
 from independent_sim._common import HOME_ALT_M, battery, geodetic, motor_commands, quaternion, sample_indices
 from independent_sim.flight import Flight
+from independent_sim.nuisances import keep_mask
 
 __all__ = ["PX4_RATES", "write_px4"]
 
@@ -354,6 +357,21 @@ def _parameters(flight: Flight) -> dict[str, int | float]:
     }
 
 
+def _without_gaps(
+    topics: list[TopicData], expected: Expected, spans_s: tuple[tuple[float, float], ...]
+) -> tuple[list[TopicData], Expected]:
+    """Every topic, and what the reader must return, less the samples inside the logging gaps."""
+    kept = []
+    for topic in topics:
+        keep = keep_mask(np.asarray(topic.fields["timestamp"]), spans_s)
+        kept.append(TopicData(topic.name, {k: np.asarray(v)[keep] for k, v in topic.fields.items()}, topic.multi_id))
+    out = {}
+    for name, (time_s, values) in expected.items():
+        keep = keep_mask(np.rint(time_s * 1e6).astype(np.int64), spans_s)
+        out[name] = (time_s[keep], values[keep])
+    return kept, out
+
+
 def write_px4(flight: Flight, path: Path) -> Expected:
     """Write `flight` as a ULog at `path`.
 
@@ -375,6 +393,8 @@ def write_px4(flight: Flight, path: Path) -> Expected:
     expected: Expected = {}
     topics = _sensors(flight, expected) + _estimates(flight, expected) + _setpoints(flight, expected)
     topics += _vehicle(flight, expected)
+    if flight.dropouts_s:
+        topics, expected = _without_gaps(topics, expected, flight.dropouts_s)
     armed_at = int(flight.time_us[np.argmax(flight.armed)])
     takeoff_at = int(flight.time_us[np.argmax(flight.airborne)])
     landed_at = int(flight.time_us[len(flight.airborne) - np.argmax(flight.airborne[::-1])])

@@ -5,8 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from independent_sim.effects import Effect
+from independent_sim.forcing import AnyEffect
 from independent_sim.maneuvers import Maneuver
+from independent_sim.nuisances import Nuisances
 from independent_sim.wind import WindModel
 
 __all__ = ["LogFormat", "NoiseModel", "Reposition", "HeightChange", "FlightPlan", "Case"]
@@ -190,8 +191,12 @@ class Case:
     plant_changes : tuple of (str, float)
         :class:`~independent_sim.plant.HoverPlant` fields set to other values (a vehicle that differs from
         the Table 3.3 one: a longer delay, a slower actuator, more drag).
-    effects : tuple of Effect
-        Physics outside the linear plant that acts on this vehicle (:mod:`independent_sim.effects`).
+    effects : tuple of AnyEffect
+        Physics outside the linear plant that acts on this vehicle (:mod:`independent_sim.effects`,
+        :mod:`independent_sim.effects_more`, :mod:`independent_sim.effects_outside`), sensor scale errors
+        included.
+    nuisances : Nuisances or None
+        Rotor vibration, gyro bias drift and logging dropouts (:mod:`independent_sim.nuisances`); None: none.
     """
 
     name: str
@@ -206,7 +211,8 @@ class Case:
     seed: int = 0
     description: str = ""
     plant_changes: tuple[tuple[str, float], ...] = ()
-    effects: tuple[Effect, ...] = ()
+    effects: tuple[AnyEffect, ...] = ()
+    nuisances: Nuisances | None = None
 
     def __post_init__(self) -> None:
         if self.fmt not in ("ulog", "dataflash"):

@@ -6,8 +6,13 @@
    400 Hz ArduPilot), follow exactly from the held, delayed inputs
    (:mod:`._zoh`); the accelerometers from the state derivative (eq. 3.7).
 3. Trim is added, the ground phases before take-off and after touch-down are
-   appended, and the sensors add their errors. The logs are samples of
-   these arrays (:mod:`.px4_log`, :mod:`.ardupilot_log`).
+   appended, and the sensors add their errors (scale errors of the case's
+   effects, and its nuisances: rotor vibration, a drifting gyro bias). The logs
+   are samples of these arrays (:mod:`.px4_log`, :mod:`.ardupilot_log`),
+   less the nuisances' logging gaps.
+
+Physics outside the plant (:mod:`.forcing`) is computed at each control step
+from the state reached and enters the plant's disturbance inputs.
 """
 
 from __future__ import annotations
@@ -28,8 +33,10 @@ from independent_sim.control import (
     closed_loop,
     px4_gains,
 )
-from independent_sim.effects import FORCED, EffectForcing, effect_forcing
+from independent_sim.effects_more import AccelScale, GyroScale
 from independent_sim.flight import Flight, ManeuverTruth
+from independent_sim.forcing import FORCED, EffectForcing, PlantContext, Step, effect_forcing
+from independent_sim.nuisances import dropout_spans, gyro_drift, nuisance_rng, vibration
 from independent_sim.plant import AIR_INPUTS, PLANT_INPUTS, STATES, G, HoverPlant, hover_plant, in_wind
 from independent_sim.scenario import Case, LogFormat
 from independent_sim.wind import WindField, wind_field
@@ -74,23 +81,33 @@ def simulate(case: Case, fmt: LogFormat | None = None) -> Flight:
             case.wind, grid.time_s[0] - delay - 10.0, grid.time_s[-1] + 10.0, 0.01, rng, zero_mean_over=span
         )
     noise = sensor_errors(case.noise, grid.time_s.size, grid.step_us * 1e-6, rng)
+    spare = nuisance_rng(case.seed)
+    if case.nuisances is not None:  # the rate loop flies on the drifting gyro too
+        drift = gyro_drift(case.nuisances, grid.time_s.size, grid.step_us * 1e-6, spare)
+        for k, name in enumerate(("p", "q", "r")):
+            noise[name] = noise[name] + drift[:, k]
     control_t = np.arange(grid.n_steps) / gains.rate_hz
     W, external, maneuvers = exogenous_inputs(
         case, loop, plant, control_t, grid.takeoff_s, noise, grid.n_before, field_, rng
     )
-    forcing = effect_forcing(
-        case.effects,
+    trim = plant.trim
+    context = PlantContext(
         gravity=G,
         z_thr=plant.Z_thr,
         l_lat=plant.L_lat,
         m_lon=plant.M_lon,
-        trim_thrust=plant.trim.delta_thr,
+        n_yaw=plant.N_yaw,
+        trim_commands=np.array([trim.delta_lat, trim.delta_lon, trim.delta_yaw, trim.delta_thr]),
+        trim_theta_rad=trim.theta0,
         hover_height_m=plan.hover_height_m,
+        period_s=loop.period_s,
     )
+    forcing = effect_forcing(case.effects, context)
+    added = np.zeros((grid.n_steps, len(FORCED)))
     if forcing is None:
         X = _run(loop, W, _initial_state(loop, plant, case))
     else:
-        X = _run_forced(loop, W, _initial_state(loop, plant, case), forcing)
+        X = _run_forced(loop, W, _initial_state(loop, plant, case), forcing, added)
         for name in FORCED:  # what the effects added, for the fine grid
             column = {c: k for k, c in enumerate(loop.inputs)}
             external[name] = (W[:, column[f"{name}@prev"]], W[:, column[f"{name}@cur"]])
@@ -98,7 +115,16 @@ def simulate(case: Case, fmt: LogFormat | None = None) -> Flight:
     outputs = {name: Y[:, k] for k, name in enumerate(loop.outputs)}
     x_fine, xdot_fine = _lift(loop, X[:-1, : len(STATES)], outputs, external)
     flight = _compose(plant, loop, x_fine, xdot_fine, outputs, W, case)
+    for k, name in enumerate(FORCED):  # for tests only: never written to a log
+        flight[f"effect_{name[5:]}"] = np.repeat(added[:, k], loop.n_sub)
     truth = _with_ground(flight, plant, grid, field_)
+    felt: dict[str, np.ndarray] = {}
+    dropouts: tuple[tuple[float, float], ...] = ()
+    if case.nuisances is not None:
+        shaking = vibration(case.nuisances, grid.time_s, truth["delta_thr"], plant.trim.delta_thr, spare)
+        felt = {name: shaking[:, k] for k, name in enumerate(("ax", "ay", "az"))}
+        touchdown_s = float(grid.time_s[grid.time_s.size - grid.n_after - 1])
+        dropouts = dropout_spans(case.nuisances, grid.takeoff_s, touchdown_s, spare)
     return Flight(
         case=case,
         fmt=fmt,
@@ -106,7 +132,7 @@ def simulate(case: Case, fmt: LogFormat | None = None) -> Flight:
         step_us=grid.step_us,
         sub_steps=loop.n_sub,
         truth=MappingProxyType(truth),
-        measured=MappingProxyType(_measure(truth, noise)),
+        measured=MappingProxyType(_measure(truth, noise, case, felt)),
         armed=grid.armed(),
         airborne=grid.airborne(),
         maneuvers=tuple(sorted((_shift(m, grid.takeoff_s) for m in maneuvers), key=lambda m: m.start_s)),
@@ -115,6 +141,7 @@ def simulate(case: Case, fmt: LogFormat | None = None) -> Flight:
         loop=loop,
         wind=field_,
         utc_offset_s=plan.utc_at_log_start - float(grid.time_s[0]),
+        dropouts_s=dropouts,
     )
 
 
@@ -186,28 +213,54 @@ def _run(loop: ClosedLoop, W: np.ndarray, x0: np.ndarray) -> np.ndarray:
     return X
 
 
-def _run_forced(loop: ClosedLoop, W: np.ndarray, x0: np.ndarray, forcing: EffectForcing) -> np.ndarray:
+def _run_forced(
+    loop: ClosedLoop, W: np.ndarray, x0: np.ndarray, forcing: EffectForcing, added_out: np.ndarray
+) -> np.ndarray:
     """States X[0..n] with the effects' disturbances computed from each step's state (W updated in place).
 
     A disturbance input without delay enters step k as ``name@cur`` and step k + 1 as ``name@prev``.
+    The effects' accelerations of each step are written to `added_out`, shape (n, 6).
     """
     column = {name: k for k, name in enumerate(loop.inputs)}
-    state = {name: k for k, name in enumerate(loop.states)}
     for name in FORCED:
         if loop.maps[PLANT_INPUTS.index(name)].n_periods != 0:
             raise ValueError(f"{name} must enter without delay")
     cur = [column[f"{name}@cur"] for name in FORCED]
     prev = [column[f"{name}@prev"] for name in FORCED]
     thrust_row = loop.outputs.index("delta_thr")
-    trim_thrust = forcing.trim_thrust
+    context, laws = forcing.context, forcing.laws()
     A, B, C_thr, D_thr = loop.A, loop.B, loop.C[thrust_row], loop.D[thrust_row]
+    s = {name: k for k, name in enumerate(STATES)}
+    yaw_input = loop.states.index(f"buf_delta_yaw_{loop.maps[PLANT_INPUTS.index('delta_yaw')].n_periods}")
+    if STATES[:6] != ("u", "v", "w", "p", "q", "r") or STATES[9:12] != ("d_lat", "d_lon", "d_thr"):
+        raise ValueError("the plant's states are out of the order the effects read them in")
+    own = loop.plant.A[[s["u"], s["v"]]]  # u' and v' of the plant alone
+    air_trim, trim = loop.plant.air_velocity_trim, context.trim_commands
+    commands = np.empty(4)
     X = np.empty((W.shape[0] + 1, x0.size))
     X[0] = x = x0
-    picked = ("z_d", "d_thr", "d_lat", "d_lon")
     for k in range(W.shape[0]):
-        command = trim_thrust + C_thr @ x + D_thr @ W[k]
-        added = forcing.at(k * loop.period_s, {n: x[state[n]] for n in picked}, float(command))
+        commands[:2], commands[2], commands[3] = x[9:11], x[yaw_input], x[11]
+        step = Step(
+            t_s=k * loop.period_s,
+            height_m=context.hover_height_m - x[s["z_d"]],
+            air_m_s=x[:3] + air_trim,
+            rates_rad_s=x[3:6],
+            phi=x[s["phi"]],
+            theta=x[s["theta"]],
+            d_lat=x[9],
+            d_lon=x[10],
+            d_thr=x[11],
+            commands=commands + trim,
+            thrust=context.gravity - context.z_thr * x[11],
+            thrust_command=float(trim[3] + C_thr @ x + D_thr @ W[k]),
+            accel_sim=own @ x[: len(STATES)],
+        )
+        added = laws[0](step)
+        for law in laws[1:]:
+            added = added + law(step)
         W[k, cur] += added
+        added_out[k] = added
         if k + 1 < W.shape[0]:
             W[k + 1, prev] += added
         x = A @ x + B @ W[k]
@@ -300,6 +353,8 @@ def _compose(
     out["wind_n"], out["wind_e"] = wind[:, 0], wind[:, 1]
     for name in MIXER:
         out[name] = hold(outputs[name]) + getattr(trim, name)
+    for axis in ("lat", "lon", "thr"):  # for tests only: the lagged inputs of eq. 3.2, trim included
+        out[f"actuator_{axis}"] = x[:, s[f"d_{axis}"]] + getattr(trim, f"delta_{axis}")
     for name in ("p_sp", "q_sp", "r_sp", "phi_sp", "vn_sp", "ve_sp", "vd_sp"):
         out[name] = hold(outputs[name])
     out["theta_sp"] = hold(outputs["theta_sp"]) + trim.theta0
@@ -347,9 +402,19 @@ def _with_ground(
     return out
 
 
-def _measure(truth: Mapping[str, np.ndarray], errors: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """Sensor outputs: truth plus the errors the controller also saw."""
-    measured = {name: truth[name] + errors[name] for name in ("p", "q", "r", "ax", "ay", "az", "phi", "theta")}
+def _measure(
+    truth: Mapping[str, np.ndarray], errors: Mapping[str, np.ndarray], case: Case, felt: Mapping[str, np.ndarray]
+) -> dict[str, np.ndarray]:
+    """Sensor outputs: truth (and what only the sensor `felt`, e.g. vibration) scaled, plus the errors the controller also saw."""
+    scales: dict[str, float] = {}
+    for effect in case.effects:
+        if isinstance(effect, GyroScale | AccelScale):
+            scales.update(effect.scales)
+    measured = {
+        name: scales.get(name, 1.0) * (truth[name] + felt.get(name, 0.0)) + errors[name]
+        for name in ("p", "q", "r", "ax", "ay", "az")
+    }
+    measured.update({name: truth[name] + errors[name] for name in ("phi", "theta")})
     measured["psi"] = _wrap(truth["psi"] + errors["psi"])
     for name in ("vn", "ve", "vd", "x_n", "y_e"):
         measured[name] = truth[name] + errors[name]

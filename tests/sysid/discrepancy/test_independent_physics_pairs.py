@@ -75,6 +75,13 @@ PAIRS: dict[str, tuple[tuple[str, ...], tuple[object, ...]]] = {
 #: Wind pairs (through ``sysid discrepancy --wind``): mean speed, m/s (the chapter 3 strong and light days).
 WINDS = {"wind": 5.4, "wind_weak": 2.7}
 
+#: Named beside the concealed effect, and right too: this generator's battery fades the roll and pitch moment per
+#: command with the voltage (7 % under the simulation's at the pack's mean voltage), a control effectiveness of its
+#: own since the catalogue has one (issue 30).
+_ALSO_RIGHT = {
+    name: {"control_effectiveness"} for name in ("battery_sag", "battery_sag_weak", "ground_effect+battery_sag")
+}
+
 Found = tuple[DiscrepancyResult, float]  # the result, and the REAL log's first flown sample on the log clock (s)
 
 
@@ -120,7 +127,8 @@ def test_the_physics_left_out_is_named_and_nothing_else(results: dict[str, Found
     """Every single effect at both strengths is named alone, both effects of a double, nothing on the null."""
     result, _ = results[name]
     concealed = PAIRS[name][0]
-    assert sorted(f.effect for f in result.findings) == sorted(concealed), result.summary
+    found = {f.effect for f in result.findings}
+    assert set(concealed) <= found and found - set(concealed) <= _ALSO_RIGHT.get(name, set()), result.summary
     assert result.verdict in (concealed or ("none",))
     for finding in result.findings:
         assert finding.improvement_percent > 0.0, finding

@@ -1,0 +1,142 @@
+"""Discrepancy discovery in an open world (issue 30), on another generator's logs with real sensors' nuisances.
+
+``independent_sim`` (no code shared with ``simulator`` or ``sysid``) flies the open pair plan
+(:func:`independent_sim.pairs.open_pair_case`: sweeps, 20 m repositions at ~6 m/s, a 4 m climb and
+descent, 20 s at 0.35 m) with every log carrying accelerometer vibration (rotor lines at 140-280 Hz,
+aliased to 60-80 Hz in the log, 1-2 m/s²), drifting gyro biases and 1-3 logging dropouts of 0.1-0.3 s
+in every topic. Its REAL vehicles carry physics written for these tests with laws of that generator's
+own: the new catalogue effects (worn motors, airframe drag, rotor inflow, translational lift, a thrust
+ceiling), the older ones (ground cushion, CG offset, longer delay, slower actuators), and three effects
+that no catalogue term describes (a load swinging on a cable, a roll command that also pitches, a
+pitch and roll moment that follow the airspeed).
+
+Tuning and assertions are apart: the search's new thresholds (the model of the unknown's margin, the
+far-from-floor rule, the interleaved folds, the anti-alias filter, the thrust re-centring) were set on
+SIM seed 3000 and REAL seeds 3001 on; every assertion runs on SIM seed 5000 and REAL seeds 5001 on.
+
+Limits, said here rather than hidden: one seed per case (not the issue's rates over many seeds); the
+catalogue's ``sensor_scale`` is not built, so the generator's gyro and accelerometer scale errors are
+not asserted; a hard per-motor thrust ceiling is named first but not alone (the lost moments leave a
+second, smaller finding).
+"""
+
+from __future__ import annotations
+
+import statistics
+
+import pytest
+from independent_sim import (
+    AirframeDrag,
+    ClimbInflow,
+    MixerCrossCoupling,
+    MotorWear,
+    SpeedPitchMoment,
+    SwingingPayload,
+    ThrustCeiling,
+    TranslationalLift,
+)
+from independent_sim.corpus import write_case
+from independent_sim.effects import GroundCushion, OffsetCentre
+from independent_sim.pairs import delayed, open_pair_case, scaled
+
+from sysid.discrepancy import DiscrepancyResult, discover
+
+from builders import discrepancy_series
+
+pytestmark = [
+    pytest.mark.long,
+    pytest.mark.timeout(1800),
+    pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning"),
+]
+
+SIM_SEED, REAL_SEED = 5000, 5001  # held out: the thresholds were set on 3000 and 3001 on
+
+#: Catalogue effects: name -> (the effect concealed, the REAL vehicle's effects, its plant changes).
+NAMED = {
+    "worn_motors_thrust": ("control_effectiveness", (MotorWear(thrust_fraction=0.30),), ()),
+    "worn_motors_moments": (
+        "control_effectiveness",
+        (MotorWear(thrust_fraction=0.0, roll_fraction=0.20, pitch_fraction=0.20),),
+        (),
+    ),
+    "parasitic_drag": ("parasitic_drag", (AirframeDrag(),), ()),
+    "inflow": ("inflow", (ClimbInflow(),), ()),
+    "translational_lift": ("translational_lift", (TranslationalLift(),), ()),
+    "ground_effect": ("ground_effect", (GroundCushion(),), ()),
+    "cg_offset": ("cg_offset", (OffsetCentre(),), ()),
+    "time_delay": ("time_delay", (), delayed(0.015)),
+    "actuator_lag": ("actuator_lag", (), scaled(1.6, "T_a")),
+}
+#: Effects outside the catalogue: the right answer is ``unexplained`` on one of their primary outputs.
+OUTSIDE = {
+    "swinging_payload": SwingingPayload(),
+    "mixer_cross_coupling": MixerCrossCoupling(),
+    "speed_pitch_moment": SpeedPitchMoment(),
+}
+CEILING = ThrustCeiling()
+
+
+@pytest.fixture(scope="module", name="results")
+def results_fixture(tmp_path_factory: pytest.TempPathFactory) -> dict[str, DiscrepancyResult]:
+    folder = tmp_path_factory.mktemp("open-world-pairs")
+    sim = discrepancy_series(write_case(open_pair_case("sim", SIM_SEED), folder).log)
+    cases: dict[str, tuple[tuple[object, ...], tuple[tuple[str, float], ...]]] = {
+        "none": ((), ()),
+        **{name: (effects, changes) for name, (_, effects, changes) in NAMED.items()},
+        **{name: ((effect,), ()) for name, effect in OUTSIDE.items()},
+        "thrust_ceiling": ((CEILING,), ()),
+    }
+    out = {}
+    for k, (name, (effects, changes)) in enumerate(cases.items()):
+        case = open_pair_case(f"real-{k}", REAL_SEED + k, effects=effects, changes=changes)  # type: ignore[arg-type]
+        out[name] = discover([sim], [discrepancy_series(write_case(case, folder).log)])
+    return out
+
+
+def test_nothing_is_found_where_nothing_is_missing_under_the_nuisances(results: dict[str, DiscrepancyResult]) -> None:
+    """Vibration, gyro drift and dropouts on both logs, no physics apart: ``none``, no finding."""
+    assert results["none"].verdict == "none" and results["none"].findings == (), results["none"].summary
+
+
+@pytest.mark.parametrize("name", list(NAMED))
+def test_a_catalogue_effect_is_named_alone(results: dict[str, DiscrepancyResult], name: str) -> None:
+    result, effect = results[name], NAMED[name][0]
+    assert [f.effect for f in result.findings] == [effect], result.summary
+    assert result.findings[0].improvement_percent > 0.0
+
+
+@pytest.mark.parametrize("name", list(OUTSIDE))
+def test_an_effect_outside_the_catalogue_is_unexplained_on_its_own_outputs(
+    results: dict[str, DiscrepancyResult], name: str
+) -> None:
+    """``unexplained`` and nothing else: never another name, never ``none``; located on a primary output."""
+    result = results[name]
+    assert [f.effect for f in result.findings] == ["unexplained"], result.summary
+    assert set(result.findings[0].outputs) & set(OUTSIDE[name].primary_outputs), result.findings[0].outputs
+
+
+def test_the_held_out_improvements_reach_the_issues_floors(results: dict[str, DiscrepancyResult]) -> None:
+    """Median held-out cut of the residual: 50 % for named findings, 30 % for unexplained ones."""
+    named = [f.improvement_percent for n in NAMED for f in results[n].findings if f.effect == NAMED[n][0]]
+    unknown = [f.improvement_percent for n in OUTSIDE for f in results[n].findings if f.effect == "unexplained"]
+    assert statistics.median(named) >= 50.0, named
+    assert statistics.median(unknown) >= 30.0, unknown
+
+
+def _parameter(result: DiscrepancyResult, name: str) -> float:
+    (value,) = [p.value for f in result.findings for p in f.parameters if p.name == name]
+    return value
+
+
+def test_worn_motors_are_measured_within_five_points(results: dict[str, DiscrepancyResult]) -> None:
+    """30 % less thrust per command: -0.30 within 0.05; 20 % less roll and pitch moment: -0.20 within 0.05."""
+    assert _parameter(results["worn_motors_thrust"], "thrust_effectiveness_change") == pytest.approx(-0.30, abs=0.05)
+    moments = results["worn_motors_moments"]
+    assert _parameter(moments, "roll_effectiveness_change") == pytest.approx(-0.20, abs=0.05)
+    assert _parameter(moments, "pitch_effectiveness_change") == pytest.approx(-0.20, abs=0.05)
+
+
+def test_a_thrust_ceiling_is_named_first(results: dict[str, DiscrepancyResult]) -> None:
+    """The ceiling (a command, as logged) is the verdict, near the generator's 0.48 per motor."""
+    result = results["thrust_ceiling"]
+    assert result.verdict == "thrust_saturation", result.summary
