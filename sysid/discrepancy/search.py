@@ -90,6 +90,7 @@ _AMBIGUOUS_SHARE = 0.1  # ... explains the same residual as well: the finding is
 _LEVEL_CHANGE = 0.05  # a trim further than this from 1, with nothing else on az, is a change of thrust per command
 _LATE_SCORE = 0.19  # held-out share a later term must remove of its outputs' residual (a 10 % cut of their RMS)
 _FAR_LEFT = 2.5  # an output's held-out residual this many times its floor with every finding modelled is unexplained
+_OWNS = 0.3  # a finding that removed this share of its outputs' residual owns what is left there
 _WEAK = 0.15  # a term that removed less of the residual of its outputs, one of them that far, is no finding
 _NAMED_SHARE = 0.8  # a catalogue term explaining under this share of what the model of the unknown does is no name
 
@@ -220,7 +221,6 @@ def discover(
         generic = fit_generic(context, y, current, scale, outputs=best.candidate.outputs, library=library)
         if _generic_wins(best, generic, options):
             # the best name explains clearly less than a generic model of the same outputs: it is not the answer;
-            # after a named effect the model of the unknown must also be substantial (else the rest is its shape's)
             # after a named effect what is left holds its shape's error (a lag's first order against the real one):
             # only a residual that stays far above the floor is then unexplained (see _far_left)
             if not kept:
@@ -312,13 +312,16 @@ def _far_left(
     """`kept`, with what stays far above the noise floor reported as ``unexplained`` and the weak names on it dropped.
 
     An output whose held-out residual stays over :data:`_FAR_LEFT` times its floor with every finding
-    modelled holds something no term and no static model of the flight explains (a load swinging under
+    modelled (but an output a finding removed :data:`_OWNS` of the residual of: what is left there is that
+    finding's shape's error, a first-order lag against the real actuator) holds something no term and no
+    static model of the flight explains (a load swinging under
     the vehicle: dynamics of its own). A catalogue term that removed under :data:`_WEAK` of the residual of
     such an output took up a sliver of it: a guess, not a finding. The rest is located as ``unexplained``
     on those outputs, with what the model of the unknown can say of it (perhaps nothing).
     """
     floor = {o: float(np.sqrt(scale[o])) for o in OUTPUTS}
-    far = tuple(o for o in OUTPUTS if _spread(y[o] - held_out[o]) > _FAR_LEFT * floor[o])
+    owned = {o for k in kept if k.score >= _OWNS for o in k.fit.candidate.outputs}  # a strong name's shape error
+    far = tuple(o for o in OUTPUTS if o not in owned and _spread(y[o] - held_out[o]) > _FAR_LEFT * floor[o])
     if not far or any(k.fit.candidate.effect == "unexplained" for k in kept):
         return kept
     weak = [k for k in kept if k.score < _WEAK and set(k.fit.candidate.outputs) & set(far)]

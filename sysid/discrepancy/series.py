@@ -41,6 +41,7 @@ _THRUST_ON = 1.0 / 3.0  # flying: thrust above this fraction of its 95th percent
 _LIFT_OFF = 0.85  # and above this fraction of its median there (a take-off ramp on the ground is not flight)
 _ON_GROUND_M = 0.05  # and, where a height is logged, above this
 _WIND = ("wind_lon", "wind_lat")
+_VIBRATING = ("ax", "ay", "az")  # signals low-passed before they are sampled at the search's rate
 _FILTER_PAD = 60  # samples the anti-alias filter pads each record's ends with
 
 
@@ -136,7 +137,9 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
             continue
         grid = np.arange(t[0], t[-1], 1.0 / rate_hz)
         window = max(5, int(round(_SMOOTH_S * record.rate_hz)) | 1)
-        absolute = {s: _anti_aliased(record.absolute(s), record.rate_hz, rate_hz) for s in record.signals}
+        absolute = {s: record.absolute(s) for s in record.signals}
+        for s in _VIBRATING:  # the accelerometer: where the rotors' vibration lives (the rates are smoothed below)
+            absolute[s] = _anti_aliased(absolute[s], record.rate_hz, rate_hz)
         values = {s: np.interp(grid, t, x) for s, x in absolute.items()}
         for rate in ("p", "q", "r"):
             derivative = savgol_filter(absolute[rate], window, 2, deriv=1, delta=1.0 / record.rate_hz)
@@ -164,6 +167,8 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
 
 def _anti_aliased(x: np.ndarray, from_hz: float, to_hz: float) -> np.ndarray:
     """`x` low-passed (zero-phase, 4th order) at 40 % of `to_hz` before it is sampled at `to_hz`, shape (n,).
+
+    Applied to the accelerometer's signals; the rates' derivatives are smoothed over 0.1 s already.
 
     A real accelerometer's log holds the rotors' vibration (100-200 Hz, aliased by the log's own rate to
     tens of Hz, often m/s² in size); sampled again at the search's rate it would alias once more into the
