@@ -219,7 +219,10 @@ def discover(
         best = min(scores, key=lambda s: s.bic_change)
         rivals = _alternatives(best, scores)
         generic = fit_generic(context, y, current, scale, outputs=best.candidate.outputs, library=library)
-        if _generic_wins(best, generic, options):
+        # the model of the unknown must also beat every passing term, not only the one the criterion prefers
+        if _generic_wins(best, generic, options) and not any(
+            c.score >= generic.score - options.generic_margin for c in scores
+        ):
             # the best name explains clearly less than a generic model of the same outputs: it is not the answer;
             # after a named effect what is left holds its shape's error (a lag's first order against the real one):
             # only a residual that stays far above the floor is then unexplained (see _far_left)
