@@ -36,7 +36,10 @@ def batch_client(scheduler: str | None = None, workers: int | None = None) -> It
     """
     from distributed import Client, LocalCluster
 
-    logging.getLogger("distributed").setLevel(logging.ERROR)  # its INFO lines are no user's business
+    # its INFO lines are no user's business, nor a worker's lost heartbeat when the batch is interrupted (a task's
+    # own error reaches the client as an exception): under --debug everything is shown
+    level = logging.DEBUG if logging.getLogger().isEnabledFor(logging.DEBUG) else logging.CRITICAL
+    logging.getLogger("distributed").setLevel(level)
     if scheduler is not None:
         try:
             client = Client(scheduler, timeout="5s")  # type: ignore[no-untyped-call]
@@ -54,7 +57,7 @@ def batch_client(scheduler: str | None = None, workers: int | None = None) -> It
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
-            silence_logs=logging.ERROR,
+            silence_logs=level,
             env={"FLIGHT_SYSID_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
         ) as cluster,
         Client(cluster) as client,  # type: ignore[no-untyped-call]

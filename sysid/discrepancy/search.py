@@ -219,10 +219,15 @@ def discover(
         best = min(scores, key=lambda s: s.bic_change)
         rivals = _alternatives(best, scores)
         generic = fit_generic(context, y, current, scale, outputs=best.candidate.outputs, library=library)
-        # the model of the unknown must also beat every passing term, not only the one the criterion prefers
-        if _generic_wins(best, generic, options) and not any(
-            c.score >= generic.score - options.generic_margin for c in scores
-        ):
+        if _generic_wins(best, generic, options):
+            # the criterion's choice explains clearly less than the model of the unknown: a passing term that
+            # explains about as much (a lag on six outputs beside a weaker gain change on four) is the answer
+            close = [c for c in scores if c.score >= generic.score - options.generic_margin]
+            if close:
+                best = max(close, key=lambda c: c.score)
+                rivals = _alternatives(best, scores)
+                generic = fit_generic(context, y, current, scale, outputs=best.candidate.outputs, library=library)
+        if _generic_wins(best, generic, options):
             # the best name explains clearly less than a generic model of the same outputs: it is not the answer;
             # after a named effect what is left holds its shape's error (a lag's first order against the real one):
             # only a residual that stays far above the floor is then unexplained (see _far_left)
