@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import click
@@ -18,6 +19,8 @@ Examples:
   sysid discrepancy sitl_1.ulg sitl_2.ulg --real flight_1.ulg --real flight_2.ulg -o gap.json --report gap.html
   sysid discrepancy sitl.bin --real flight.bin --wind anemometer.csv --json -
   sysid discrepancy model.json flight.ulg --report gap.html
+  sysid discrepancy sitl.ulg flight_1.ulg --model-out corrected.json
+  sysid discrepancy corrected.json flight_2.ulg
 """
 
 
@@ -41,6 +44,12 @@ Examples:
 )
 @click.option("-o", "--out", type=OutputPath(), help="Write the findings (JSON) here.")
 @click.option("--report", type=OutputPath(), help="Write the HTML report here.")
+@click.option(
+    "--model-out",
+    "model_out",
+    type=OutputPath(),
+    help="Write the simulation's model with what was found added (JSON); give it as SIM to check another flight.",
+)
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")
 def discrepancy(
@@ -52,11 +61,12 @@ def discrepancy(
     rotor_radius: float | None,
     out: Path | None,
     report: Path | None,
+    model_out: Path | None,
     json_path: str | None,
     quiet: bool,
 ) -> None:
     """Compare simulated flights (LOGS: PX4 SITL, ArduPilot SITL, Gazebo or `sysid simulate`, as ULog or
-    DataFlash; or one model from `sysid fit -o`, evaluated along the real flights) with real flights of the same vehicle: locate where they differ, name the physics the
+    DataFlash; or one model from `sysid fit -o` or `--model-out`, evaluated along the real flights) with real flights of the same vehicle: locate where they differ, name the physics the
     simulation leaves out from a catalogue of terms (ground_effect, rotor_drag, wind, time_delay, actuator_lag,
     battery_sag, mass_change, cg_offset, control_effectiveness, parasitic_drag, inflow, translational_lift,
     thrust_saturation), fit it with its uncertainty and show the residual it removes on held-out data. What no
@@ -69,13 +79,16 @@ def discrepancy(
     from reports.discrepancy_report import write_discrepancy_report
     from sysid.discrepancy import (
         DiscrepancyOptions,
+        ResponseComparison,
         compare_model_responses,
         compare_responses,
         discover,
         flight_series,
-        model_flight,
+        read_simulation_model,
+        simulated_flight,
+        write_corrected_model,
     )
-    from sysid.fit.model_file import read_model
+    from sysid.model.statespace import DelayedStateSpace
 
     sim_logs: tuple[Path, ...] = logs
     if not real_logs:
@@ -85,7 +98,7 @@ def discrepancy(
     models = [p for p in sim_logs if p.suffix.lower() == ".json"]
     if models and len(sim_logs) > 1:
         raise DataError(f"{models[0]}: a fitted model is the whole simulation; give it alone, or only flight logs")
-    model = read_model(models[0]).linear_model(include_wind=False) if models else None
+    model = read_simulation_model(models[0]) if models else None
     # the search needs no maneuvers; the report's frequency responses need the sweeps (2 s a log to find)
     maneuvers = None if report is not None else ()
     windy = ConditioningOptions(wind_offset_s=wind_offset, wind_distance_m=wind_distance, segments=maneuvers)
@@ -98,14 +111,20 @@ def discrepancy(
         )
         sim_series = [flight_series(f.source.name, f.records) for f in simulated]
     else:
-        sim_series = [model_flight(model, s, source=models[0].name) for s in real_series]
+        sim_series = [simulated_flight(model, s, source=models[0].name) for s in real_series]
     with staged_progress("discrepancy", quiet=quiet) as progress:
         result = discover(sim_series, real_series, DiscrepancyOptions(rotor_radius_m=rotor_radius), progress=progress)
     summary = result.to_dict()
     if out is not None:
         write_json(out, summary)
+    if model_out is not None and result.corrected is not None:
+        write_corrected_model(model_out, result.corrected)
     if report is not None:
-        comparisons = compare_responses(simulated, flown) if model is None else compare_model_responses(model, flown)
+        comparisons: Sequence[ResponseComparison]
+        if model is None:
+            comparisons = compare_responses(simulated, flown)
+        else:  # a corrected simulation has no frequency response of its own to draw
+            comparisons = compare_model_responses(model, flown) if isinstance(model, DelayedStateSpace) else []
         write_discrepancy_report(report, result, comparisons, model=models[0].name if models else None)
     if not quiet:
         click.echo(f"verdict: {result.verdict}")
@@ -113,7 +132,7 @@ def discrepancy(
             click.echo(f"  {finding.effect:14s} {finding.improvement_percent:5.1f} % held-out  {finding.evidence}")
         if not result.findings:
             click.echo(f"  {result.summary}")
-        for written in (out, report):
+        for written in (out, report, model_out):
             if written is not None:
                 click.echo(f"wrote {written}")
     emit_json(summary, json_path)

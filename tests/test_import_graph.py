@@ -68,7 +68,7 @@ FORBIDDEN_THIRD_PARTY = {
 # freqresp        2    -
 # fit             3    core, model, freqresp
 # verify          4    core, model, fit
-# discrepancy     3    model, freqresp
+# discrepancy     4    core, model, freqresp, fit   (a fitted model file in the simulation's place)
 # batch           5    model, fit, verify, discrepancy   (runs them all on a cluster)
 SUBPACKAGE_LAYERS: dict[str, dict[str, tuple[int, frozenset[str]]]] = {
     "flightlogs": {
@@ -95,7 +95,7 @@ SUBPACKAGE_LAYERS: dict[str, dict[str, tuple[int, frozenset[str]]]] = {
         "freqresp": (2, frozenset()),
         "fit": (3, frozenset({"core", "model", "freqresp"})),
         "verify": (4, frozenset({"core", "model", "fit"})),
-        "discrepancy": (3, frozenset({"model", "freqresp"})),  # equation error on flight series or a model; responses
+        "discrepancy": (4, frozenset({"core", "model", "freqresp", "fit"})),  # series or a model file; responses
         "batch": (5, frozenset({"model", "fit", "verify", "discrepancy"})),
     },
 }

@@ -2,12 +2,20 @@
 
 :func:`discover` compares flights as :class:`FlightSeries` (:func:`flight_series`
 from a conditioned flight's records) and returns a :class:`DiscrepancyResult`. A fitted model
-takes the simulation's place through :func:`model_flight`.
+takes the simulation's place through :func:`model_flight`; the search's corrected simulation
+(``result.corrected``, :func:`write_corrected_model`) through :func:`simulated_flight`.
 """
 
 from sysid.discrepancy.catalogue import CATALOGUE, EFFECTS, Term
+from sysid.discrepancy.corrected import CorrectedModel
 from sysid.discrepancy.describe import FAR_FROM_FLOOR
-from sysid.discrepancy.fitted_model import model_flight, model_outputs
+from sysid.discrepancy.fitted_model import model_flight, model_outputs, simulated_flight
+from sysid.discrepancy.model_files import (
+    SimulationModel,
+    read_corrected_model,
+    read_simulation_model,
+    write_corrected_model,
+)
 from sysid.discrepancy.responses import RATE_PAIRS, ResponseComparison, compare_model_responses, compare_responses
 from sysid.discrepancy.result import Alternative, DiscrepancyResult, Finding, FittedParameter, Regime, Screening
 from sysid.discrepancy.search import DiscrepancyOptions, discover
@@ -15,6 +23,12 @@ from sysid.discrepancy.series import FlightSeries, flight_series
 
 __all__ = [
     "Alternative",
+    "CorrectedModel",
+    "SimulationModel",
+    "read_corrected_model",
+    "read_simulation_model",
+    "simulated_flight",
+    "write_corrected_model",
     "CATALOGUE",
     "EFFECTS",
     "Screening",

@@ -25,7 +25,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries
 
-__all__ = ["BaselineModel", "fit_baseline", "Commands"]
+__all__ = ["BaselineModel", "fit_baseline", "Commands", "design_width"]
 
 _LAG_S = 0.3  # longest input lag of the impulse responses, s
 _STATES = ("u", "v", "w", "p", "q", "r")
@@ -188,6 +188,19 @@ def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...], squ
     columns += [_lagged(series, series[c] ** 2, _square_lags(lags)) for c in squared]
     columns.append(np.column_stack([series[s] for s in states] + [np.ones(series.n)]))
     return np.column_stack(columns)
+
+
+def design_width(lags: np.ndarray, states: tuple[str, ...], squared: tuple[str, ...]) -> int:
+    """How many regressors the model has per output: each input at `lags`, the `squared` ones' squares, states, 1.
+
+    Parameters
+    ----------
+    lags : ndarray of int, shape (n_lags,)
+        Input lags, samples.
+    states, squared : tuple of str
+        As :class:`BaselineModel`.
+    """
+    return len(COMMANDS) * lags.size + len(squared) * _square_lags(lags).size + len(states) + 1
 
 
 def _square_lags(lags: np.ndarray) -> np.ndarray:

@@ -17,6 +17,10 @@ To that the noise REAL leaves is added: the residual of the best linear model of
 (:func:`~sysid.discrepancy.baseline.fit_baseline`), moved by half of each piece in time so that it
 follows no regime of the flight. The result is a simulated flight: the search then runs as on a
 log, its noise floor and null scores those of noise of REAL's size.
+
+A corrected simulation (:class:`~.corrected.CorrectedModel`, the search's own model of SIM with what it
+found) takes the same place: :func:`corrected_outputs` evaluates it along a flight, :func:`corrected_flight`
+adds REAL's noise, and :func:`simulated_flight` flies whichever a model file held.
 """
 
 from __future__ import annotations
@@ -27,11 +31,21 @@ import numpy as np
 
 from flightlogs.errors import ModelError
 from sysid.discrepancy.baseline import fit_baseline
-from sysid.discrepancy.series import OUTPUTS, FlightSeries, smoothed_as_derivative
+from sysid.discrepancy.catalogue import FlightContext, term_of
+from sysid.discrepancy.corrected import UNEXPLAINED, CorrectedModel, ModelTerm
+from sysid.discrepancy.generic import generic_library
+from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries, smoothed_as_derivative
 from sysid.model.discrete import discretize, predict_one_step
 from sysid.model.statespace import DelayedStateSpace
 
-__all__ = ["model_outputs", "model_flight"]
+__all__ = [
+    "corrected_flight",
+    "corrected_outputs",
+    "model_flight",
+    "model_outputs",
+    "simulated_flight",
+    "with_real_noise",
+]
 
 _RATES = {"p_dot": "p", "q_dot": "q", "r_dot": "r"}  # an angular acceleration is its rate's row of A x + B u
 _FORCES = ("ax", "ay", "az")
@@ -126,21 +140,151 @@ def model_flight(model: DelayedStateSpace, flight: FlightSeries, *, source: str 
         As :func:`model_outputs`.
     """
     outputs = model_outputs(model, flight, source=source)
+    # an angular acceleration's trim is 0
+    levels = {o: (_trim(flight, o, model.trim) if o in _FORCES else 0.0) + outputs[o] for o in OUTPUTS}
+    return with_real_noise(flight, levels, name=f"{source} on {flight.name}")
+
+
+def with_real_noise(flight: FlightSeries, outputs: Mapping[str, np.ndarray], *, name: str) -> FlightSeries:
+    """`flight` with its six outputs a model's plus the noise the flight itself leaves: a simulated flight.
+
+    The noise is the residual of the best linear model of the flight itself
+    (:func:`~sysid.discrepancy.baseline.fit_baseline`), moved by half of each piece in time so that it
+    follows no regime of the flight.
+
+    Parameters
+    ----------
+    flight : FlightSeries
+        A real flight.
+    outputs : Mapping[str, ndarray]
+        ``ax ay az`` (m/s²) and ``p_dot q_dot r_dot`` (rad/s²) as the model gives them, shape (n,) each.
+    name : str
+        The simulated flight's name.
+
+    Returns
+    -------
+    FlightSeries
+        The same samples and signals; the six outputs replaced.
+    """
     own = fit_baseline(flight).predict(flight)  # the best linear model of REAL: its residual is REAL's noise
     signals = dict(flight.signals)
     for o in OUTPUTS:
         noise = flight[o] - own[o]
         for piece in flight.pieces():
             noise[piece] = np.roll(noise[piece], piece.size // 2)
-        level = _trim(flight, o, model.trim) if o in _FORCES else 0.0  # an angular acceleration's trim is 0
-        signals[o] = level + outputs[o] + noise
-    return FlightSeries(
-        name=f"{source} on {flight.name}",
-        time_s=flight.time_s,
-        piece=flight.piece,
-        signals=signals,
-        rate_hz=flight.rate_hz,
-    )
+        signals[o] = np.asarray(outputs[o]) + noise
+    return FlightSeries(name=name, time_s=flight.time_s, piece=flight.piece, signals=signals, rate_hz=flight.rate_hz)
+
+
+def corrected_outputs(model: CorrectedModel, flight: FlightSeries) -> dict[str, np.ndarray]:
+    """The six outputs the corrected simulation gives along `flight`, shape (n,) each.
+
+    Parameters
+    ----------
+    model : CorrectedModel
+        The corrected simulation.
+    flight : FlightSeries
+        A flight logging every signal the terms read (the wind, for a wind term).
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``ax ay az`` (m/s²) and ``p_dot q_dot r_dot`` (rad/s²).
+
+    Raises
+    ------
+    ModelError
+        If the flight lacks a signal a term reads.
+    """
+    if missing := [s for s in (*COMMANDS, *model.baseline.states) if s not in flight]:
+        raise ModelError(f"{flight.name}: the corrected simulation reads {missing[0]}, which this flight does not log")
+    base = model.baseline.predict(flight)
+    trim = model.thrust_trim * base["az"]  # -trim × thrust, the thrust being -az
+    additions = {o: np.zeros(flight.n) for o in OUTPUTS}
+    additions["az"] = trim
+    library: dict[str, np.ndarray] | None = None
+    for term in model.terms:
+        context = FlightContext(series=flight, baseline=model.baseline, thrust=-(base["az"] + trim))
+        try:
+            if term.effect == UNEXPLAINED:
+                if library is None:  # the search's library: built once, on the model before any term
+                    first = FlightContext(series=flight, baseline=model.baseline, thrust=-(base["az"] + trim))
+                    library = {r.key: r.values for r in generic_library(first)}
+                columns = {o: _centred(library, keys, term) for o, keys in term.regressors.items()}
+            else:
+                candidate = term_of(term.effect).make(context)
+                if candidate is None:  # a wind term without the wind, a ground effect without the height
+                    raise KeyError(f"what its {term.effect} term needs")
+                built = candidate.build(term.value)
+                if candidate.kind == "transform":
+                    base = dict(built)
+                    continue
+                columns = dict(built)
+        except KeyError as err:
+            raise ModelError(
+                f"{flight.name}: the corrected simulation's {term.effect} term reads {err.args[0]}, "
+                "which this flight does not log"
+            ) from None
+        for o, coefficients in term.coefficients.items():
+            if columns[o].shape[1] != coefficients.size:
+                raise ModelError(
+                    f"{flight.name}: the corrected simulation's {term.effect} term has {coefficients.size} "
+                    f"coefficients on {o}, its regressors {columns[o].shape[1]}"
+                )
+            additions[o] = additions[o] + columns[o] @ coefficients
+    return {o: base[o] + additions[o] for o in OUTPUTS}
+
+
+def corrected_flight(model: CorrectedModel, flight: FlightSeries, *, source: str = "corrected") -> FlightSeries:
+    """`flight` with its six outputs the corrected simulation's, plus the noise the flight leaves.
+
+    Parameters
+    ----------
+    model : CorrectedModel
+        The corrected simulation.
+    flight : FlightSeries
+        A real flight.
+    source : str, optional
+        The model's name, for the flight's name.
+
+    Returns
+    -------
+    FlightSeries
+        A simulated flight (:func:`~sysid.discrepancy.fitted_model.with_real_noise`).
+    """
+    return with_real_noise(flight, corrected_outputs(model, flight), name=f"{source} on {flight.name}")
+
+
+def _centred(library: Mapping[str, np.ndarray], keys: tuple[str, ...], term: ModelTerm) -> np.ndarray:
+    """The named library columns, each less its mean, shape (n, len(keys))."""
+    missing = [k for k in keys if k not in library]
+    if missing:
+        raise KeyError(f"the regressor {missing[0]}")
+    return np.column_stack([library[k] - library[k].mean() for k in keys])
+
+
+def simulated_flight(
+    model: DelayedStateSpace | CorrectedModel, flight: FlightSeries, *, source: str = "model"
+) -> FlightSeries:
+    """`flight` as a model file's model would have flown it, with the noise the flight leaves: a simulated flight.
+
+    Parameters
+    ----------
+    model : DelayedStateSpace or CorrectedModel
+        From ``sysid fit -o`` or ``sysid discrepancy --model-out``.
+    flight : FlightSeries
+        A real flight.
+    source : str, optional
+        The model's name, for messages and the flight's name.
+
+    Raises
+    ------
+    ModelError
+        If the flight lacks what the model reads.
+    """
+    if isinstance(model, CorrectedModel):
+        return corrected_flight(model, flight, source=source)
+    return model_flight(model, flight, source=source)
 
 
 def _shifted(t: np.ndarray, columns: np.ndarray, delays_s: np.ndarray) -> np.ndarray:

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from sysid.discrepancy.corrected import CorrectedModel
 
 __all__ = ["Alternative", "FittedParameter", "Regime", "FindingTraces", "Finding", "Screening", "DiscrepancyResult"]
 
@@ -182,6 +185,8 @@ class DiscrepancyResult:
         Per output, the real flight's held-out residual RMS with every finding modelled, over the noise floor:
         about 1 when the findings account for the difference, far above it when the simulation is not a close
         model of the real vehicle or an effect outside the library remains.
+    corrected : CorrectedModel or None
+        The simulation's model with the kept terms (not in the JSON; ``--model-out`` writes it).
     """
 
     verdict: str
@@ -193,6 +198,7 @@ class DiscrepancyResult:
     real: tuple[str, ...]
     thrust_scale: float = 1.0
     unexplained: dict[str, float] = field(default_factory=dict)
+    corrected: CorrectedModel | None = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: ``verdict``, ``findings[]`` (empty when the verdict is ``none``) and the context."""

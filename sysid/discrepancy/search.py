@@ -44,6 +44,7 @@ from scipy.signal import welch
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
 from sysid.discrepancy.catalogue import Candidate, Derivation, FlightContext, Term, candidate_terms, term_of
 from sysid.discrepancy.catalogue._air import air_velocity, climb_rate
+from sysid.discrepancy.corrected import UNEXPLAINED, CorrectedModel, ModelTerm
 from sysid.discrepancy.describe import describe_finding, parameters_of, summary_of
 from sysid.discrepancy.generic import GenericFit, Regressor, fit_generic, generic_library, generic_term
 from sysid.discrepancy.result import (
@@ -268,8 +269,14 @@ def discover(
                 kept.append(_unexplained(generic, y, base, additions, scale, held_out, (), terms))
     kept = _far_left(kept, y, base, additions, scale, held_out, library, flown, baseline, trim, terms)
     level = _thrust_level(kept, gain, thrust, y["az"] - combined(base, additions)["az"], base, additions, y, scale)
+    corrected = CorrectedModel(
+        baseline=baseline,
+        thrust_trim=gain,
+        terms=tuple(t for k in kept if (t := _model_term(k)) is not None),
+        made_from=(*(s.name for s in sim), *(s.name for s in real)),
+    )
     if level is not None and len(kept) < options.max_findings:
-        kept.append(level)
+        kept.append(level)  # the trim itself, which the corrected model holds already
     _report(progress, "done", 3, 3)
     gains = {id(k.fit): _thrust_gain(k.fit) for k in kept}
     findings = sorted(
@@ -301,7 +308,22 @@ def discover(
         sim=tuple(s.name for s in sim),
         real=tuple(s.name for s in real),
         thrust_scale=round(1.0 + gain, 5),
+        corrected=corrected,
     )
+
+
+def _model_term(kept: _Kept) -> ModelTerm | None:
+    """A kept term as the corrected simulation holds it (None: a residual located, not modelled)."""
+    fit = kept.fit
+    if fit.candidate.kind == "linear" and not fit.coefficients:
+        return None
+    regressors: dict[str, tuple[str, ...]] = {}
+    if fit.candidate.effect == UNEXPLAINED:  # its coefficients' keys are "output:regressor"
+        for key in fit.candidate.coefficients:
+            output, regressor = key.split(":", 1)
+            regressors[output] = (*regressors.get(output, ()), regressor)
+    coefficients = {o: np.asarray(c, dtype=float) for o, c in fit.coefficients.items()}
+    return ModelTerm(effect=fit.candidate.effect, value=fit.value, coefficients=coefficients, regressors=regressors)
 
 
 def _far_left(

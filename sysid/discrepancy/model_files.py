@@ -1,0 +1,250 @@
+"""Model files in the simulation's place: the corrected simulation's JSON, and either kind read by its schema.
+
+A corrected simulation (:class:`~.corrected.CorrectedModel`, ``sysid discrepancy --model-out``) is
+written as versioned JSON (schema ``flight-sysid/corrected-simulation``); a model from ``sysid fit -o``
+keeps its own schema (:mod:`sysid.fit.model_file`). :func:`read_simulation_model` reads either.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flightlogs.errors import ModelError
+from sysid._json import float_array, json_floats, read_json_object, write_json
+from sysid._json import value_text as _show
+from sysid.discrepancy.baseline import BaselineModel, design_width
+from sysid.discrepancy.catalogue import EFFECTS
+from sysid.discrepancy.corrected import UNEXPLAINED, CorrectedModel, ModelTerm
+from sysid.discrepancy.series import COMMANDS, OUTPUTS
+from sysid.fit.model_file import model_from_dict
+from sysid.model.statespace import DelayedStateSpace
+
+__all__ = [
+    "SCHEMA",
+    "SCHEMA_VERSION",
+    "SimulationModel",
+    "corrected_from_dict",
+    "corrected_to_dict",
+    "read_corrected_model",
+    "read_simulation_model",
+    "write_corrected_model",
+]
+
+SCHEMA = "flight-sysid/corrected-simulation"
+SCHEMA_VERSION = 1
+
+#: What a model file holds: an identified state-space model, or the search's corrected simulation.
+SimulationModel = DelayedStateSpace | CorrectedModel
+
+
+def read_simulation_model(path: str | Path) -> SimulationModel:
+    """The model a JSON file holds, by its schema.
+
+    Parameters
+    ----------
+    path : str or Path
+        A model from ``sysid fit -o`` or a corrected simulation from ``sysid discrepancy --model-out``.
+
+    Raises
+    ------
+    ModelError
+        If the file cannot be read or is neither.
+    """
+    doc = read_json_object(path, ModelError, "model")
+    if doc.get("schema") == SCHEMA:
+        return corrected_from_dict(doc, source=str(path))
+    return model_from_dict(doc, source=str(path)).linear_model(include_wind=False)
+
+
+def corrected_to_dict(model: CorrectedModel) -> dict[str, Any]:
+    """The JSON document of a corrected simulation (schema ``flight-sysid/corrected-simulation`` version 1).
+
+    Parameters
+    ----------
+    model : CorrectedModel
+        The model.
+
+    Returns
+    -------
+    dict
+        JSON-compatible.
+    """
+    b = model.baseline
+    return {
+        "schema": SCHEMA,
+        "schema_version": SCHEMA_VERSION,
+        "made_from": list(model.made_from),
+        "baseline": {
+            "rate_hz": b.rate_hz,
+            "lags": [int(k) for k in b.lags],
+            "states": list(b.states),
+            "squared": list(b.squared),
+            "coefficients": {o: json_floats(np.asarray(w)) for o, w in b.coefficients.items()},
+        },
+        "thrust_trim": model.thrust_trim,
+        "terms": [
+            {
+                "effect": t.effect,
+                "value": None if not np.isfinite(t.value) else t.value,
+                "coefficients": {o: json_floats(np.asarray(c)) for o, c in t.coefficients.items()},
+                **({"regressors": {o: list(k) for o, k in t.regressors.items()}} if t.regressors else {}),
+            }
+            for t in model.terms
+        ],
+    }
+
+
+def corrected_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> CorrectedModel:
+    """A corrected simulation from its JSON document, checked field by field.
+
+    Parameters
+    ----------
+    doc : Mapping
+        As written by :func:`corrected_to_dict`.
+    source : str, optional
+        The file's name, for messages.
+
+    Raises
+    ------
+    ModelError
+        Naming the file and the field, if the document is not a corrected simulation of a supported version.
+    """
+    read = _Reader(source)
+    if doc.get("schema") != SCHEMA:
+        raise read.fail(f"not a corrected simulation (schema {_show(doc.get('schema'))}, not {SCHEMA!r})")
+    if doc.get("schema_version") != SCHEMA_VERSION:
+        raise read.fail(f"schema_version {_show(doc.get('schema_version'))} is not {SCHEMA_VERSION}")
+    b = read.get(doc, "baseline", dict)
+    lags = read.numbers(b, "lags", "baseline")
+    states = tuple(read.names(b, "states", "baseline"))
+    squared = tuple(read.names(b, "squared", "baseline"))
+    if lags.size == 0 or np.any(lags != np.round(lags)) or np.any(np.diff(lags) <= 0) or lags[0] < 0:
+        raise read.fail("baseline: lags are not increasing whole samples from 0")
+    if unknown := [c for c in squared if c not in COMMANDS]:
+        raise read.fail(f"baseline: squared names {unknown[0]!r}, not a mixer input ({', '.join(COMMANDS)})")
+    width = design_width(lags, states, squared)
+    table = read.get(b, "coefficients", dict)
+    if sorted(table) != sorted(OUTPUTS):
+        raise read.fail(f"baseline: coefficients are for {', '.join(table)}, not {', '.join(OUTPUTS)}")
+    coefficients = {o: read.numbers(table, o, "baseline coefficients", size=width) for o in OUTPUTS}
+    baseline = BaselineModel(
+        coefficients=coefficients,
+        lags=lags.astype(int),
+        states=states,
+        rate_hz=read.number(b, "rate_hz", "baseline"),
+        squared=squared,
+    )
+    terms = []
+    for k, t in enumerate(read.get(doc, "terms", list)):
+        where = f"terms[{k}]"
+        t = read.check(t, where, dict)
+        effect = read.get(t, "effect", str, where=where)
+        if effect != UNEXPLAINED and effect not in EFFECTS:
+            raise read.fail(f"{where}: effect {effect!r} is not in the catalogue ({', '.join(EFFECTS)}, unexplained)")
+        value = t.get("value")
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+            raise read.fail(f"{where}: value is {_show(value)}, not a number")
+        regressors = {o: tuple(read.names(t.get("regressors", {}), o, where)) for o in t.get("regressors", {})}
+        table = read.get(t, "coefficients", dict, where=where)
+        coefficients = {
+            o: read.numbers(table, o, f"{where} coefficients", size=len(regressors[o]) if regressors else None)
+            for o in table
+        }
+        if effect == UNEXPLAINED and sorted(regressors) != sorted(coefficients):
+            raise read.fail(f"{where}: regressors and coefficients name different outputs")
+        if unknown := [o for o in coefficients if o not in OUTPUTS]:
+            raise read.fail(f"{where}: coefficients for {unknown[0]!r}, not an output ({', '.join(OUTPUTS)})")
+        terms.append(
+            ModelTerm(
+                effect=effect,
+                value=float("nan") if value is None else float(value),
+                coefficients=coefficients,
+                regressors=regressors,
+            )
+        )
+    return CorrectedModel(
+        baseline=baseline,
+        thrust_trim=read.number(doc, "thrust_trim", "the file"),
+        terms=tuple(terms),
+        made_from=tuple(read.names(doc, "made_from", "the file")),
+    )
+
+
+def write_corrected_model(path: str | Path, model: CorrectedModel) -> Path:
+    """Write a corrected simulation as versioned JSON, atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination (``corrected.json``).
+    model : CorrectedModel
+        The model.
+
+    Returns
+    -------
+    Path
+    """
+    return write_json(path, corrected_to_dict(model))
+
+
+def read_corrected_model(path: str | Path) -> CorrectedModel:
+    """Read a corrected simulation written by :func:`write_corrected_model`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file.
+
+    Raises
+    ------
+    ModelError
+        If the file cannot be read or is not a corrected simulation of a supported version.
+    """
+    return corrected_from_dict(read_json_object(path, ModelError, "corrected simulation"), source=str(path))
+
+
+class _Reader:
+    """Reads the document field by field; a missing or bad field raises a ModelError naming file and field."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, message: str) -> ModelError:
+        return ModelError(f"{self.source}: {message}")
+
+    def check(self, value: Any, what: str, kind: type) -> Any:
+        if not isinstance(value, kind):
+            raise self.fail(f"{what} is {_show(value)}, not {'an object' if kind is dict else kind.__name__}")
+        return value
+
+    def get(self, parent: Mapping[str, Any], key: str, kind: type, *, where: str = "the file") -> Any:
+        if key not in parent:
+            raise self.fail(f"{where} has no {key}")
+        return self.check(parent[key], f"{where}: {key}", kind)
+
+    def number(self, parent: Mapping[str, Any], key: str, where: str) -> float:
+        value = self.get(parent, key, object, where=where)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise self.fail(f"{where}: {key} is {_show(value)}, not a finite number")
+        return float(value)
+
+    def numbers(self, parent: Mapping[str, Any], key: str, where: str, *, size: int | None = None) -> np.ndarray:
+        values = self.get(parent, key, list, where=where)
+        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in values):
+            raise self.fail(f"{where}: {key} holds a value that is not a finite number")
+        out = float_array(values)
+        if not np.all(np.isfinite(out)):
+            raise self.fail(f"{where}: {key} holds a value that is not a finite number")
+        if size is not None and out.size != size:
+            raise self.fail(f"{where}: {key} has {out.size} values, not {size}")
+        return out
+
+    def names(self, parent: Mapping[str, Any], key: str, where: str) -> list[str]:
+        values = self.get(parent, key, list, where=where)
+        if not all(isinstance(v, str) for v in values):
+            raise self.fail(f"{where}: {key} holds a value that is not a name")
+        return list(values)
