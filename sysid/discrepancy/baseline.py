@@ -17,7 +17,7 @@ which was first read as a CG offset (found on another generator's flights).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -70,18 +70,43 @@ class BaselineModel:
         commands : Mapping[str, ndarray], optional
             Mixer inputs to use instead of the logged ones (delayed, lagged).
         """
-        inputs = commands if commands is not None else {c: series[c] for c in COMMANDS}
+        return self.predictor(series)(commands)
+
+    def predictor(self, series: FlightSeries) -> Callable[[Commands], dict[str, np.ndarray]]:
+        """:meth:`predict` on `series` as a function of the mixer inputs, the states' part computed once.
+
+        A transform re-predicts one flight from its inputs changed many times (60 delays): the part of
+        the prediction the states and the constant make is the same each time.
+
+        Parameters
+        ----------
+        series : FlightSeries
+            A flight with the same signals.
+
+        Returns
+        -------
+        callable
+            ``predict(commands)``: as :meth:`predict` with these `commands` (None: as logged).
+        """
         square_lags = _square_lags(self.lags)
         n_lags, n_squares, n_in = self.lags.size, square_lags.size, len(COMMANDS)
         weights = np.column_stack(list(self.coefficients.values()))  # (n_regressors, n_outputs)
         fixed = np.column_stack([series[s] for s in self.states] + [np.ones(series.n)])
-        total = fixed @ weights[n_in * n_lags + len(self.squared) * n_squares :]
-        for k, name in enumerate(COMMANDS):  # lagged inputs times all outputs' weights at once: no whole design
-            total += _lagged(series, np.asarray(inputs[name]), self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
-        for k, name in enumerate(self.squared):
-            first = n_in * n_lags + k * n_squares
-            total += _lagged(series, np.asarray(inputs[name]) ** 2, square_lags) @ weights[first : first + n_squares]
-        return {o: total[:, j] for j, o in enumerate(self.coefficients)}
+        steady = fixed @ weights[n_in * n_lags + len(self.squared) * n_squares :]
+        spans = series.spans()
+
+        def predict(commands: Commands = None) -> dict[str, np.ndarray]:
+            inputs = commands if commands is not None else {c: series[c] for c in COMMANDS}
+            total = steady.copy()
+            for k, name in enumerate(COMMANDS):  # lagged inputs times all outputs' weights at once: no whole design
+                total += _lagged(spans, np.asarray(inputs[name]), self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
+            for k, name in enumerate(self.squared):
+                first = n_in * n_lags + k * n_squares
+                squares = _lagged(spans, np.asarray(inputs[name]) ** 2, square_lags)
+                total += squares @ weights[first : first + n_squares]
+            return {o: total[:, j] for j, o in enumerate(self.coefficients)}
+
+        return predict
 
     def recentred(self, thrust_shift: float) -> BaselineModel:
         """The model with the thrust command read `thrust_shift` lower by every output but az.
@@ -138,10 +163,11 @@ class BaselineModel:
         square_lags = _square_lags(self.lags)
         n_lags, n_squares = self.lags.size, square_lags.size
         weights = np.column_stack(list(self.coefficients.values()))
-        total = _lagged(series, x, self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
+        spans = series.spans()
+        total = _lagged(spans, x, self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
         if command in self.squared:
             first = len(COMMANDS) * n_lags + self.squared.index(command) * n_squares
-            total += _lagged(series, x**2, square_lags) @ weights[first : first + n_squares]
+            total += _lagged(spans, x**2, square_lags) @ weights[first : first + n_squares]
         return {o: total[:, j] for j, o in enumerate(self.coefficients)}
 
 
@@ -163,8 +189,8 @@ def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> Baseli
     states = tuple(s for s in _STATES if s in series)
     use = slice(None) if rows is None else rows
     squared = tuple(c for c in COMMANDS if _curvature_share(series[c][use]) >= _MIN_CURVATURE_SHARE)
-    design = _design(series, lags, states, squared)
-    coefficients = {o: np.linalg.lstsq(design[use], series[o][use], rcond=None)[0] for o in OUTPUTS}
+    design = _design(series, lags, states, squared)[use]  # taken once, not per output
+    coefficients = {o: np.linalg.lstsq(design, series[o][use], rcond=None)[0] for o in OUTPUTS}
     return BaselineModel(coefficients=coefficients, lags=lags, states=states, rate_hz=series.rate_hz, squared=squared)
 
 
@@ -184,8 +210,9 @@ def _curvature_share(x: np.ndarray) -> float:
 
 def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...], squared: tuple[str, ...]) -> np.ndarray:
     """The regressors of the fit, shape (n, n_regressors), in the order :meth:`BaselineModel.predict` reads them."""
-    columns = [_lagged(series, series[c], lags) for c in COMMANDS]
-    columns += [_lagged(series, series[c] ** 2, _square_lags(lags)) for c in squared]
+    spans = series.spans()
+    columns = [_lagged(spans, series[c], lags) for c in COMMANDS]
+    columns += [_lagged(spans, series[c] ** 2, _square_lags(lags)) for c in squared]
     columns.append(np.column_stack([series[s] for s in states] + [np.ones(series.n)]))
     return np.column_stack(columns)
 
@@ -207,12 +234,21 @@ def _square_lags(lags: np.ndarray) -> np.ndarray:
     return lags[:: max(1, lags.size // _N_SQUARE_LAGS)]
 
 
-def _lagged(series: FlightSeries, x: np.ndarray, lags: np.ndarray) -> np.ndarray:
-    """Columns x(t - lag) per lag, each piece padded with its first value (no lag reaches across a gap)."""
+def _lagged(spans: list[slice], x: np.ndarray, lags: np.ndarray) -> np.ndarray:
+    """Columns x(t - lag) per lag, each piece (`spans`, :meth:`FlightSeries.spans`) padded with its first value.
+
+    No lag reaches across a gap.
+    """
     out = np.empty((x.size, lags.size))
     longest = int(lags[-1])
-    for rows in series.pieces():
+    step = int(lags[1] - lags[0]) if lags.size > 1 else 1
+    even = step > 0 and np.array_equal(lags, np.arange(0, longest + 1, step))  # 0, s, 2 s ... L: a strided view
+    for rows in spans:
         piece = x[rows]
         padded = np.concatenate([np.full(longest, piece[0]), piece])
-        out[rows] = sliding_window_view(padded, longest + 1)[:, longest - lags]  # row t holds x(t - L) .. x(t)
+        if even:
+            out[rows] = sliding_window_view(padded, longest + 1)[:, longest::-step]  # row t: x(t), x(t - s) .. x(t - L)
+            continue
+        for j, lag in enumerate(lags.tolist()):  # a column at a time: slices, no gather of a (n, n_lags) window
+            out[rows, j] = padded[longest - lag : longest - lag + piece.size]
     return out

@@ -14,7 +14,7 @@ noise weighs little.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -35,6 +35,7 @@ __all__ = [
 
 _N_BLOCKS = 6
 _FOLD_BLOCK = 200  # samples per interleaved block of a fold (4 s at 50 Hz)
+_CHUNK = 64  # grid values of a linear term whose regressors are held at once (a mass step's 640 times: 64 at a time)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -163,13 +164,21 @@ def cross_validated(
     n = next(iter(y.values())).size
     current = dict(reference) if reference is not None else combined(base, additions)
     predicted = {o: current[o].copy() for o in current}
-    fixed = replace(candidate, grid=(fit_term(candidate, y, base, additions, scale).value,))
-    for test in folds(n):
-        train = np.setdiff1d(np.arange(n), test)
-        fit = fit_term(fixed, y, base, additions, scale, train)
-        with_term = fit.prediction(base, additions)
+    build = _Builds(candidate.build)  # one build per value for the whole flight's fit and every fold's
+    value = _fit_term(candidate, y, base, additions, scale, None, build, uncertainties=False).value
+    built = build(value)
+    if candidate.kind == "transform":  # nothing is fitted per fold: every block's prediction is the transform's
         for o in candidate.outputs:
-            predicted[o][test] = with_term[o][test]
+            predicted[o] = built[o] + additions[o]
+    else:
+        fixed = replace(candidate, grid=(value,))
+        held = np.zeros(n, dtype=bool)
+        for test in folds(n):
+            held[:] = False
+            held[test] = True
+            fit = _fit_term(fixed, y, base, additions, scale, np.flatnonzero(~held), build, uncertainties=False)
+            for o, coefficients in fit.coefficients.items():  # the prediction with the term, as TermFit.prediction
+                predicted[o][test] = ((base[o] + additions[o]) + built[o] @ coefficients)[test]
     outputs = judged if judged is not None else candidate.outputs
     before = sum(np.sum((y[o] - current[o]) ** 2) / scale[o] for o in outputs)
     after = sum(np.sum((y[o] - predicted[o]) ** 2) / scale[o] for o in outputs)
@@ -267,47 +276,131 @@ def fit_term(
     -------
     TermFit
     """
+    return _fit_term(candidate, y, base, additions, scale, rows, _Builds(candidate.build))
+
+
+class _Builds:
+    """A candidate's ``build`` that keeps the last value's regressors (NaN included): a fit reads them often.
+
+    Only the last: a grid of 640 step times would otherwise hold 640 copies of its regressors.
+    """
+
+    def __init__(self, build: Callable[[float], Mapping[str, np.ndarray]]) -> None:
+        self._build = build
+        self._key: object = None
+        self._made: Mapping[str, np.ndarray] = {}
+
+    def __call__(self, value: float) -> Mapping[str, np.ndarray]:
+        key = "nan" if value != value else value
+        if key != self._key:
+            self._key, self._made = key, self._build(value)
+        return self._made
+
+
+def _fit_term(
+    candidate: Candidate,
+    y: Mapping[str, np.ndarray],
+    base: Mapping[str, np.ndarray],
+    additions: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+    rows: np.ndarray | None,
+    build: _Builds,
+    *,
+    uncertainties: bool = True,
+) -> TermFit:
+    """:func:`fit_term` with the candidate's regressors from `build`; without `uncertainties`, none are computed.
+
+    `rows` None: all samples, read in place (the same numbers as ``arange(n)`` gives, without the copies).
+    """
     n = next(iter(y.values())).size
-    rows = np.arange(n) if rows is None else rows
-    costs, fits = [], []
-    kept = {o: y[o][rows] - additions[o][rows] for o in candidate.outputs}  # what the term and the base must explain
-    targets = {o: kept[o] - base[o][rows] for o in candidate.outputs}
-    for value in candidate.grid:
-        built = candidate.build(value)
-        coefficients, cost = {}, 0.0
-        for o in candidate.outputs:
-            if candidate.kind == "transform":
-                residual = kept[o] - built[o][rows]
-            else:
-                target = targets[o]
-                z = built[o][rows]
-                coefficients[o] = _least_squares(z, target)
-                residual = target - z @ coefficients[o]
-            cost += float(np.sum(residual**2)) / scale[o]
-        costs.append(cost)
-        fits.append((value, coefficients))
+    count = n if rows is None else rows.size
+
+    def take(a: np.ndarray) -> np.ndarray:
+        return a if rows is None else a[rows]
+
+    costs: list[float] = []
+    fits: list[tuple[float, dict[str, np.ndarray]]] = []
+    kept = {o: take(y[o]) - take(additions[o]) for o in candidate.outputs}  # what the term and the base must explain
+    targets = {o: kept[o] - take(base[o]) for o in candidate.outputs}
+    if candidate.kind == "transform":
+        for value in candidate.grid:
+            built = build(value)
+            cost = 0.0
+            for o in candidate.outputs:
+                cost += float(np.sum((kept[o] - take(built[o])) ** 2)) / scale[o]
+            costs.append(cost)
+            fits.append((value, {}))
+    else:
+        for first in range(0, len(candidate.grid), _CHUNK):
+            for value, coefficients, cost in _linear_fits(
+                candidate.grid[first : first + _CHUNK], build, take, targets, scale, candidate.outputs
+            ):
+                costs.append(cost)
+                fits.append((value, coefficients))
     best = int(np.argmin(costs))
     value, coefficients = fits[best]
-    covariance = {}
-    if candidate.kind == "linear":  # the covariance of the chosen grid value's coefficients only
-        built = candidate.build(value)
-        for o in candidate.outputs:
-            z = built[o][rows]
-            covariance[o] = _covariance(z, targets[o] - z @ coefficients[o])
-    spread = _grid_spread(np.asarray(candidate.grid), np.asarray(costs), best, rows.size, candidate, y, base, scale)
-    if np.isfinite(spread) and len(candidate.grid) > 1:  # never finer than the grid can tell
-        spread = max(spread, float(np.median(np.diff(candidate.grid))) / np.sqrt(12.0))
+    covariance: dict[str, np.ndarray] = {}
+    spread = float("nan")
+    if uncertainties:
+        if candidate.kind == "linear":  # the covariance of the chosen grid value's coefficients only
+            built = build(value)
+            for o in candidate.outputs:
+                z = np.ascontiguousarray(take(built[o]))
+                covariance[o] = _covariance(z, targets[o] - z @ coefficients[o])
+        spread = _grid_spread(
+            np.asarray(candidate.grid), np.asarray(costs), best, count, candidate, y, base, scale, build
+        )
+        if np.isfinite(spread) and len(candidate.grid) > 1:  # never finer than the grid can tell
+            spread = max(spread, float(np.median(np.diff(candidate.grid))) / np.sqrt(12.0))
     return TermFit(
         candidate=candidate, value=value, coefficients=coefficients, covariance=covariance, value_uncertainty=spread
     )
 
 
-def _least_squares(z: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """Coefficients minimising ``|target - z c|``: the normal equations when well conditioned (a few columns), else SVD."""
-    gram = z.T @ z
-    if np.linalg.cond(gram) < 1e10:
-        return np.asarray(np.linalg.solve(gram, z.T @ target))
-    return np.asarray(np.linalg.lstsq(z, target, rcond=None)[0])
+def _linear_fits(
+    values: Sequence[float],
+    build: _Builds,
+    take: Callable[[np.ndarray], np.ndarray],
+    targets: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+    outputs: tuple[str, ...],
+) -> list[tuple[float, dict[str, np.ndarray], float]]:
+    """Per grid value of a linear term: its value, coefficients per output and weighted cost.
+
+    The small normal equations of all `values` are judged and solved as stacks (numpy's linear algebra solves each
+    matrix of a stack as it solves one alone: the same numbers, without a call per value).
+    """
+    columns: dict[str, list[np.ndarray]] = {o: [] for o in outputs}
+    for value in values:
+        built = build(value)
+        for o in outputs:
+            columns[o].append(np.ascontiguousarray(take(built[o])))
+    solved = {o: _least_squares_each(columns[o], targets[o]) for o in outputs}
+    out = []
+    for j, value in enumerate(values):
+        cost = 0.0
+        for o in outputs:
+            residual = targets[o] - columns[o][j] @ solved[o][j]
+            cost += float(np.sum(residual**2)) / scale[o]
+        out.append((value, {o: solved[o][j] for o in outputs}, cost))
+    return out
+
+
+def _least_squares_each(zs: list[np.ndarray], target: np.ndarray) -> list[np.ndarray]:
+    """Coefficients minimising ``|target - z c|`` for every `z` of `zs` (each shape (n, k), one k).
+
+    The normal equations where well conditioned (a few columns), else SVD.
+    """
+    grams = np.stack([z.T @ z for z in zs])
+    rhs = np.stack([z.T @ target for z in zs])
+    well = np.linalg.cond(grams) < 1e10
+    out: list[np.ndarray] = [np.empty(0)] * len(zs)
+    if well.any():
+        for j, c in zip(np.flatnonzero(well), np.linalg.solve(grams[well], rhs[well][..., None])[..., 0]):
+            out[j] = c
+    for j in np.flatnonzero(~well):
+        out[j] = np.asarray(np.linalg.lstsq(zs[j], target, rcond=None)[0])
+    return out
 
 
 def effective_samples(residual: np.ndarray) -> float:
@@ -341,6 +434,7 @@ def _grid_spread(
     y: Mapping[str, np.ndarray],
     base: Mapping[str, np.ndarray],
     scale: Mapping[str, float],
+    build: _Builds,
 ) -> float:
     """Standard deviation of the grid value: the cost's curvature at its minimum, residual correlation counted.
 
@@ -356,7 +450,7 @@ def _grid_spread(
         return float(h1 + h2)
     per_sample = costs[best] / max(n * len(candidate.outputs), 1)  # about 1 when the floor is right
     first = candidate.outputs[0]
-    built = candidate.build(float(grid[best]))
+    built = build(float(grid[best]))
     residual = (y[first] - (built[first] if candidate.kind == "transform" else base[first])) / np.sqrt(scale[first])
     inflation = residual.size / max(effective_samples(residual), 1.0)
     return float(np.sqrt(2.0 * max(per_sample, 1e-12) * inflation / curvature))

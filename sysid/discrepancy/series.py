@@ -86,6 +86,11 @@ class FlightSeries:
         edges = np.flatnonzero(np.diff(self.piece)) + 1
         return np.split(np.arange(self.n), edges)
 
+    def spans(self) -> list[slice]:
+        """Each contiguous piece as a slice of the samples, in order (:meth:`pieces` without index arrays)."""
+        edges = [0, *(np.flatnonzero(np.diff(self.piece)) + 1).tolist(), self.n]
+        return [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
+
     def without(self, names: Sequence[str]) -> FlightSeries:
         """The same samples without the signals `names`."""
         kept = {k: v for k, v in self.signals.items() if k not in names}

@@ -212,11 +212,12 @@ def input_transform(
     change : callable
         ``change(series, command, value)``: one mixer input changed (delayed, lagged), shape (n,).
     """
-    series, baseline = context.series, context.baseline
+    series = context.series
+    predict = context.baseline.predictor(series)  # the states' part once for the whole grid
 
     @cache
     def build(value: float) -> Prediction:
-        return baseline.predict(series, {c: change(series, series[c], value) for c in COMMANDS})
+        return predict({c: change(series, series[c], value) for c in COMMANDS})
 
     return Candidate(
         effect=effect, outputs=OUTPUTS, kind="transform", grid=grid, grid_parameter=grid_parameter, build=build
@@ -302,8 +303,8 @@ def delayed(series: FlightSeries, x: np.ndarray, tau: float) -> np.ndarray:
         Delay, s.
     """
     out = np.empty_like(x)
-    for rows in series.pieces():
-        t = np.arange(rows.size) / series.rate_hz
+    for rows in series.spans():
+        t = np.arange(rows.stop - rows.start) / series.rate_hz
         out[rows] = np.interp(t - tau, t, x[rows])
     return out
 
@@ -322,7 +323,7 @@ def averaged(series: FlightSeries, x: np.ndarray, width_s: float) -> np.ndarray:
     """
     width = max(1, int(round(width_s * series.rate_hz)))
     out = np.empty_like(x)
-    for rows in series.pieces():
+    for rows in series.spans():
         out[rows] = uniform_filter1d(x[rows], width, mode="nearest")
     return out
 
@@ -341,7 +342,7 @@ def first_order(series: FlightSeries, x: np.ndarray, time_constant: float) -> np
     """
     a = float(np.exp(-1.0 / (series.rate_hz * time_constant)))
     out = np.empty_like(x)
-    for rows in series.pieces():
+    for rows in series.spans():
         piece = x[rows]
         out[rows] = lfilter([1.0 - a], [1.0, -a], piece - piece[0]) + piece[0]
     return out
