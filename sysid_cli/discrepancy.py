@@ -76,7 +76,6 @@ def discrepancy(
     from flightlogs.conditioning.condition import ConditioningOptions
     from flightlogs.errors import DataError
     from flightlogs.writers.jsonio import write_json
-    from reports.discrepancy_report import write_discrepancy_report
     from sysid.discrepancy import (
         DiscrepancyOptions,
         ResponseComparison,
@@ -120,6 +119,8 @@ def discrepancy(
     if model_out is not None and result.corrected is not None:
         write_corrected_model(model_out, result.corrected)
     if report is not None:
+        from reports.discrepancy_report import write_discrepancy_report  # matplotlib: only for a report
+
         comparisons: Sequence[ResponseComparison]
         if model is None:
             comparisons = compare_responses(simulated, flown)

@@ -168,7 +168,10 @@ def discover(
     screened: list[Screening] = []
     terms: dict[int, Term] = {}
     held_out = combined(base, additions)  # the baseline is fitted on SIM: on REAL its prediction is held out already
-    library = generic_library(FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim)))
+    first = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
+    library = generic_library(first)
+    # a delay's or lag's re-predictions read no thrust: built once, reused by every round of the selection
+    transforms = {c.effect: c for c in candidate_terms(first) if c.kind == "transform"}
     generic_null = options.null_margin * max(null.get("unexplained", 0.0), 0.0)
     while len(kept) < options.max_findings:
         found = {k.fit.candidate.effect for k in kept}
@@ -182,7 +185,7 @@ def discover(
         # every term reads one thrust, the model's with the trim: two terms' thrust gains are then one column, whose
         # sum is measured, and not two near copies whose difference (the first term's contribution) a fit would use
         context = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
-        for candidate in candidate_terms(context, exclude=tuple(exclude)):
+        for candidate in (transforms.get(c.effect, c) for c in candidate_terms(context, exclude=tuple(exclude))):
             together = candidate.kind == "linear" and bool(linear)
             trial, adds = (joined(candidate, linear), without) if together else (candidate, additions)
             reference = held_out if together else None  # judged against the kept terms' held-out prediction
