@@ -349,3 +349,34 @@ def discover_independent_pairs(
         )
         for k, (name, plant) in enumerate(changes.items())
     }
+
+
+def synthetic_series(n: int = 3000, seed: int = 0, *, drag: float = 0.0, lowest_m: float = 2.0) -> FlightSeries:
+    """A synthetic flight at 50 Hz: smooth random commands and states, outputs linear in them plus white noise.
+
+    ``ax = -(0.3 + drag) u + 2 δ_lon``, ``ay`` likewise in ``v`` and ``δ_lat``, ``az = -9.81 - 20 (δ_thr - 0.45)``,
+    each angular acceleration 50 times its command; noise 0.05 m/s² and 0.1 rad/s². `drag` (1/s) is a
+    rotor drag that a flight built with 0 lacks; the height stays above `lowest_m`.
+    """
+    from sysid.discrepancy.series import COMMANDS
+
+    rng = np.random.default_rng(seed)
+
+    def smooth(scale: float) -> np.ndarray:
+        return scale * np.convolve(rng.normal(size=n + 49), np.ones(50) / 50.0, mode="valid")
+
+    signals = {c: smooth(0.05) for c in COMMANDS}
+    signals["delta_thr"] = signals["delta_thr"] + 0.45
+    for name, scale in (("u", 3.0), ("v", 3.0), ("w", 0.5), ("p", 0.2), ("q", 0.2), ("r", 0.2), ("vd", 0.5)):
+        signals[name] = smooth(scale)
+    signals["height_agl"] = lowest_m + np.abs(smooth(5.0))
+    signals["battery_v"] = 25.0 - np.linspace(0.0, 1.0, n) + smooth(0.05)
+    signals["t_flight"] = np.arange(n) / 50.0
+    signals["ax"] = -(0.3 + drag) * signals["u"] + 2.0 * signals["delta_lon"] + rng.normal(0, 0.05, n)
+    signals["ay"] = -(0.3 + drag) * signals["v"] + 2.0 * signals["delta_lat"] + rng.normal(0, 0.05, n)
+    signals["az"] = -9.81 - 20.0 * (signals["delta_thr"] - 0.45) + rng.normal(0, 0.05, n)
+    for axis, command in (("p_dot", "delta_lat"), ("q_dot", "delta_lon"), ("r_dot", "delta_yaw")):
+        signals[axis] = 50.0 * signals[command] + rng.normal(0, 0.1, n)
+    return FlightSeries(
+        name=f"synthetic-{seed}", time_s=np.arange(n) / 50.0, piece=np.zeros(n, int), signals=signals, rate_hz=50.0
+    )

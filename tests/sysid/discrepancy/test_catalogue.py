@@ -9,38 +9,16 @@ import pytest
 
 from sysid.discrepancy.baseline import fit_baseline
 from sysid.discrepancy.catalogue import CATALOGUE, EFFECTS, FlightContext, candidate_terms, term_of
-from sysid.discrepancy.series import COMMANDS, FlightSeries
+from sysid.discrepancy.series import FlightSeries
+
+from builders import synthetic_series
 
 NEW_TERMS = ("control_effectiveness", "parasitic_drag", "inflow", "translational_lift", "thrust_saturation")
 
 
-def _flight(n: int = 3000, seed: int = 0) -> FlightSeries:
-    """A synthetic flight: smooth random commands, states and a voltage, outputs linear in them."""
-    rng = np.random.default_rng(seed)
-
-    def smooth(scale: float) -> np.ndarray:
-        return scale * np.convolve(rng.normal(size=n + 49), np.ones(50) / 50.0, mode="valid")
-
-    signals = {c: smooth(0.05) for c in COMMANDS}
-    signals["delta_thr"] = signals["delta_thr"] + 0.45
-    for name, scale in (("u", 3.0), ("v", 3.0), ("w", 0.5), ("p", 0.2), ("q", 0.2), ("r", 0.2), ("vd", 0.5)):
-        signals[name] = smooth(scale)
-    signals["height_agl"] = 2.0 + np.abs(smooth(5.0))
-    signals["battery_v"] = 25.0 - np.linspace(0.0, 1.0, n) + smooth(0.05)
-    signals["t_flight"] = np.arange(n) / 50.0
-    signals["ax"] = -0.3 * signals["u"] + 2.0 * signals["delta_lon"] + rng.normal(0, 0.05, n)
-    signals["ay"] = -0.3 * signals["v"] + 2.0 * signals["delta_lat"] + rng.normal(0, 0.05, n)
-    signals["az"] = -9.81 - 20.0 * (signals["delta_thr"] - 0.45) + rng.normal(0, 0.05, n)
-    for axis, command in (("p_dot", "delta_lat"), ("q_dot", "delta_lon"), ("r_dot", "delta_yaw")):
-        signals[axis] = 50.0 * signals[command] + rng.normal(0, 0.1, n)
-    return FlightSeries(
-        name="synthetic", time_s=np.arange(n) / 50.0, piece=np.zeros(n, int), signals=signals, rate_hz=50.0
-    )
-
-
 @pytest.fixture(scope="module", name="context")
 def context_fixture() -> FlightContext:
-    flight = _flight()
+    flight = synthetic_series()
     baseline = fit_baseline(flight)
     return FlightContext(series=flight, baseline=baseline, thrust=-baseline.predict(flight)["az"])
 

@@ -22,41 +22,17 @@ from sysid.discrepancy import discover, read_corrected_model, simulated_flight, 
 from sysid.discrepancy.corrected import CorrectedModel, ModelTerm
 from sysid.discrepancy.fitted_model import corrected_outputs
 from sysid.discrepancy.model_files import corrected_to_dict
-from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries
+from sysid.discrepancy.series import OUTPUTS, FlightSeries
 from sysid_cli.main import cli
 
-
-def _flight(n: int = 6000, seed: int = 0, drag: float = 0.0) -> FlightSeries:
-    """A synthetic flight (smooth random commands and states), its outputs linear in them; REAL adds `drag`.
-
-    ``ax -= drag u`` and ``ay -= drag v``: a rotor drag of `drag` 1/s that the SIM flight (drag 0) lacks.
-    """
-    rng = np.random.default_rng(seed)
-
-    def smooth(scale: float) -> np.ndarray:
-        return scale * np.convolve(rng.normal(size=n + 49), np.ones(50) / 50.0, mode="valid")
-
-    signals = {c: smooth(0.05) for c in COMMANDS}
-    signals["delta_thr"] = signals["delta_thr"] + 0.45
-    for name, scale in (("u", 3.0), ("v", 3.0), ("w", 0.5), ("p", 0.2), ("q", 0.2), ("r", 0.2), ("vd", 0.5)):
-        signals[name] = smooth(scale)
-    signals["height_agl"] = 5.0 + np.abs(smooth(5.0))
-    signals["t_flight"] = np.arange(n) / 50.0
-    signals["ax"] = -(0.3 + drag) * signals["u"] + 2.0 * signals["delta_lon"] + rng.normal(0, 0.05, n)
-    signals["ay"] = -(0.3 + drag) * signals["v"] + 2.0 * signals["delta_lat"] + rng.normal(0, 0.05, n)
-    signals["az"] = -9.81 - 20.0 * (signals["delta_thr"] - 0.45) + rng.normal(0, 0.05, n)
-    for axis, command in (("p_dot", "delta_lat"), ("q_dot", "delta_lon"), ("r_dot", "delta_yaw")):
-        signals[axis] = 50.0 * signals[command] + rng.normal(0, 0.1, n)
-    return FlightSeries(
-        name=f"synthetic-{seed}", time_s=np.arange(n) / 50.0, piece=np.zeros(n, int), signals=signals, rate_hz=50.0
-    )
+from builders import synthetic_series
 
 
 @pytest.fixture(scope="module", name="found")
 def found_fixture() -> tuple[CorrectedModel, FlightSeries]:
     """The search on SIM (drag 0) and REAL (0.4 1/s more): its corrected model and REAL."""
-    real = _flight(seed=1, drag=0.4)
-    result = discover([_flight(seed=0)], [real])
+    real = synthetic_series(6000, seed=1, drag=0.4, lowest_m=5.0)
+    result = discover([synthetic_series(6000, seed=0, lowest_m=5.0)], [real])
     assert result.verdict == "rotor_drag"
     assert result.corrected is not None
     return result.corrected, real
