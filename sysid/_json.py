@@ -9,15 +9,17 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from flightlogs.errors import SysidError
+from flightlogs.errors import ModelError, SysidError
 from flightlogs.writers.jsonio import finite_or_none, jsonable, write_json
 
 __all__ = [
+    "DocumentFields",
     "finite_or_none",
     "float_or_nan",
     "json_floats",
@@ -138,3 +140,76 @@ def read_json_object(path: str | Path, error: type[SysidError], what: str) -> di
     if not isinstance(doc, dict):
         raise error(f"{path}: not a flight-sysid {what} file")
     return doc
+
+
+_REQUIRED: Any = object()
+_KINDS = {dict: "an object", list: "a list", str: "text", int: "a whole number", bool: "true or false"}
+
+
+class DocumentFields:
+    """Reads a JSON document field by field; a missing or bad field raises an error naming file and field.
+
+    Parameters
+    ----------
+    source : str
+        The file's name, first in every message.
+    error : type of SysidError, optional
+        What is raised (default :class:`~flightlogs.errors.ModelError`).
+    """
+
+    def __init__(self, source: str, error: type[SysidError] = ModelError) -> None:
+        self.source = source
+        self.error = error
+
+    def fail(self, message: str) -> SysidError:
+        """The error to raise, its message after the file's name."""
+        return self.error(f"{self.source}: {message}")
+
+    def get(self, parent: Mapping[str, Any], key: str, where: str, kind: type, default: Any = _REQUIRED) -> Any:
+        if key not in parent:
+            if default is _REQUIRED:
+                raise self.fail(f"{where} has no {key}")
+            return default
+        return self.check(parent[key], f"{where}: {key}", kind)
+
+    def check(self, value: Any, what: str, kind: type) -> Any:
+        if not isinstance(value, kind) or (isinstance(value, bool) and kind is int):
+            raise self.fail(f"{what} is {value_text(value)}, not {_KINDS[kind]}")
+        return value
+
+    def number(self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False) -> float:
+        value = self.get(parent, key, where, object)
+        if value is None:
+            if finite:
+                raise self.fail(f"{where}: {key} is null, not a finite number")
+            return math.nan
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(f"{where}: {key} is {value_text(value)}, not a number")
+        if finite and not math.isfinite(value):
+            raise self.fail(f"{where}: {key} is {value_text(value)}, not a finite number")
+        return float(value)
+
+    def numbers(
+        self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False, size: int | None = None
+    ) -> np.ndarray:
+        values = self.get(parent, key, where, list)
+        bad = [v for v in values if (isinstance(v, bool) or not isinstance(v, (int, float))) and v is not None]
+        if bad:
+            raise self.fail(f"{where}: {key} holds {value_text(bad[0])}, not a number")
+        out = float_array(values)
+        if finite and not np.all(np.isfinite(out)):
+            raise self.fail(f"{where}: {key} holds a missing or non-finite value")
+        if size is not None and out.size != size:
+            raise self.fail(f"{where}: {key} has {out.size} values, not {size}")
+        return out
+
+    def names(self, parent: Mapping[str, Any], key: str, where: str) -> list[str]:
+        values = self.get(parent, key, where, list)
+        if not all(isinstance(v, str) for v in values):
+            raise self.fail(f"{where}: {key} holds a value that is not a name")
+        return list(values)
+
+    def table(self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False) -> dict[str, float]:
+        table = self.get(parent, key, where, dict, {})
+        label = key if where == "the file" else f"{where} {key}"
+        return {k: self.number(table, k, label, finite=finite) for k in table}

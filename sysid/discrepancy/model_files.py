@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from flightlogs.errors import ModelError
-from sysid._json import float_array, json_floats, read_json_object, write_json
+from sysid._json import DocumentFields, json_floats, read_json_object, write_json
 from sysid._json import value_text as _show
 from sysid.discrepancy.baseline import BaselineModel, design_width
 from sysid.discrepancy.catalogue import EFFECTS
@@ -113,13 +113,13 @@ def corrected_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Co
     ModelError
         Naming the file and the field, if the document is not a corrected simulation of a supported version.
     """
-    read = _Reader(source)
+    read = DocumentFields(source)
     if doc.get("schema") != SCHEMA:
         raise read.fail(f"not a corrected simulation (schema {_show(doc.get('schema'))}, not {SCHEMA!r})")
     if doc.get("schema_version") != SCHEMA_VERSION:
         raise read.fail(f"schema_version {_show(doc.get('schema_version'))} is not {SCHEMA_VERSION}")
-    b = read.get(doc, "baseline", dict)
-    lags = read.numbers(b, "lags", "baseline")
+    b = read.get(doc, "baseline", "the file", dict)
+    lags = read.numbers(b, "lags", "baseline", finite=True)
     states = tuple(read.names(b, "states", "baseline"))
     squared = tuple(read.names(b, "squared", "baseline"))
     if lags.size == 0 or np.any(lags != np.round(lags)) or np.any(np.diff(lags) <= 0) or lags[0] < 0:
@@ -127,31 +127,33 @@ def corrected_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Co
     if unknown := [c for c in squared if c not in COMMANDS]:
         raise read.fail(f"baseline: squared names {unknown[0]!r}, not a mixer input ({', '.join(COMMANDS)})")
     width = design_width(lags, states, squared)
-    table = read.get(b, "coefficients", dict)
+    table = read.get(b, "coefficients", "baseline", dict)
     if sorted(table) != sorted(OUTPUTS):
         raise read.fail(f"baseline: coefficients are for {', '.join(table)}, not {', '.join(OUTPUTS)}")
-    coefficients = {o: read.numbers(table, o, "baseline coefficients", size=width) for o in OUTPUTS}
+    coefficients = {o: read.numbers(table, o, "baseline coefficients", finite=True, size=width) for o in OUTPUTS}
     baseline = BaselineModel(
         coefficients=coefficients,
         lags=lags.astype(int),
         states=states,
-        rate_hz=read.number(b, "rate_hz", "baseline"),
+        rate_hz=read.number(b, "rate_hz", "baseline", finite=True),
         squared=squared,
     )
     terms = []
-    for k, t in enumerate(read.get(doc, "terms", list)):
+    for k, t in enumerate(read.get(doc, "terms", "the file", list)):
         where = f"terms[{k}]"
         t = read.check(t, where, dict)
-        effect = read.get(t, "effect", str, where=where)
+        effect = read.get(t, "effect", where, str)
         if effect != UNEXPLAINED and effect not in EFFECTS:
             raise read.fail(f"{where}: effect {effect!r} is not in the catalogue ({', '.join(EFFECTS)}, unexplained)")
         value = t.get("value")
         if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
             raise read.fail(f"{where}: value is {_show(value)}, not a number")
         regressors = {o: tuple(read.names(t.get("regressors", {}), o, where)) for o in t.get("regressors", {})}
-        table = read.get(t, "coefficients", dict, where=where)
+        table = read.get(t, "coefficients", where, dict)
         coefficients = {
-            o: read.numbers(table, o, f"{where} coefficients", size=len(regressors[o]) if regressors else None)
+            o: read.numbers(
+                table, o, f"{where} coefficients", finite=True, size=len(regressors[o]) if regressors else None
+            )
             for o in table
         }
         if effect == UNEXPLAINED and sorted(regressors) != sorted(coefficients):
@@ -168,7 +170,7 @@ def corrected_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Co
         )
     return CorrectedModel(
         baseline=baseline,
-        thrust_trim=read.number(doc, "thrust_trim", "the file"),
+        thrust_trim=read.number(doc, "thrust_trim", "the file", finite=True),
         terms=tuple(terms),
         made_from=tuple(read.names(doc, "made_from", "the file")),
     )
@@ -205,46 +207,3 @@ def read_corrected_model(path: str | Path) -> CorrectedModel:
         If the file cannot be read or is not a corrected simulation of a supported version.
     """
     return corrected_from_dict(read_json_object(path, ModelError, "corrected simulation"), source=str(path))
-
-
-class _Reader:
-    """Reads the document field by field; a missing or bad field raises a ModelError naming file and field."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, message: str) -> ModelError:
-        return ModelError(f"{self.source}: {message}")
-
-    def check(self, value: Any, what: str, kind: type) -> Any:
-        if not isinstance(value, kind):
-            raise self.fail(f"{what} is {_show(value)}, not {'an object' if kind is dict else kind.__name__}")
-        return value
-
-    def get(self, parent: Mapping[str, Any], key: str, kind: type, *, where: str = "the file") -> Any:
-        if key not in parent:
-            raise self.fail(f"{where} has no {key}")
-        return self.check(parent[key], f"{where}: {key}", kind)
-
-    def number(self, parent: Mapping[str, Any], key: str, where: str) -> float:
-        value = self.get(parent, key, object, where=where)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-            raise self.fail(f"{where}: {key} is {_show(value)}, not a finite number")
-        return float(value)
-
-    def numbers(self, parent: Mapping[str, Any], key: str, where: str, *, size: int | None = None) -> np.ndarray:
-        values = self.get(parent, key, list, where=where)
-        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in values):
-            raise self.fail(f"{where}: {key} holds a value that is not a finite number")
-        out = float_array(values)
-        if not np.all(np.isfinite(out)):
-            raise self.fail(f"{where}: {key} holds a value that is not a finite number")
-        if size is not None and out.size != size:
-            raise self.fail(f"{where}: {key} has {out.size} values, not {size}")
-        return out
-
-    def names(self, parent: Mapping[str, Any], key: str, where: str) -> list[str]:
-        values = self.get(parent, key, list, where=where)
-        if not all(isinstance(v, str) for v in values):
-            raise self.fail(f"{where}: {key} holds a value that is not a name")
-        return list(values)

@@ -24,8 +24,8 @@ from scipy import io as sio
 
 from flightlogs.errors import ModelError
 from flightlogs.writers.atomic import atomic_output
+from sysid._json import DocumentFields as _Fields
 from sysid._json import finite_or_none as _num
-from sysid._json import float_array as _vector
 from sysid._json import json_floats as _array
 from sysid._json import read_json_object, write_json
 from sysid._json import value_text as _show
@@ -142,59 +142,6 @@ def _response_to_dict(r: FrequencyResponse) -> dict[str, Any]:
         "reference": r.reference,
         "whole_record": r.whole_record,
     }
-
-
-_REQUIRED: Any = object()
-_KINDS = {dict: "an object", list: "a list", str: "text", int: "a whole number", bool: "true or false"}
-
-
-class _Fields:
-    """Reads a model document field by field; a missing or bad field raises a ModelError naming file and field."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, message: str) -> ModelError:
-        return ModelError(f"{self.source}: {message}")
-
-    def get(self, parent: Mapping[str, Any], key: str, where: str, kind: type, default: Any = _REQUIRED) -> Any:
-        if key not in parent:
-            if default is _REQUIRED:
-                raise self.fail(f"{where} has no {key}")
-            return default
-        return self.check(parent[key], f"{where}: {key}", kind)
-
-    def check(self, value: Any, what: str, kind: type) -> Any:
-        if not isinstance(value, kind) or (isinstance(value, bool) and kind is int):
-            raise self.fail(f"{what} is {_show(value)}, not {_KINDS[kind]}")
-        return value
-
-    def number(self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False) -> float:
-        value = self.get(parent, key, where, object)
-        if value is None:
-            if finite:
-                raise self.fail(f"{where}: {key} is null, not a finite number")
-            return math.nan
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.fail(f"{where}: {key} is {_show(value)}, not a number")
-        if finite and not math.isfinite(value):
-            raise self.fail(f"{where}: {key} is {_show(value)}, not a finite number")
-        return float(value)
-
-    def numbers(self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False) -> np.ndarray:
-        values = self.get(parent, key, where, list)
-        bad = [v for v in values if (isinstance(v, bool) or not isinstance(v, (int, float))) and v is not None]
-        if bad:
-            raise self.fail(f"{where}: {key} holds {_show(bad[0])}, not a number")
-        out = _vector(values)
-        if finite and not np.all(np.isfinite(out)):
-            raise self.fail(f"{where}: {key} holds a missing or non-finite value")
-        return out
-
-    def table(self, parent: Mapping[str, Any], key: str, where: str, *, finite: bool = False) -> dict[str, float]:
-        table = self.get(parent, key, where, dict, {})
-        label = key if where == "the file" else f"{where} {key}"
-        return {k: self.number(table, k, label, finite=finite) for k in table}
 
 
 def _response_from_dict(d: Mapping[str, Any], f: _Fields, where: str) -> FrequencyResponse:

@@ -83,7 +83,10 @@ def test_the_model_of_the_unknown_is_applied_by_its_regressors_names(
         (lambda d: d["baseline"]["coefficients"]["ax"].pop(), "baseline coefficients: ax has"),
         (lambda d: d["terms"][0].update(effect="sensor_drift"), "terms\\[0\\]: effect 'sensor_drift' is not in"),
         (lambda d: d.update(schema_version=7), "schema_version 7 is not 1"),
-        (lambda d: d["terms"][0]["coefficients"].update(ax=["x"]), "terms\\[0\\] coefficients: ax holds a value"),
+        (
+            lambda d: d["terms"][0]["coefficients"].update(ax=["x"]),
+            "terms\\[0\\] coefficients: ax holds 'x', not a number",
+        ),
     ],
 )
 def test_a_bad_corrected_model_file_is_named_by_its_field(
