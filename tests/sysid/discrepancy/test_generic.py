@@ -10,7 +10,7 @@ from sysid.discrepancy.catalogue import FlightContext
 from sysid.discrepancy.generic import MAX_REGRESSORS, fit_generic, generic_library
 from sysid.discrepancy.series import OUTPUTS
 
-from .test_catalogue import _flight
+from builders import synthetic_series as _flight
 
 
 @pytest.fixture(scope="module", name="context")
