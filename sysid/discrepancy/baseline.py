@@ -4,7 +4,12 @@ Each output (a specific force or an angular acceleration) is regressed on
 the four mixer inputs at lags 0 to 0.3 s (an impulse response that holds
 the simulated delays and lags, whatever they are), their squares at four of
 those lags (differential rotor speeds change the total thrust: a yaw sweep
-pulls az down), the body velocities and rates, and a constant. Nothing about the vehicle is assumed. What REAL
+pulls az down), the body velocities and rates, and a constant. Where SIM flew
+in a logged wind (a real flight as the reference), u and v are read relative
+to the air (``u_air``, ``v_air``: ground velocity less wind): the drag and
+moments the sweeps identify then act on the wind too, and a REAL flight in
+another wind is no discrepancy (read on the ground velocity, the fleet's
+healthy flights against their first were named wind, 83 %, and a CG offset). Nothing about the vehicle is assumed. What REAL
 does that this model of SIM does not is the discrepancy.
 
 An input's square is left out when SIM flew it over too narrow a range for a curvature to show: when
@@ -29,6 +34,7 @@ __all__ = ["BaselineModel", "fit_baseline", "Commands", "design_width"]
 
 _LAG_S = 0.3  # longest input lag of the impulse responses, s
 _STATES = ("u", "v", "w", "p", "q", "r")
+_AIR = {"u": ("u_air", "wind_lon"), "v": ("v_air", "wind_lat")}  # where SIM flew in a logged wind: u, v on the air
 _N_SQUARE_LAGS = 4  # the inputs' squares (a rotor's thrust grows with its speed squared) at this many lags
 _MIN_CURVATURE_SHARE = 0.01  # std of (x - mean)² over std of x²: below it, SIM cannot inform x²'s coefficient
 
@@ -59,6 +65,14 @@ class BaselineModel:
     states: tuple[str, ...]
     rate_hz: float
     squared: tuple[str, ...] = COMMANDS
+
+    @property
+    def signals(self) -> tuple[str, ...]:
+        """The logged signals it reads: the mixer inputs and those its states are made of (``u_air``: ``u``, wind)."""
+        read = [*COMMANDS]
+        for state in self.states:
+            read += next(([ground, wind] for ground, (air, wind) in _AIR.items() if air == state), [state])
+        return tuple(dict.fromkeys(read))
 
     def predict(self, series: FlightSeries, commands: Commands = None) -> dict[str, np.ndarray]:
         """Each output as the simulation would have it on `series`, shape (n,) each.
@@ -91,7 +105,7 @@ class BaselineModel:
         square_lags = _square_lags(self.lags)
         n_lags, n_squares, n_in = self.lags.size, square_lags.size, len(COMMANDS)
         weights = np.column_stack(list(self.coefficients.values()))  # (n_regressors, n_outputs)
-        fixed = np.column_stack([series[s] for s in self.states] + [np.ones(series.n)])
+        fixed = np.column_stack([_state(series, s) for s in self.states] + [np.ones(series.n)])
         steady = fixed @ weights[n_in * n_lags + len(self.squared) * n_squares :]
         spans = series.spans()
 
@@ -186,7 +200,7 @@ def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> Baseli
     BaselineModel
     """
     lags = np.arange(int(round(_LAG_S * series.rate_hz)) + 1)
-    states = tuple(s for s in _STATES if s in series)
+    states = tuple(_AIR[s][0] if series.windy and s in _AIR else s for s in _STATES if s in series)
     use = slice(None) if rows is None else rows
     squared = tuple(c for c in COMMANDS if _curvature_share(series[c][use]) >= _MIN_CURVATURE_SHARE)
     design = _design(series, lags, states, squared)[use]  # taken once, not per output
@@ -213,7 +227,7 @@ def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...], squ
     spans = series.spans()
     columns = [_lagged(spans, series[c], lags) for c in COMMANDS]
     columns += [_lagged(spans, series[c] ** 2, _square_lags(lags)) for c in squared]
-    columns.append(np.column_stack([series[s] for s in states] + [np.ones(series.n)]))
+    columns.append(np.column_stack([_state(series, s) for s in states] + [np.ones(series.n)]))
     return np.column_stack(columns)
 
 
@@ -228,6 +242,14 @@ def design_width(lags: np.ndarray, states: tuple[str, ...], squared: tuple[str, 
         As :class:`BaselineModel`.
     """
     return len(COMMANDS) * lags.size + len(squared) * _square_lags(lags).size + len(states) + 1
+
+
+def _state(series: FlightSeries, name: str) -> np.ndarray:
+    """A state regressor's values, shape (n,): a logged signal, or ``u_air``, ``v_air`` (ground velocity less wind), m/s."""
+    for ground, (air, wind) in _AIR.items():
+        if name == air:
+            return np.asarray(series[ground]) - np.asarray(series[wind])
+    return np.asarray(series[name])
 
 
 def _square_lags(lags: np.ndarray) -> np.ndarray:

@@ -34,7 +34,7 @@ from sysid.discrepancy.baseline import fit_baseline
 from sysid.discrepancy.catalogue import FlightContext, term_of
 from sysid.discrepancy.corrected import UNEXPLAINED, CorrectedModel, ModelTerm
 from sysid.discrepancy.generic import generic_library
-from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries, smoothed_as_derivative
+from sysid.discrepancy.series import OUTPUTS, FlightSeries, smoothed_as_derivative
 from sysid.model.discrete import discretize, predict_one_step
 from sysid.model.statespace import DelayedStateSpace
 
@@ -196,7 +196,7 @@ def corrected_outputs(model: CorrectedModel, flight: FlightSeries) -> dict[str, 
     ModelError
         If the flight lacks a signal a term reads.
     """
-    if missing := [s for s in (*COMMANDS, *model.baseline.states) if s not in flight]:
+    if missing := [s for s in model.baseline.signals if s not in flight]:
         raise ModelError(f"{flight.name}: the corrected simulation reads {missing[0]}, which this flight does not log")
     base = model.baseline.predict(flight)
     trim = model.thrust_trim * base["az"]  # -trim × thrust, the thrust being -az

@@ -24,7 +24,8 @@
    one's are listed as its alternatives. When nothing is named, the model of the unknown is tried on
    every output; a later term must cut its outputs' residual RMS by 10 %; an output whose residual
    stays 2.5 times over its floor with every finding modelled is ``unexplained`` (weak names on it are
-   dropped). A trim of the thrust per input beyond 5 %, with nothing else on az, is a control
+   dropped); names that are all weak (each under 15 % of its outputs' residual) give way to the model of
+   the unknown on every output when it removes more of the whole flight's residual than they do. A trim of the thrust per input beyond 5 %, with nothing else on az, is a control
    effectiveness. The folds are 4 s blocks dealt in turn to six (a manoeuvre's regime lives in one
    stretch of the flight), and a sensor's constant bias is a nuisance, never a finding.
 3. **Model, locate and show.** Each kept term is fitted on all of REAL with
@@ -260,17 +261,17 @@ def discover(
         built = best.fit.candidate.build(best.fit.value)
         for o, coefficients in best.fit.coefficients.items():
             additions[o] = additions[o] + built[o] @ coefficients
+    context = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
+    first_floor = max(options.min_share, generic_null)
     if not kept:
         current = combined(base, additions)
-        context = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
         generic = fit_generic(context, y, current, scale, library=library)
-        threshold = max(options.min_share, generic_null)
-        if generic.chosen and generic.score > threshold:
-            rows = _support(generic.predicted, current, scale)
-            local = _local_score(y, generic.predicted, current, scale, generic.outputs)
-            if local > options.min_improvement and _sustained(rows, flown["t_flight"]):
-                kept.append(_unexplained(generic, y, base, additions, scale, held_out, (), terms))
-    kept = _far_left(kept, y, base, additions, scale, held_out, library, flown, baseline, trim, terms)
+        if _generic_passes(generic, y, current, scale, first_floor, options, flown["t_flight"]):
+            kept.append(_unexplained(generic, y, base, additions, scale, held_out, (), terms))
+    kept, additions = _instead_of_weak(
+        kept, y, base, additions, scale, held_out, library, context, first_floor, options, terms
+    )
+    kept = _far_left(kept, y, base, additions, scale, held_out, library, context, terms)
     level = _thrust_level(kept, gain, thrust, y["az"] - combined(base, additions)["az"], base, additions, y, scale)
     corrected = CorrectedModel(
         baseline=baseline,
@@ -329,6 +330,71 @@ def _model_term(kept: _Kept) -> ModelTerm | None:
     return ModelTerm(effect=fit.candidate.effect, value=fit.value, coefficients=coefficients, regressors=regressors)
 
 
+def _generic_passes(
+    generic: GenericFit,
+    y: Mapping[str, np.ndarray],
+    current: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+    threshold: float,
+    options: DiscrepancyOptions,
+    clock: np.ndarray,
+) -> bool:
+    """Whether the model of the unknown passes a first term's screen: `threshold` on the whole flight, the floor
+    where it acts, and a sustained support (`clock`: the flight's time, s, shape (n,))."""
+    if not generic.chosen or generic.score <= threshold:
+        return False
+    local = _local_score(y, generic.predicted, current, scale, generic.outputs)
+    return local > options.min_improvement and _sustained(_support(generic.predicted, current, scale), clock)
+
+
+def _instead_of_weak(
+    kept: list[_Kept],
+    y: Mapping[str, np.ndarray],
+    base: Mapping[str, np.ndarray],
+    additions: dict[str, np.ndarray],
+    scale: Mapping[str, float],
+    held_out: dict[str, np.ndarray],
+    library: list[Regressor],
+    context: FlightContext,
+    threshold: float,
+    options: DiscrepancyOptions,
+    terms: dict[int, Term],
+) -> tuple[list[_Kept], dict[str, np.ndarray]]:
+    """`kept` and the additions, with the model of the unknown in the place of names that are all weak.
+
+    Names that each removed under :data:`_WEAK` of their outputs' residual (a mass step's 0.2 % beside a
+    roll command that also pitches) may be slivers of something no catalogue term describes, each judged
+    on its own outputs only. The model of the unknown, fitted on every output to what was left before
+    them, takes their place when it passes a first term's screen (`threshold`) and removes more of the
+    weighted held-out residual of the whole flight than they do together; the names become its alternatives.
+    """
+    if not kept or any(
+        k.score >= _WEAK or k.fit.candidate.kind != "linear" or k.fit.candidate.effect == UNEXPLAINED for k in kept
+    ):
+        return kept, additions
+    without = _without(additions, [k.fit for k in kept])
+    current = combined(base, without)
+    generic = fit_generic(context, y, current, scale, library=library)
+    if not _generic_passes(generic, y, current, scale, threshold, options, context.series["t_flight"]):
+        return kept, additions
+    before = kept[0].before
+    if _removed(y, generic.predicted, before, scale) <= _removed(y, held_out, before, scale):
+        return kept, additions
+    held_out.update(before)  # the names' share goes back to the residual
+    alternatives = tuple(Alternative(effect=k.fit.candidate.effect, explained_variance=round(k.score, 4)) for k in kept)
+    return [_unexplained(generic, y, base, without, scale, held_out, alternatives, terms)], without
+
+
+def _removed(
+    y: Mapping[str, np.ndarray],
+    after: Mapping[str, np.ndarray],
+    before: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+) -> float:
+    """The weighted residual (each output over its floor's variance) a prediction removes from `before`'s, all outputs."""
+    return sum(float(np.sum((y[o] - before[o]) ** 2) - np.sum((y[o] - after[o]) ** 2)) / scale[o] for o in OUTPUTS)
+
+
 def _far_left(
     kept: list[_Kept],
     y: Mapping[str, np.ndarray],
@@ -337,9 +403,7 @@ def _far_left(
     scale: Mapping[str, float],
     held_out: dict[str, np.ndarray],
     library: list[Regressor],
-    flown: FlightSeries,
-    baseline: BaselineModel,
-    trim: np.ndarray,
+    context: FlightContext,
     terms: dict[int, Term],
 ) -> list[_Kept]:
     """`kept`, with what stays far above the noise floor reported as ``unexplained`` and the weak names on it dropped.
@@ -362,7 +426,6 @@ def _far_left(
     if weak:
         held_out.update(weak[0].before)  # the weak terms' share goes back to the residual
     current = {o: held_out[o] for o in OUTPUTS}
-    context = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
     generic = fit_generic(context, y, current, scale, outputs=far, library=library)
     kept.append(_unexplained(generic, y, base, additions, scale, held_out, (), terms, outputs=far))
     return kept

@@ -41,6 +41,7 @@ _THRUST_ON = 1.0 / 3.0  # flying: thrust above this fraction of its 95th percent
 _LIFT_OFF = 0.85  # and above this fraction of its median there (a take-off ramp on the ground is not flight)
 _ON_GROUND_M = 0.05  # and, where a height is logged, above this
 _WIND = ("wind_lon", "wind_lat")
+_CALM_M_S = 0.5  # RMS wind below which a flight flew in a calm: its drag is below anything the search tells from noise
 _VIBRATING = ("ax", "ay", "az")  # signals low-passed before they are sampled at the search's rate
 _FILTER_PAD = 60  # samples the anti-alias filter pads each record's ends with
 
@@ -80,6 +81,13 @@ class FlightSeries:
     def n(self) -> int:
         """Number of samples."""
         return int(self.time_s.size)
+
+    @property
+    def windy(self) -> bool:
+        """Whether a wind is logged (``wind_lon``, ``wind_lat``, m/s) and is no calm: its RMS is 0.5 m/s or more."""
+        if not all(w in self.signals for w in _WIND):
+            return False
+        return bool(np.sqrt(np.mean(self.signals[_WIND[0]] ** 2 + self.signals[_WIND[1]] ** 2)) >= _CALM_M_S)
 
     def pieces(self) -> list[np.ndarray]:
         """Sample indices of each contiguous piece, in order."""

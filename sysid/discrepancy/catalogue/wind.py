@@ -8,8 +8,6 @@ moment then came out 30 % short, and the constant rest was named a CG offset on 
 
 from __future__ import annotations
 
-import numpy as np
-
 from sysid.discrepancy.catalogue._term import (
     Candidate,
     Coefficient,
@@ -24,16 +22,13 @@ from sysid.discrepancy.result import Finding
 
 __all__ = ["TERM"]
 
-_CALM_M_S = 0.5  # RMS wind below which the wind term is not tried, m/s
 _WIND_AVERAGE_S = 1.0
 
 
 def _make(context: FlightContext) -> Candidate | None:
     series, thrust = context.series, context.thrust
-    if "wind_lon" not in series or "wind_lat" not in series:
-        return None
-    if np.sqrt(np.mean(series["wind_lon"] ** 2 + series["wind_lat"] ** 2)) < _CALM_M_S:
-        return None  # a calm: its drag is below anything the search can tell from noise
+    if not series.windy:
+        return None  # no wind logged, or a calm: its drag is below anything the search can tell from noise
     along = thrust * averaged(series, series["wind_lon"], _WIND_AVERAGE_S)
     across = thrust * averaged(series, series["wind_lat"], _WIND_AVERAGE_S)
     columns = {"ax": [along], "ay": [across], "p_dot": [across], "q_dot": [along]}
