@@ -248,7 +248,8 @@ def _state(series: FlightSeries, name: str) -> np.ndarray:
     """A state regressor's values, shape (n,): a logged signal, or ``u_air``, ``v_air`` (ground velocity less wind), m/s."""
     for ground, (air, wind) in _AIR.items():
         if name == air:
-            return np.asarray(series[ground]) - np.asarray(series[wind])
+            difference: np.ndarray = np.asarray(series[ground]) - np.asarray(series[wind])
+            return difference
     return np.asarray(series[name])
 
 
