@@ -27,6 +27,7 @@ from flightlogs.errors import DataQualityWarning, LogCorruptionWarning, LogForma
 from flightlogs.flightlog import FlightLog, Signal
 from flightlogs.frames import quaternion_to_euler
 from flightlogs.readers._series import make_signal
+from flightlogs.readers._ulog_fast import FastPathDeclined, FastULog, WholeFile, scan_clean
 from flightlogs.readers.px4_topics import (
     GPS_TOPICS,
     MAPPED_TOPICS,
@@ -49,9 +50,6 @@ _WHOLE_FILE_LIMIT = 1 << 28  # files up to 256 MB are read into memory when thei
 #: comes from, and their damage is reported); larger ones only the topics of
 #: :data:`~flightlogs.readers.px4_topics.MAPPED_TOPICS`: a 1 GB log's other topics are not held in memory.
 _EVERY_TOPIC_UP_TO = _WHOLE_FILE_LIMIT
-_MESSAGE_TYPES = frozenset(
-    getattr(ULog, name) for name in dir(ULog) if name.startswith("MSG_TYPE_") and isinstance(getattr(ULog, name), int)
-)
 _STALL_READS = 400_000  # reads with nothing new: pyulog loops (walking garbage re-reads < 2 * 65535)
 _MIN_UTC_US = 946_684_800_000_000  # 2000-01-01: GPS time before this is a receiver default
 _DOWNWARD = 25  # distance_sensor.orientation ROTATION_DOWNWARD_FACING
@@ -68,6 +66,8 @@ _PYULOG_ERRORS = (
 )
 
 _Datasets = dict[str, dict[int, Mapping[str, np.ndarray]]]
+#: A pyulog reader class: ``kind(source, topics)`` parses `source`, keeping `topics` (None: every one).
+_Reader = Callable[[Any, frozenset[str] | None], "_PlainULog | FastULog"]
 
 
 def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], None] | None = None) -> FlightLog:
@@ -199,47 +199,6 @@ def _check_header(path: Path) -> int:
     return size
 
 
-class _WholeFile(io.BytesIO):
-    """A file read into memory whose messages chain cleanly to its end: pyulog reads it at C speed.
-
-    It answers what :class:`_TrackedFile` answers with nothing to report: no
-    zero tail, no cut, no stall.
-    """
-
-    def __init__(self, data: bytes) -> None:
-        super().__init__(data)
-        self.size = self.zero_start = self.end = self.furthest = len(data)
-        self.zero_tail = self.last_read_at = 0
-        self.searching = False
-        self.cut_at: int | None = None
-        self.stalled_at: int | None = None
-
-
-def _whole_if_clean(path: Path, size: int, progress: Callable[[int, int], None] | None) -> _WholeFile | None:
-    """The file in memory if every message, from the header on, is of a ULog type and the last ends at the end.
-
-    Such a file needs none of :class:`_TrackedFile`'s watching: no message is
-    cut, no zeros pad it, and pyulog never has to search for a sync marker.
-    Anything else (and files too large to hold twice) is read through the
-    tracked file.
-    """
-    if size > _WHOLE_FILE_LIMIT:
-        return None
-    data = path.read_bytes()
-    header = struct.Struct("<HB")
-    position, step = _HEADER_BYTES, max(size // 50, 1 << 16)
-    next_report = step
-    while position + 3 <= len(data):
-        length, kind = header.unpack_from(data, position)
-        if kind not in _MESSAGE_TYPES:
-            return None
-        position += 3 + length
-        if position >= next_report and progress is not None:
-            progress(min(position, size), size)
-            next_report = position + step
-    return _WholeFile(data) if position == len(data) else None
-
-
 class _TrackedFile:
     """A read-only file for pyulog: reports progress, notices a cut-off last message, and
     ends before a long zero-filled tail (which pyulog would walk one byte at a time)."""
@@ -315,7 +274,7 @@ def _zero_tail(stream: Any, size: int) -> int:
 class _PlainULog(ULog):  # type: ignore[misc]
     """pyulog's reader as it is, with the damage counters of :class:`_CountingULog` at zero (a clean file)."""
 
-    def __init__(self, log_file: _TrackedFile | _WholeFile, topics: frozenset[str] | None) -> None:
+    def __init__(self, log_file: _TrackedFile | WholeFile, topics: frozenset[str] | None) -> None:
         self.skipped: dict[str | int, int] = {}  # topic name (wrong size) or unknown msg id
         self.skipped_bytes = 0
         self.resyncs = 0
@@ -336,7 +295,7 @@ class _CountingULog(_PlainULog):
                 ulog_object.skipped[key] = ulog_object.skipped.get(key, 0) + 1
             return corrupt
 
-    def __init__(self, log_file: _TrackedFile | _WholeFile, topics: frozenset[str] | None) -> None:
+    def __init__(self, log_file: _TrackedFile | WholeFile, topics: frozenset[str] | None) -> None:
         self._last_skip = -1
         super().__init__(log_file, topics)
 
@@ -368,17 +327,23 @@ def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None, t
     pyulog keeps the data of `topics` only (every topic with None): on a log of many topics the
     others' bytes are walked past instead of being copied, parsed and held.
 
-    A file whose messages chain cleanly is parsed in memory by pyulog as it is;
-    one that pyulog then finds corrupt, or whose chain is not clean, is parsed
-    again through :class:`_TrackedFile` with the damage counted.
+    A file whose messages chain cleanly (up to 256 MB) is parsed in memory: by
+    :class:`~flightlogs.readers._ulog_fast.FastULog` (pyulog for every message
+    but the data ones, numpy for those), else, where that path is declined, by
+    pyulog as it is. One that pyulog then finds corrupt, or whose chain is not
+    clean, is parsed again through :class:`_TrackedFile` with the damage counted.
     """
-    whole = _whole_if_clean(path, size, progress)
-    if whole is not None:
-        try:
-            ulog, tracked, said = _run_pyulog(path, _PlainULog, whole, topics)
-        except LogFormatError:
-            pass  # the tracked reader says where the damage lies
-        else:
+    clean = scan_clean(path, size, progress) if size <= _WHOLE_FILE_LIMIT else None
+    if clean is not None:
+        readers: tuple[tuple[_Reader, Callable[[], WholeFile]], ...] = (
+            (FastULog, clean.reduced_file),
+            (_PlainULog, clean.whole),
+        )
+        for kind, source in readers:
+            try:
+                ulog, tracked, said = _run_pyulog(path, kind, source(), topics)
+            except (FastPathDeclined, LogFormatError):
+                continue  # the whole file, then the tracked reader, which says where the damage lies
             if not ulog.file_corruption:
                 return _reported(ulog, tracked, said, size, path)
     tracked = _TrackedFile(path, size, progress)
@@ -386,8 +351,8 @@ def _parse(path: Path, size: int, progress: Callable[[int, int], None] | None, t
 
 
 def _run_pyulog(
-    path: Path, kind: type[_PlainULog], source: _TrackedFile | _WholeFile, topics: frozenset[str] | None
-) -> tuple[_PlainULog, _TrackedFile | _WholeFile, list[str]]:
+    path: Path, kind: _Reader, source: _TrackedFile | WholeFile, topics: frozenset[str] | None
+) -> tuple[_PlainULog | FastULog, _TrackedFile | WholeFile, list[str]]:
     """pyulog's parse of `source`, and what it printed or warned."""
     printed = io.StringIO()
     try:
@@ -407,7 +372,9 @@ def _run_pyulog(
     return ulog, source, said
 
 
-def _reported(ulog: _PlainULog, tracked: _TrackedFile | _WholeFile, said: list[str], size: int, path: Path) -> ULog:
+def _reported(
+    ulog: _PlainULog | FastULog, tracked: _TrackedFile | WholeFile, said: list[str], size: int, path: Path
+) -> ULog:
     """`ulog`, after warning of the damage read past, the dropouts and pyulog's own complaints."""
     for note in _damage_notes(ulog, tracked, size, path.name):
         _warnings.warn(LogCorruptionWarning(note), stacklevel=2)
@@ -420,7 +387,7 @@ def _reported(ulog: _PlainULog, tracked: _TrackedFile | _WholeFile, said: list[s
     return ulog
 
 
-def _damage_notes(ulog: _PlainULog, tracked: _TrackedFile | _WholeFile, size: int, name: str) -> list[str]:
+def _damage_notes(ulog: _PlainULog | FastULog, tracked: _TrackedFile | WholeFile, size: int, name: str) -> list[str]:
     """Sentences saying what pyulog skipped, from our counters and its flag."""
     notes = []
     if tracked.stalled_at is not None:

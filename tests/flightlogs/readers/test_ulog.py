@@ -613,9 +613,9 @@ def test_a_clean_file_read_in_memory_equals_the_tracked_read(
     import flightlogs.readers.ulog as ulog_module
 
     path = real_data / name
-    assert ulog_module._whole_if_clean(path, path.stat().st_size, None) is not None  # the fast path is taken
+    assert ulog_module.scan_clean(path, path.stat().st_size, None) is not None  # the fast path is taken
     fast = read_warned(read_ulog, path)
-    monkeypatch.setattr(ulog_module, "_whole_if_clean", lambda *_: None)
+    monkeypatch.setattr(ulog_module, "scan_clean", lambda *_: None)
     tracked = read_warned(read_ulog, path)
     assert fast.warnings == tracked.warnings and fast.vehicle == tracked.vehicle
     assert dict(fast.parameters) == dict(tracked.parameters) and list(fast.signals) == list(tracked.signals)
