@@ -13,7 +13,8 @@
    it acts, so that an effect of 20 s near the ground is judged there; a
    later one: 5 % of the whole), and if 80 % of what it changes lies in at least 2 s of flight or in
    episodes 10 s apart (near the ground at take-off and at landing)
-   (a touchdown's spike is no physics); of those that pass, the one that lowers the Bayesian information
+   (a touchdown's spike is no physics), and, for a term whose mark is on some outputs (a rotor's drag on ax and
+   ay), if it passes the same threshold on those alone; of those that pass, the one that lowers the Bayesian information
    criterion most (effective samples, the parameter inside its shape
    counted) is kept; its contribution joins the model and the others are
    screened again (forward selection), until none passes. A delay and a lag compete:
@@ -63,7 +64,9 @@ from sysid.discrepancy.selection import (
     cross_validated,
     effective_samples,
     fit_term,
+    held_out_share,
     joined,
+    narrowed,
     split_joined,
 )
 from sysid.discrepancy.series import OUTPUTS, FlightSeries
@@ -188,9 +191,25 @@ def discover(
         context = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
         for candidate in (transforms.get(c.effect, c) for c in candidate_terms(context, exclude=tuple(exclude))):
             together = candidate.kind == "linear" and bool(linear)
-            trial, adds = (joined(candidate, linear), without) if together else (candidate, additions)
+            adds = without if together else additions
             reference = held_out if together else None  # judged against the kept terms' held-out prediction
-            score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
+            against = reference if reference is not None else current
+            shown_on = term_of(candidate.effect).shown_on
+            for _ in range(2):
+                trial = joined(candidate, linear) if together else candidate
+                score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
+                # a companion output (a rotor drag's hub moment) stays only where it removes a share of its own
+                # residual: columns that fit nothing would cost the term its score and criterion
+                idle = [
+                    o
+                    for o in candidate.outputs
+                    if shown_on
+                    and o not in shown_on
+                    and held_out_share(y, predicted, against, scale, (o,)) <= options.min_share
+                ]
+                if not idle:
+                    break
+                candidate = narrowed(candidate, tuple(o for o in candidate.outputs if o not in idle))
             # once a term is kept, the residual where it acts holds its shape's error, which another term acting
             # there fits as well (a mass step at the low hover beside a ground effect): later terms must also
             # remove a share of the whole flight's residual
@@ -198,8 +217,10 @@ def discover(
             threshold = max(least, options.null_margin * max(null.get(candidate.effect, 0.0), 0.0))
             if kept:  # a later term takes up what the first one's shape left: it must cut its outputs' RMS by 10 %
                 threshold = max(threshold, _LATE_SCORE)
-            against = reference if reference is not None else current
             local = _local_score(y, predicted, against, scale, candidate.outputs)
+            # a term whose own mark is missing (a rotor drag without a drag force) removes what it does with its
+            # companion columns only (a hub moment): it is not that effect
+            shown = not shown_on or held_out_share(y, predicted, against, scale, shown_on) > threshold
             if not kept:
                 screened.append(
                     Screening(
@@ -209,7 +230,7 @@ def discover(
                         where_it_acts=round(local, 4),
                     )
                 )
-            if score > threshold and local > options.min_improvement:
+            if score > threshold and local > options.min_improvement and shown:
                 fit = fit_term(trial, y, base, adds, scale)
                 if candidate.kind == "transform" and fit.value >= candidate.grid[-1]:
                     continue  # at the end of the range searched: a bound, not a measured delay or lag
@@ -643,9 +664,13 @@ def _local_score(
     rows = _support({o: predicted.get(o, current[o]) for o in OUTPUTS}, current, scale)
     if rows.size == 0:
         return 0.0
-    before = sum(float(np.sum((y[o][rows] - current[o][rows]) ** 2)) / scale[o] for o in outputs)
-    after = sum(float(np.sum((y[o][rows] - predicted[o][rows]) ** 2)) / scale[o] for o in outputs)
-    return 1.0 - after / before if before > 0 else 0.0
+    return held_out_share(
+        {o: y[o][rows] for o in outputs},
+        {o: predicted[o][rows] for o in outputs},
+        {o: current[o][rows] for o in outputs},
+        scale,
+        outputs,
+    )
 
 
 def _noise_floor(sim: FlightSeries) -> tuple[dict[str, float], dict[str, float]]:

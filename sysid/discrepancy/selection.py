@@ -27,6 +27,8 @@ __all__ = [
     "folds",
     "combined",
     "cross_validated",
+    "held_out_share",
+    "narrowed",
     "fit_term",
     "joined",
     "split_joined",
@@ -179,10 +181,41 @@ def cross_validated(
             fit = _fit_term(fixed, y, base, additions, scale, np.flatnonzero(~held), build, uncertainties=False)
             for o, coefficients in fit.coefficients.items():  # the prediction with the term, as TermFit.prediction
                 predicted[o][test] = ((base[o] + additions[o]) + built[o] @ coefficients)[test]
-    outputs = judged if judged is not None else candidate.outputs
-    before = sum(np.sum((y[o] - current[o]) ** 2) / scale[o] for o in outputs)
-    after = sum(np.sum((y[o] - predicted[o]) ** 2) / scale[o] for o in outputs)
-    return float(1.0 - after / before) if before > 0 else 0.0, predicted
+    return held_out_share(y, predicted, current, scale, judged if judged is not None else candidate.outputs), predicted
+
+
+def held_out_share(
+    y: Mapping[str, np.ndarray],
+    predicted: Mapping[str, np.ndarray],
+    current: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+    outputs: Sequence[str],
+) -> float:
+    """``1 - SSE_with / SSE_without`` of `outputs`, each weighted by its noise floor's inverse.
+
+    Parameters
+    ----------
+    y : Mapping[str, ndarray]
+        Each output as flown, shape (n,).
+    predicted : Mapping[str, ndarray]
+        Each output as predicted with the term (held out), shape (n,).
+    current : Mapping[str, ndarray]
+        Each output as predicted without it, shape (n,).
+    scale : Mapping[str, float]
+        Each output's noise-floor variance.
+    outputs : sequence of str
+        The outputs summed over.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> y, without = {"ax": np.ones(4)}, {"ax": np.zeros(4)}
+    >>> held_out_share(y, {"ax": np.full(4, 0.5)}, without, {"ax": 1.0}, ["ax"])
+    0.75
+    """
+    before = sum(float(np.sum((y[o] - current[o]) ** 2)) / scale[o] for o in outputs)
+    after = sum(float(np.sum((y[o] - predicted[o]) ** 2)) / scale[o] for o in outputs)
+    return 1.0 - after / before if before > 0 else 0.0
 
 
 def joined(candidate: Candidate, kept: Sequence[TermFit]) -> Candidate:
@@ -213,6 +246,33 @@ def joined(candidate: Candidate, kept: Sequence[TermFit]) -> Candidate:
 
     names = candidate.coefficients + tuple(n for k in kept for n in k.candidate.coefficients)
     return replace(candidate, outputs=outputs, build=build, coefficients=names)
+
+
+def narrowed(candidate: Candidate, outputs: tuple[str, ...]) -> Candidate:
+    """A linear `candidate` on `outputs` only (a subset of its own), its coefficients' keys kept in order.
+
+    Parameters
+    ----------
+    candidate : Candidate
+        A linear term.
+    outputs : tuple of str
+        The outputs it keeps.
+    """
+    built = candidate.build(candidate.grid[0])
+    keys: list[str] = []
+    first = 0
+    for o in candidate.outputs:
+        width = built[o].shape[1]
+        if o in outputs:
+            keys.extend(candidate.coefficients[first : first + width])
+        first += width
+    build = candidate.build
+
+    def narrow(value: float) -> dict[str, np.ndarray]:
+        whole = build(value)
+        return {o: whole[o] for o in outputs}
+
+    return replace(candidate, outputs=outputs, build=narrow, coefficients=tuple(keys))
 
 
 def split_joined(fit: TermFit, candidate: Candidate, kept: Sequence[TermFit]) -> list[TermFit]:

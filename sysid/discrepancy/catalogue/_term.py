@@ -168,6 +168,9 @@ class Term:
         Terms it competes with for one residual: once one is kept the others are not tried.
     separated_by : str
         The flight that shows it apart from the terms it may be confused with (for an ambiguous finding).
+    shown_on : tuple of str
+        Outputs on which the term must by itself remove a held-out share above its threshold (empty: any):
+        a rotor's drag is a force first, and its hub moment alone (a flapping rotor) is not one.
     """
 
     effect: str
@@ -180,6 +183,7 @@ class Term:
     derive: Callable[[list[FittedParameter], Derivation], list[FittedParameter]] = field(default=_no_derivation)
     rivals: tuple[str, ...] = ()
     separated_by: str = ""
+    shown_on: tuple[str, ...] = ()
 
     def coefficient(self, key: str) -> Coefficient:
         """The coefficient of column `key` (a key the term does not list is reported as it is, unit 1)."""

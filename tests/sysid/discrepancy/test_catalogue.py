@@ -9,6 +9,7 @@ import pytest
 
 from sysid.discrepancy.baseline import fit_baseline
 from sysid.discrepancy.catalogue import CATALOGUE, EFFECTS, FlightContext, candidate_terms, term_of
+from sysid.discrepancy.selection import narrowed
 from sysid.discrepancy.series import FlightSeries
 
 from builders import synthetic_series
@@ -75,3 +76,18 @@ def test_a_baseline_recentred_on_the_thrust_reads_the_thrust_about_the_real_hove
         if o != "az":
             np.testing.assert_allclose(after[o], before[o], atol=1e-10)
     np.testing.assert_allclose(after["az"], baseline.predict(moved)["az"], atol=1e-12)
+
+
+def test_a_rotor_drag_narrowed_to_its_force_keeps_its_force_columns_and_names(context: FlightContext) -> None:
+    """The search drops a companion output (the hub moment) where it removes nothing: the rest is untouched."""
+    whole = term_of("rotor_drag").make(context)
+    assert whole is not None
+    assert whole.outputs == ("ax", "ay", "p_dot", "q_dot") and term_of("rotor_drag").shown_on == ("ax", "ay")
+    force = narrowed(whole, ("ax", "ay"))
+    assert force.outputs == ("ax", "ay") and force.coefficients == ("d_x_s_m", "d_y_s_m")
+    built, full = force.build(force.grid[0]), whole.build(whole.grid[0])
+    assert set(built) == {"ax", "ay"}
+    for o in built:
+        np.testing.assert_array_equal(built[o], full[o])
+    moment = narrowed(whole, ("ax", "q_dot"))
+    assert moment.coefficients == ("d_x_s_m", "m_u_rad_m")

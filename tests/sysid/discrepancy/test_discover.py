@@ -58,13 +58,8 @@ EFFECTS: dict[str, list[str]] = {
     "quad": ["none", "ground_effect", "rotor_drag", "wind", "cg_offset", "actuator_lag"],
 }
 #: Cases the open-world search (issue 30) gets wrong on this simulator, as measured on 2026-11-28 (CI, seed as below):
-#: a rotor's drag also pitches and rolls the vehicle (the hub above the CG: the model of the unknown finds
-#: p_dot ∝ thrust × v, q_dot ∝ thrust × u, 86 % of those outputs), which the rotor_drag and wind terms lack;
-#: the battery's sag leaves a thrust trim read as control_effectiveness. Issue 30 stays open on them.
+#: the battery's sag leaves a thrust trim read as control_effectiveness. Issue 30 stays open on it.
 _OPEN = {
-    ("octo", "rotor_drag"): "rotor_drag and unexplained (the rotors' hub moment, not in the rotor_drag term)",
-    ("quad", "rotor_drag"): "unexplained first (p_dot ∝ T v, q_dot ∝ T u: the hub moment), rotor_drag second",
-    ("quad", "wind"): "wind and unexplained (the hub moment of the wind's drag, not in the wind term)",
     ("octo", "battery_sag"): "battery_sag and control_effectiveness (the trim beside the sag)",
 }
 CASES = [
@@ -183,10 +178,7 @@ def test_the_cg_moment_is_mass_times_offset_over_inertia(results: Results, name:
     assert abs(roll) < 0.05 * abs(truth)
 
 
-@pytest.mark.parametrize(
-    "name",
-    ["octo", pytest.param("quad", marks=pytest.mark.xfail(strict=False, reason=_OPEN["quad", "rotor_drag"]))],
-)
+@pytest.mark.parametrize("name", ["octo", "quad"])
 @pytest.mark.parametrize(("effect", "variable"), [("rotor_drag", "ground_speed"), ("wind", "wind_speed")])
 def test_the_drag_per_thrust_and_speed_is_the_rotors(results: Results, name: str, effect: str, variable: str) -> None:
     """Rotors dragging twice the simulated, or hovering in a wind the simulation lacked: either way the term's
@@ -195,6 +187,17 @@ def test_the_drag_per_thrust_and_speed_is_the_rotors(results: Results, name: str
     drag, _ = _parameter(results[name, effect], "drag_x")
     assert drag == pytest.approx(VEHICLES[name].drag_s_m[0], rel=0.05)
     assert finding.regime.variable == variable
+
+
+@pytest.mark.parametrize("name", ["octo", "quad"])
+def test_the_wind_pitches_at_the_hubs(results: Results, name: str) -> None:
+    """The wind's drag acts at the hubs, above the CG, and flaps the discs back: per specific thrust and m/s of
+    wind a pitch acceleration -m (d_x h + flapping_x) / I_yy, h the hubs' height (the simulator's constants)."""
+    vehicle = VEHICLES[name]
+    height_m = -float(np.mean(vehicle.rotor_positions_m[:, 2]))
+    truth = vehicle.mass_kg * (vehicle.drag_s_m[0] * height_m + vehicle.flapping_s[0]) / vehicle.inertia_kg_m2[1]
+    moment, _ = _parameter(results[name, "wind"], "pitch_moment_per_wind")
+    assert moment == pytest.approx(-truth, rel=0.05)
 
 
 @pytest.mark.xfail(
