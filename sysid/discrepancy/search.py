@@ -195,21 +195,22 @@ def discover(
             reference = held_out if together else None  # judged against the kept terms' held-out prediction
             against = reference if reference is not None else current
             shown_on = term_of(candidate.effect).shown_on
-            for _ in range(2):
+            trial = joined(candidate, linear) if together else candidate
+            score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
+            # a companion output (a rotor drag's hub moment) stays only where it removes a share of its own
+            # residual: columns that fit nothing would cost the term its score and criterion (each output's
+            # columns are fitted on their own, so the others' shares do not change once these are dropped)
+            kept_outputs = tuple(
+                o
+                for o in candidate.outputs
+                if not shown_on
+                or o in shown_on
+                or held_out_share(y, predicted, against, scale, (o,)) > options.min_share
+            )
+            if kept_outputs != candidate.outputs:
+                candidate = narrowed(candidate, kept_outputs)
                 trial = joined(candidate, linear) if together else candidate
                 score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
-                # a companion output (a rotor drag's hub moment) stays only where it removes a share of its own
-                # residual: columns that fit nothing would cost the term its score and criterion
-                idle = [
-                    o
-                    for o in candidate.outputs
-                    if shown_on
-                    and o not in shown_on
-                    and held_out_share(y, predicted, against, scale, (o,)) <= options.min_share
-                ]
-                if not idle:
-                    break
-                candidate = narrowed(candidate, tuple(o for o in candidate.outputs if o not in idle))
             # once a term is kept, the residual where it acts holds its shape's error, which another term acting
             # there fits as well (a mass step at the low hover beside a ground effect): later terms must also
             # remove a share of the whole flight's residual
