@@ -18,6 +18,7 @@ import dataclasses
 import io
 import struct
 import warnings
+from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -39,7 +40,6 @@ from simulator.autopilot.excitation import Maneuver
 from simulator.flights.linear import simulate_hover
 from simulator.output.px4 import write_px4_log
 
-REAL = Path("/work/shared/data/real")
 CLEAN_REAL = ["pyulog/sample.ulg", "px4-ulog-rs/quadrotor_local.ulg", "kd0aij-impulse-response/log1.ulg"]
 OTHER_REAL = [
     "pyulog/sample_appended_multiple.ulg",
@@ -50,10 +50,14 @@ OTHER_REAL = [
 pytestmark = pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning")
 
 
-def _real(name: str) -> Path:
-    path = REAL / name
-    if not path.is_file():
-        pytest.skip(f"{path} is not on this machine")
+@pytest.fixture(name="real")
+def real_fixture(real_data: Path) -> Callable[[str], Path]:
+    """A real log of ``../shared/data/real`` by its name there (the suite fails where that folder is missing)."""
+
+    def path(name: str) -> Path:
+        assert (real_data / name).is_file(), f"{real_data / name} is missing"
+        return real_data / name
+
     return path
 
 
@@ -131,8 +135,10 @@ def _assert_same_log(fast: FlightLog, slow: FlightLog) -> None:
 
 
 @pytest.mark.parametrize("name", CLEAN_REAL)
-def test_a_clean_real_log_takes_the_fast_path_and_parses_as_pyulog(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    path = _real(name)
+def test_a_clean_real_log_takes_the_fast_path_and_parses_as_pyulog(
+    name: str, real: Callable[[str], Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = real(name)
     got = _parse(path)
     assert isinstance(got, FastULog)
     assert_same_parse(got, _pyulog(path))
@@ -140,22 +146,24 @@ def test_a_clean_real_log_takes_the_fast_path_and_parses_as_pyulog(name: str, mo
 
 
 @pytest.mark.parametrize("name", CLEAN_REAL[:2])
-def test_the_fast_path_keeps_only_the_topics_asked_for_as_pyulog(name: str) -> None:
-    path = _real(name)
+def test_the_fast_path_keeps_only_the_topics_asked_for_as_pyulog(name: str, real: Callable[[str], Path]) -> None:
+    path = real(name)
     got = _parse(path, MAPPED_TOPICS)
     assert isinstance(got, FastULog)
     assert_same_parse(got, _pyulog(path, MAPPED_TOPICS))
 
 
-def test_the_real_logs_with_dropouts_and_parameter_changes_are_stamped_as_pyulog() -> None:
-    sample = _pyulog(_real("pyulog/sample.ulg"))
+def test_the_real_logs_with_dropouts_and_parameter_changes_are_stamped_as_pyulog(real: Callable[[str], Path]) -> None:
+    sample = _pyulog(real("pyulog/sample.ulg"))
     assert len(sample.dropouts) == 4 and len(sample.changed_parameters) == 6  # what the comparison above covered
-    assert len(_pyulog(_real("kd0aij-impulse-response/log1.ulg")).dropouts) == 3
+    assert len(_pyulog(real("kd0aij-impulse-response/log1.ulg")).dropouts) == 3
 
 
 @pytest.mark.parametrize("name", OTHER_REAL)
-def test_an_appended_or_damaged_real_log_is_read_as_before(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    path = _real(name)
+def test_an_appended_or_damaged_real_log_is_read_as_before(
+    name: str, real: Callable[[str], Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = real(name)
     got = _parse(path)
     assert not isinstance(got, FastULog)
     clean = scan_clean(path, path.stat().st_size, None)
