@@ -10,20 +10,20 @@ rates, the attitude, the climb rate, the specific thrust ``T`` and its products 
 rate, the squares and signed squares of the velocities, the products of the rates, and each axis'
 command as the simulation's model makes it a moment or thrust (:meth:`BaselineModel.command_part`: a
 roll command's moment may act on pitch). Each output's regressors are chosen by orthogonal matching
-pursuit (scikit-learn's ``orthogonal_mp_gram``, forward selection with least-squares refits, on the
-columns centred and scaled to unit variance), at most :data:`MAX_REGRESSORS`; how many is chosen per
-output on held-out time blocks (:func:`~sysid.discrepancy.selection.folds`), and the held-out prediction of each block comes from the regressors and
+pursuit (scikit-learn's ``orthogonal_mp_gram``, ported in :mod:`sysid.discrepancy._omp`: forward
+selection with least-squares refits, on the columns centred and scaled to unit variance), at most
+:data:`MAX_REGRESSORS`; how many is chosen per output on held-out time blocks (:func:`~sysid.discrepancy.selection.folds`), and the held-out prediction of each block comes from the regressors and
 coefficients chosen without it (each fold's Gram matrix is summed once; a training set's is the total less its own).
 """
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
+from sysid.discrepancy._omp import omp_gram_path
 from sysid.discrepancy.catalogue import Candidate, Coefficient, FlightContext, Term
 from sysid.discrepancy.catalogue._air import climb_rate
 from sysid.discrepancy.catalogue._term import pm
@@ -227,21 +227,13 @@ class _BlockSums:
 
     def _path(self, keep: np.ndarray, xy: np.ndarray, y_sum: float) -> tuple[list[np.ndarray], np.ndarray, float]:
         """Orthogonal matching pursuit on the blocks `keep`: supports and coefficients of 1.. regressors."""
-        from sklearn import config_context
-        from sklearn.linear_model import orthogonal_mp_gram  # a second to import: only when a residual is modelled
-
         n = float(self.count[keep].sum())
         mean = self.column[keep].sum(axis=0) / n
         centred = self.gram[keep].sum(axis=0) - n * np.outer(mean, mean)
         spread = np.sqrt(np.maximum(np.diag(centred), 1e-300))
         gram = centred / np.outer(spread, spread)
         covariance = (xy - mean * y_sum) / spread
-        # a path that ends early (collinear columns) is read as it is; the arguments are ours and sound: sklearn's
-        # check of them took 2.5 ms a call, 140 calls a search
-        with warnings.catch_warnings(), config_context(skip_parameter_validation=True):
-            warnings.simplefilter("ignore", RuntimeWarning)
-            path = orthogonal_mp_gram(gram, covariance, n_nonzero_coefs=MAX_REGRESSORS, return_path=True)
-        path = path.reshape(gram.shape[0], -1)
+        path = omp_gram_path(gram, covariance, n_nonzero_coefs=MAX_REGRESSORS)  # shorter where it ends early
         coefficients = [path[:, k] / spread for k in range(path.shape[1])]
         return coefficients, mean, y_sum / n
 
