@@ -49,3 +49,23 @@ def test_the_fit_loads_neither_scipy_signal_nor_python_control() -> None:
     loaded = _loaded("import sysid.fit, sysid.freqresp")
     assert "control" not in loaded["top"] and "matplotlib" not in loaded["top"]
     assert "scipy.signal" not in loaded["scipy"] and "scipy.stats" not in loaded["scipy"]
+
+
+def test_the_discrepancy_search_filters_a_flight_without_scipy_signal_ndimage_or_stats() -> None:
+    """Its series (anti-alias filter, rate derivatives), lags, averages and bands are numpy (scipy.signal and ndimage: 0.8 s)."""
+    loaded = _loaded(
+        "import numpy as np\nfrom pathlib import Path\n"
+        "from flightlogs.record import Record\n"
+        "import sysid.discrepancy\n"
+        "from sysid.discrepancy.catalogue._term import averaged, first_order\n"
+        "from sysid.discrepancy.search import _band\n"
+        "from sysid.discrepancy.series import COMMANDS, flight_series\n"
+        "t = np.arange(5000) / 250.0\n"
+        "columns = {s: np.sin(t * (k + 1)) for k, s in enumerate(('p', 'q', 'r', 'ax', 'ay', 'az', *COMMANDS))}\n"
+        "record = Record(time_s=t, columns=columns, units=dict.fromkeys(columns, '-'), trim={'delta_thr': 2.0},"
+        " source=Path('x.ulg'))\n"
+        "series = flight_series('x', [record])\n"
+        "lagged = first_order(series, series['delta_lat'], 0.03)\n"
+        "_band({'p_dot': averaged(series, lagged, 0.5)}, series.rate_hz)"
+    )
+    assert not {"scipy.signal", "scipy.ndimage", "scipy.stats", "scipy.interpolate"} & set(loaded["scipy"])

@@ -41,8 +41,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.signal import welch
 
+from sysid.discrepancy._filters import welch_density
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
 from sysid.discrepancy.catalogue import Candidate, Derivation, FlightContext, Term, candidate_terms, term_of
 from sysid.discrepancy.catalogue._air import air_velocity, climb_rate
@@ -790,7 +790,7 @@ def _band(contribution: Mapping[str, np.ndarray], rate_hz: float) -> tuple[float
     """Frequencies holding 5-95 % of the contribution's power (its mean included at the lowest bin), rad/s."""
     total = None
     for x in contribution.values():
-        f, power = welch(x, fs=rate_hz, nperseg=min(x.size, int(64 * rate_hz)), detrend=False)
+        f, power = welch_density(x, rate_hz, min(x.size, int(64 * rate_hz)))
         total = power if total is None else total + power
     assert total is not None
     cumulative = np.cumsum(total) / max(float(np.sum(total)), 1e-300)

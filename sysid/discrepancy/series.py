@@ -22,11 +22,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import butter, savgol_filter, sosfiltfilt
 
 from flightlogs.errors import DataError
 from flightlogs.frames import earth_to_body, wind_to_body_axes
 from flightlogs.record import Record
+from sysid.discrepancy._filters import butterworth_zero_phase, savgol_slope
 
 __all__ = ["OUTPUTS", "COMMANDS", "FlightSeries", "flight_series", "smoothed_as_derivative"]
 
@@ -155,7 +155,7 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
             absolute[s] = _anti_aliased(absolute[s], record.rate_hz, rate_hz)
         values = {s: np.interp(grid, t, x) for s, x in absolute.items()}
         for rate in ("p", "q", "r"):
-            derivative = savgol_filter(absolute[rate], window, 2, deriv=1, delta=1.0 / record.rate_hz)
+            derivative = savgol_slope(absolute[rate], window, 2, 1.0 / record.rate_hz)
             values[f"{rate}_dot"] = np.interp(grid, t, derivative)
         times.append(grid)
         pieces.append(np.full(grid.size, k))
@@ -189,8 +189,7 @@ def _anti_aliased(x: np.ndarray, from_hz: float, to_hz: float) -> np.ndarray:
     """
     if from_hz < 2.5 * to_hz or x.size <= _FILTER_PAD:
         return x
-    sos = butter(4, 0.4 * to_hz, fs=from_hz, output="sos")
-    return np.asarray(sosfiltfilt(sos, x, padlen=min(_FILTER_PAD, x.size - 1)))
+    return butterworth_zero_phase(x, 0.4 * to_hz, from_hz, order=4, pad=min(_FILTER_PAD, x.size - 1))
 
 
 def smoothed_as_derivative(series: FlightSeries, x: np.ndarray) -> np.ndarray:

@@ -15,9 +15,8 @@ from functools import cache, cached_property
 from typing import Literal
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
-from scipy.signal import lfilter
 
+from sysid.discrepancy._filters import moving_mean, one_pole
 from sysid.discrepancy.baseline import BaselineModel
 from sysid.discrepancy.result import Finding, FittedParameter
 from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries
@@ -328,7 +327,7 @@ def averaged(series: FlightSeries, x: np.ndarray, width_s: float) -> np.ndarray:
     width = max(1, int(round(width_s * series.rate_hz)))
     out = np.empty_like(x)
     for rows in series.spans():
-        out[rows] = uniform_filter1d(x[rows], width, mode="nearest")
+        out[rows] = moving_mean(x[rows], width)
     return out
 
 
@@ -348,5 +347,5 @@ def first_order(series: FlightSeries, x: np.ndarray, time_constant: float) -> np
     out = np.empty_like(x)
     for rows in series.spans():
         piece = x[rows]
-        out[rows] = lfilter([1.0 - a], [1.0, -a], piece - piece[0]) + piece[0]
+        out[rows] = one_pole(a, (1.0 - a) * (piece - piece[0])) + piece[0]
     return out
