@@ -26,7 +26,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
+from numpy.lib.stride_tricks import as_strided
 
 from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries
 
@@ -269,8 +269,12 @@ def _lagged(spans: list[slice], x: np.ndarray, lags: np.ndarray) -> np.ndarray:
     for rows in spans:
         piece = x[rows]
         padded = np.concatenate([np.full(longest, piece[0]), piece])
-        if even:
-            out[rows] = sliding_window_view(padded, longest + 1)[:, longest::-step]  # row t: x(t), x(t - s) .. x(t - L)
+        if even:  # row t: x(t), x(t - s) .. x(t - L): a view walking back from each sample (a third cheaper to make
+            # than numpy's checked sliding_window_view, 8 000 times a search)
+            stride = padded.strides[0]
+            out[rows] = as_strided(
+                padded[longest:], shape=(piece.size, lags.size), strides=(stride, -step * stride), writeable=False
+            )
             continue
         for j, lag in enumerate(lags.tolist()):  # a column at a time: slices, no gather of a (n, n_lags) window
             out[rows, j] = padded[longest - lag : longest - lag + piece.size]

@@ -20,7 +20,6 @@ from sysid.discrepancy.baseline import BaselineModel, design_width
 from sysid.discrepancy.catalogue import EFFECTS
 from sysid.discrepancy.corrected import UNEXPLAINED, CorrectedModel, ModelTerm
 from sysid.discrepancy.series import COMMANDS, OUTPUTS
-from sysid.fit.model_file import model_from_dict
 from sysid.model.statespace import DelayedStateSpace
 
 __all__ = [
@@ -57,6 +56,8 @@ def read_simulation_model(path: str | Path) -> SimulationModel:
     doc = read_json_object(path, ModelError, "model")
     if doc.get("schema") == SCHEMA:
         return corrected_from_dict(doc, source=str(path))
+    from sysid.fit.model_file import model_from_dict  # the fit's package: 0.5 s to import, only for its files
+
     return model_from_dict(doc, source=str(path)).linear_model(include_wind=False)
 
 
