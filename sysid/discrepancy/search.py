@@ -198,19 +198,13 @@ def discover(
             trial = joined(candidate, linear) if together else candidate
             score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
             # a companion output (a rotor drag's hub moment) stays only where it removes a share of its own
-            # residual: columns that fit nothing would cost the term its score and criterion (each output's
-            # columns are fitted on their own, so the others' shares do not change once these are dropped)
-            kept_outputs = tuple(
-                o
-                for o in candidate.outputs
-                if not shown_on
-                or o in shown_on
-                or held_out_share(y, predicted, against, scale, (o,)) > options.min_share
-            )
-            if kept_outputs != candidate.outputs:
-                candidate = narrowed(candidate, kept_outputs)
-                trial = joined(candidate, linear) if together else candidate
-                score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
+            # residual: columns that fit nothing would cost the term its score and criterion
+            if shown_on:
+                acting = _acting(candidate, y, predicted, against, scale, options.min_share, shown_on)
+                if acting != candidate.outputs:
+                    candidate = narrowed(candidate, acting)
+                    trial = joined(candidate, linear) if together else candidate
+                    score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
             # once a term is kept, the residual where it acts holds its shape's error, which another term acting
             # there fits as well (a mass step at the low hover beside a ground effect): later terms must also
             # remove a share of the whole flight's residual
@@ -232,6 +226,14 @@ def discover(
                     )
                 )
             if score > threshold and local > options.min_improvement and shown:
+                # a term that passes on all its outputs is a finding on those where it acts only (worn roll and
+                # pitch motors: not on the yaw and the thrust, whose residuals it leaves at the floor); judged on
+                # all of them first, so that an idle term is not made to pass on its one best output (the null)
+                acting = _acting(candidate, y, predicted, against, scale, options.min_share, shown_on)
+                if acting and acting != candidate.outputs:
+                    candidate = narrowed(candidate, acting)
+                    trial = joined(candidate, linear) if together else candidate
+                    score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
                 fit = fit_term(trial, y, base, adds, scale)
                 if candidate.kind == "transform" and fit.value >= candidate.grid[-1]:
                     continue  # at the end of the range searched: a bound, not a measured delay or lag
@@ -647,6 +649,29 @@ def _sustained(rows: np.ndarray, clock: np.ndarray) -> bool:
     breaks = np.flatnonzero(np.diff(times) > 1.0) + 1  # episodes: support samples less than 1 s apart
     episodes = [(e[0], e[-1]) for e in np.split(times, breaks) if e[-1] - e[0] + step >= _EPISODE_S]
     return len(episodes) > 1 and episodes[-1][0] - episodes[0][1] >= _APART_S
+
+
+def _acting(
+    candidate: Candidate,
+    y: Mapping[str, np.ndarray],
+    predicted: Mapping[str, np.ndarray],
+    current: Mapping[str, np.ndarray],
+    scale: Mapping[str, float],
+    min_share: float,
+    always: tuple[str, ...],
+) -> tuple[str, ...]:
+    """The outputs of a linear `candidate` where it removes more than `min_share` of its own held-out residual.
+
+    Each output's columns are fitted on their own, so the others' shares do not change once one is dropped.
+    A transform (a delay, a lag) re-predicts every output: all are kept. So are the outputs in `always`.
+    """
+    if candidate.kind != "linear":
+        return candidate.outputs
+    return tuple(
+        o
+        for o in candidate.outputs
+        if o in always or held_out_share(y, predicted, current, scale, (o,)) > min_share
+    )
 
 
 def _local_score(
