@@ -204,7 +204,9 @@ def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> Baseli
     use = slice(None) if rows is None else rows
     squared = tuple(c for c in COMMANDS if _curvature_share(series[c][use]) >= _MIN_CURVATURE_SHARE)
     design = _design(series, lags, states, squared)[use]  # taken once, not per output
-    coefficients = {o: np.linalg.lstsq(design, series[o][use], rcond=None)[0] for o in OUTPUTS}
+    # one factorisation of the design for every output (a least-squares fit per output took six)
+    solved = np.linalg.lstsq(design, np.column_stack([series[o][use] for o in OUTPUTS]), rcond=None)[0]
+    coefficients = {o: solved[:, j] for j, o in enumerate(OUTPUTS)}
     return BaselineModel(coefficients=coefficients, lags=lags, states=states, rate_hz=series.rate_hz, squared=squared)
 
 
