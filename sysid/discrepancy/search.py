@@ -668,9 +668,7 @@ def _acting(
     if candidate.kind != "linear":
         return candidate.outputs
     return tuple(
-        o
-        for o in candidate.outputs
-        if o in always or held_out_share(y, predicted, current, scale, (o,)) > min_share
+        o for o in candidate.outputs if o in always or held_out_share(y, predicted, current, scale, (o,)) > min_share
     )
 
 
