@@ -69,3 +69,15 @@ def test_the_discrepancy_search_filters_a_flight_without_scipy_signal_ndimage_or
         "_band({'p_dot': averaged(series, lagged, 0.5)}, series.rate_hz)"
     )
     assert not {"scipy.signal", "scipy.ndimage", "scipy.stats", "scipy.interpolate"} & set(loaded["scipy"])
+
+
+def test_the_model_of_the_unknown_runs_without_scikit_learn() -> None:
+    """Its matching pursuit is the port in sysid.discrepancy._omp: scikit-learn's import (1.3 s and more) stays out."""
+    probe = (
+        "import sys, numpy as np\nfrom sysid.discrepancy._omp import omp_gram_path\n"
+        "x = np.random.default_rng(0).normal(size=(50, 6))\n"
+        "omp_gram_path(x.T @ x, x.T @ x[:, 0], n_nonzero_coefs=3)\n"
+        "import sysid.discrepancy\nprint('sklearn' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert done.stdout.strip().splitlines()[-1] == "False"

@@ -2,15 +2,14 @@
 
 ``scipy.signal`` and ``scipy.ndimage`` take 0.8-0.9 s to import on top of what the search imports
 anyway (scipy.signal pulls in scipy.stats, scipy.interpolate and array-API decorators that parse
-docstrings), more than the filtering itself takes on a pair of flights. The five calls the search
+docstrings), more than the filtering itself takes on a pair of flights. Four of the calls the search
 makes are written out here, each equal to SciPy's to rounding (``tests/sysid/discrepancy/test_filters.py``
-compares them):
+compares them); the fifth, ``uniform_filter1d``, is ingest's :func:`flightlogs._moving.moving_mean`:
 
 =====================================  ================================================================
 here                                   SciPy
 =====================================  ================================================================
 :func:`one_pole`                       ``lfilter([b], [1, -pole], x)`` (and complex poles, any state)
-:func:`moving_mean`                    ``ndimage.uniform_filter1d(x, width, mode="nearest")``
 :func:`savgol_slope`                   ``savgol_filter(x, window, polyorder, deriv=1, delta=dt)``
 :func:`welch_density`                  ``welch(x, fs=rate_hz, nperseg=n, detrend=False)``
 :func:`butterworth_zero_phase`         ``sosfiltfilt(butter(order, cutoff_hz, fs=rate_hz, output="sos"), x, padlen=pad)``
@@ -117,36 +116,6 @@ def _scan(ratio: complex | float, c: np.ndarray) -> np.ndarray:
         s[shift:] = s[shift:] + factor * s[:-shift]  # the right side is read whole before it is written
         factor, shift = factor * factor, 2 * shift
     return s
-
-
-def moving_mean(x: np.ndarray, width: int) -> np.ndarray:
-    """Mean over `width` samples around each one, the ends held: ``uniform_filter1d(x, width, mode="nearest")``.
-
-    Parameters
-    ----------
-    x : ndarray, shape (n,)
-        Signal, any unit.
-    width : int
-        Window, samples (>= 1); an even window reaches one sample further back than forward, as SciPy's.
-
-    Returns
-    -------
-    ndarray, shape (n,)
-
-    Notes
-    -----
-    A difference of cumulative sums of ``x - mean(x)``: its rounding is a few units of the last place
-    of the signal's spread times the number of samples, not of its offset.
-    """
-    x = np.asarray(x, dtype=np.float64)
-    if width < 1:
-        raise ValueError(f"{width=} must be ≥ 1")
-    if x.size == 0:
-        return x.copy()
-    level = float(np.mean(x))
-    padded = np.pad(x - level, (width // 2, (width - 1) // 2), mode="edge")
-    sums = np.concatenate(([0.0], np.cumsum(padded)))
-    return cast(np.ndarray, (sums[width:] - sums[:-width]) / width + level)
 
 
 def savgol_slope(x: np.ndarray, window: int, polyorder: int, interval_s: float) -> np.ndarray:

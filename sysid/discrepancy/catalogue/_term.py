@@ -16,7 +16,8 @@ from typing import Literal
 
 import numpy as np
 
-from sysid.discrepancy._filters import moving_mean, one_pole
+from flightlogs._moving import moving_mean
+from sysid.discrepancy._filters import one_pole
 from sysid.discrepancy.baseline import BaselineModel
 from sysid.discrepancy.result import Finding, FittedParameter
 from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries
