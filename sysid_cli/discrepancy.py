@@ -130,7 +130,8 @@ def discrepancy(
     if not quiet:
         click.echo(f"verdict: {result.verdict}")
         for finding in result.findings:
-            click.echo(f"  {finding.effect:14s} {finding.improvement_percent:5.1f} % held-out  {finding.evidence}")
+            cut = f"{finding.improvement_percent:5.1f} % held-out" if finding.modelled else "located only    "
+            click.echo(f"  {finding.effect:14s} {cut}  {finding.evidence}")
         if not result.findings:
             click.echo(f"  {result.summary}")
         for written in (out, report, model_out):

@@ -18,6 +18,13 @@ at 0.45 ± 0.002 through a flight without height changes). Its coefficients woul
 cancels within SIM's range and extrapolates outside it: a REAL vehicle that needs 3 % more thrust (a
 sagging battery, a heavier one) would be predicted a roll and pitch moment from the thrust alone,
 which was first read as a CG offset (found on another generator's flights).
+
+A square is also left out when the flight the model is read on takes that input outside SIM's range
+for more than a tenth of its samples (a REAL vehicle with worn motors hovers at 0.50 where SIM flew
+0.44-0.46). The square's lag coefficients, each informed by SIM's narrow range, then change the
+model's thrust dynamics, not only its level: on one SIM flight of four (another generator's), the
+worn motors' 30 % thrust loss left az at 2.8 times its floor after the trim, and a thrust ceiling
+was fitted to what the square extrapolated.
 """
 
 from __future__ import annotations
@@ -37,6 +44,7 @@ _STATES = ("u", "v", "w", "p", "q", "r")
 _AIR = {"u": ("u_air", "wind_lon"), "v": ("v_air", "wind_lat")}  # where SIM flew in a logged wind: u, v on the air
 _N_SQUARE_LAGS = 4  # the inputs' squares (a rotor's thrust grows with its speed squared) at this many lags
 _MIN_CURVATURE_SHARE = 0.01  # std of (x - mean)² over std of x²: below it, SIM cannot inform x²'s coefficient
+_MAX_OUTSIDE_SHARE = 0.10  # share of the flight read on outside SIM's range of an input: above it, no square
 
 #: Mixer inputs to drive a prediction with (each shape (n,)); None: as logged.
 Commands = Mapping[str, np.ndarray] | None
@@ -84,13 +92,24 @@ class BaselineModel:
         commands : Mapping[str, ndarray], optional
             Mixer inputs to use instead of the logged ones (delayed, lagged).
         """
-        return self.predictor(series)(commands)
+        weights, spans = self._weights(), series.spans()
+        inputs = commands if commands is not None else {c: series[c] for c in COMMANDS}
+        total = self._steady(series)
+        for k, name in enumerate(COMMANDS):  # lagged inputs times all outputs' weights at once: no whole design
+            total += _lagged(spans, np.asarray(inputs[name]), self.lags) @ weights[self._linear_rows(k)]
+        self._add_squares(total, spans, inputs, weights)
+        return {o: total[:, j] for j, o in enumerate(self.coefficients)}
 
-    def predictor(self, series: FlightSeries) -> Callable[[Commands], dict[str, np.ndarray]]:
-        """:meth:`predict` on `series` as a function of the mixer inputs, the states' part computed once.
+    def changed(self, series: FlightSeries) -> Callable[[Callable[[np.ndarray], np.ndarray]], dict[str, np.ndarray]]:
+        """:meth:`predict` on `series` with every mixer input passed through one `change`, as a function of it.
 
-        A transform re-predicts one flight from its inputs changed many times (60 delays): the part of
-        the prediction the states and the constant make is the same each time.
+        The change must be linear and time-invariant within each piece of the flight, holding a piece's
+        first value before it (:func:`~sysid.discrepancy.catalogue._term.delayed`, :func:`~.first_order`): it then
+        commutes with the model's impulse responses, whose lags hold the same first value. The part of
+        each output the inputs make is computed once and changed (six columns), not each input before its
+        lags (four inputs, 16 lags each), for each of a delay's or lag's 60 values; the squares of the
+        changed inputs are lagged as :meth:`predict` lags them. Equal to ``predict(series, {c: change(x_c)})``
+        to rounding.
 
         Parameters
         ----------
@@ -100,27 +119,45 @@ class BaselineModel:
         Returns
         -------
         callable
-            ``predict(commands)``: as :meth:`predict` with these `commands` (None: as logged).
+            ``predict(change)``: each output, shape (n,), with ``change(x)`` (shape (n,) to (n,)) applied to
+            every mixer input.
         """
-        square_lags = _square_lags(self.lags)
-        n_lags, n_squares, n_in = self.lags.size, square_lags.size, len(COMMANDS)
-        weights = np.column_stack(list(self.coefficients.values()))  # (n_regressors, n_outputs)
-        fixed = np.column_stack([_state(series, s) for s in self.states] + [np.ones(series.n)])
-        steady = fixed @ weights[n_in * n_lags + len(self.squared) * n_squares :]
-        spans = series.spans()
+        weights, spans, steady = self._weights(), series.spans(), self._steady(series)
+        made = np.zeros_like(steady)  # the part of each output the inputs make (their squares apart)
+        for k, name in enumerate(COMMANDS):
+            made += _lagged(spans, np.asarray(series[name]), self.lags) @ weights[self._linear_rows(k)]
+        columns = [np.ascontiguousarray(made[:, j]) for j in range(made.shape[1])]
 
-        def predict(commands: Commands = None) -> dict[str, np.ndarray]:
-            inputs = commands if commands is not None else {c: series[c] for c in COMMANDS}
-            total = steady.copy()
-            for k, name in enumerate(COMMANDS):  # lagged inputs times all outputs' weights at once: no whole design
-                total += _lagged(spans, np.asarray(inputs[name]), self.lags) @ weights[k * n_lags : (k + 1) * n_lags]
-            for k, name in enumerate(self.squared):
-                first = n_in * n_lags + k * n_squares
-                squares = _lagged(spans, np.asarray(inputs[name]) ** 2, square_lags)
-                total += squares @ weights[first : first + n_squares]
+        def predict(change: Callable[[np.ndarray], np.ndarray]) -> dict[str, np.ndarray]:
+            total = steady + np.column_stack([change(column) for column in columns])
+            self._add_squares(total, spans, {c: change(np.asarray(series[c])) for c in self.squared}, weights)
             return {o: total[:, j] for j, o in enumerate(self.coefficients)}
 
         return predict
+
+    def _weights(self) -> np.ndarray:
+        """Every output's coefficients as columns, shape (n_regressors, n_outputs)."""
+        return np.column_stack(list(self.coefficients.values()))
+
+    def _linear_rows(self, k: int) -> slice:
+        """The rows of mixer input `k`'s lags in the coefficients."""
+        return slice(k * self.lags.size, (k + 1) * self.lags.size)
+
+    def _steady(self, series: FlightSeries) -> np.ndarray:
+        """The part of each output the states and the constant make on `series`, shape (n, n_outputs)."""
+        first = len(COMMANDS) * self.lags.size + len(self.squared) * _square_lags(self.lags).size
+        fixed = np.column_stack([_state(series, s) for s in self.states] + [np.ones(series.n)])
+        return np.asarray(fixed @ self._weights()[first:])
+
+    def _add_squares(
+        self, total: np.ndarray, spans: list[slice], inputs: Mapping[str, np.ndarray], weights: np.ndarray
+    ) -> None:
+        """Add to `total` (shape (n, n_outputs)) the part of each output the squared `inputs` (each (n,)) make."""
+        square_lags = _square_lags(self.lags)
+        for k, name in enumerate(self.squared):
+            first = len(COMMANDS) * self.lags.size + k * square_lags.size
+            squares = _lagged(spans, np.asarray(inputs[name]) ** 2, square_lags)
+            total += squares @ weights[first : first + square_lags.size]
 
     def recentred(self, thrust_shift: float) -> BaselineModel:
         """The model with the thrust command read `thrust_shift` lower by every output but az.
@@ -185,7 +222,9 @@ class BaselineModel:
         return {o: total[:, j] for j, o in enumerate(self.coefficients)}
 
 
-def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> BaselineModel:
+def fit_baseline(
+    series: FlightSeries, rows: np.ndarray | None = None, *, read_on: FlightSeries | None = None
+) -> BaselineModel:
     """Least-squares fit of every output on samples `rows` (default all).
 
     Parameters
@@ -194,6 +233,8 @@ def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> Baseli
         The simulation's flight.
     rows : ndarray of int, optional
         Samples to fit on (the others are held out).
+    read_on : FlightSeries, optional
+        The flight the model will predict (REAL): an input it takes outside SIM's range has no square.
 
     Returns
     -------
@@ -202,7 +243,12 @@ def fit_baseline(series: FlightSeries, rows: np.ndarray | None = None) -> Baseli
     lags = np.arange(int(round(_LAG_S * series.rate_hz)) + 1)
     states = tuple(_AIR[s][0] if series.windy and s in _AIR else s for s in _STATES if s in series)
     use = slice(None) if rows is None else rows
-    squared = tuple(c for c in COMMANDS if _curvature_share(series[c][use]) >= _MIN_CURVATURE_SHARE)
+    squared = tuple(
+        c
+        for c in COMMANDS
+        if _curvature_share(series[c][use]) >= _MIN_CURVATURE_SHARE
+        and (read_on is None or _outside_share(read_on[c], series[c][use]) <= _MAX_OUTSIDE_SHARE)
+    )
     design = _design(series, lags, states, squared)[use]  # taken once, not per output
     # one factorisation of the design for every output (a least-squares fit per output took six)
     solved = np.linalg.lstsq(design, np.column_stack([series[o][use] for o in OUTPUTS]), rcond=None)[0]
@@ -222,6 +268,17 @@ def _curvature_share(x: np.ndarray) -> float:
     """
     spread = float(np.std(x**2))
     return float(np.std((x - x.mean()) ** 2)) / spread if spread > 0 else 0.0
+
+
+def _outside_share(x: np.ndarray, fitted: np.ndarray) -> float:
+    """The share of `x`'s samples outside the range of `fitted` (0..1).
+
+    Examples
+    --------
+    >>> _outside_share(np.array([0.49, 0.50, 0.51, 0.45]), np.array([0.44, 0.46]))
+    0.75
+    """
+    return float(np.mean((x < np.min(fitted)) | (x > np.max(fitted))))
 
 
 def _design(series: FlightSeries, lags: np.ndarray, states: tuple[str, ...], squared: tuple[str, ...]) -> np.ndarray:

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-import numpy as np
-
 from sysid.discrepancy.catalogue import EFFECTS, Derivation, Term, term_of
 from sysid.discrepancy.result import Finding, FittedParameter
 from sysid.discrepancy.selection import TermFit
@@ -47,18 +45,9 @@ def parameters_of(fit: TermFit, term: Term, derivation: Derivation = Derivation(
                 name=candidate.grid_parameter, value=fit.value, uncertainty=fit.value_uncertainty, unit=unit
             )
         )
-    keys = iter(candidate.coefficients)
-    for o in candidate.outputs:
-        if o not in fit.coefficients:
-            continue
-        sigma = np.sqrt(np.maximum(np.diag(fit.covariance[o]), 0.0))
-        for value, spread in zip(fit.coefficients[o], sigma):
-            coefficient = term.coefficient(next(keys))
-            out.append(
-                FittedParameter(
-                    name=coefficient.name, value=float(value), uncertainty=float(spread), unit=coefficient.unit
-                )
-            )
+    for key, value, spread in fit.coefficient_values():
+        coefficient = term.coefficient(key)
+        out.append(FittedParameter(name=coefficient.name, value=value, uncertainty=spread, unit=coefficient.unit))
     return tuple(term.derive(out, derivation))
 
 
@@ -73,7 +62,11 @@ def describe_finding(finding: Finding, term: Term) -> str:
         Its catalogue entry.
     """
     outputs = ", ".join(finding.outputs)
-    gain = f"modelling it cuts the {outputs} residual by {finding.improvement_percent:.0f} % on held-out data"
+    gain = (
+        f"modelling it cuts the {outputs} residual by {finding.improvement_percent:.0f} % on held-out data"
+        if finding.modelled
+        else "it is located, not modelled: no held-out improvement is claimed"
+    )
     return f"{term.what(finding)}; {gain}." + _ambiguity(finding, term)
 
 

@@ -160,6 +160,12 @@ class Finding:
     alternatives: tuple[Alternative, ...] = ()
     traces: FindingTraces | None = field(default=None, repr=False, compare=False)
 
+    @property
+    def modelled(self) -> bool:
+        """Whether it is modelled (has fitted parameters), not only located: a residual no model of the flight
+        explains (a load swinging under the vehicle) is located on its outputs and removes nothing."""
+        return bool(self.parameters)
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class DiscrepancyResult:
@@ -222,6 +228,7 @@ class DiscrepancyResult:
                     "rmse_before": f.rmse_before,
                     "rmse_after": f.rmse_after,
                     "improvement_percent": f.improvement_percent,
+                    "modelled": f.modelled,
                     "evidence": f.evidence,
                     "alternatives": [
                         {"effect": a.effect, "explained_variance": a.explained_variance} for a in f.alternatives

@@ -160,7 +160,7 @@ def discover(
     _report(progress, "simulation model", 1, 3)
     # the moments and side forces read the thrust command about the real vehicle's own hover (see recentred)
     shift = float(np.mean(flown["delta_thr"]) - np.mean(simulated["delta_thr"]))
-    baseline = fit_baseline(simulated).recentred(shift)
+    baseline = fit_baseline(simulated, read_on=flown).recentred(shift)
     y = {o: flown[o] for o in OUTPUTS}
     base = baseline.predict(flown)
     additions = {o: np.zeros(flown.n) for o in OUTPUTS}
@@ -235,6 +235,9 @@ def discover(
                     trial = joined(candidate, linear) if together else candidate
                     score, predicted = cross_validated(trial, y, base, adds, scale, reference, candidate.outputs)
                 fit = fit_term(trial, y, base, adds, scale)
+                own = split_joined(fit, candidate, linear)[0] if together else fit
+                if term_of(candidate.effect).against_physics(own.coefficient_values()):
+                    continue  # its shape fitted the other way round is another effect's (the thrust's curvature)
                 if candidate.kind == "transform" and fit.value >= candidate.grid[-1]:
                     continue  # at the end of the range searched: a bound, not a measured delay or lag
                 prediction = fit.prediction(base, adds)

@@ -64,6 +64,17 @@ class TermFit:
     covariance: Mapping[str, np.ndarray]
     value_uncertainty: float
 
+    def coefficient_values(self) -> list[tuple[str, float, float]]:
+        """Each coefficient as (key, value, standard deviation), in the candidate's column order over its outputs."""
+        keys = iter(self.candidate.coefficients)
+        out = []
+        for o in self.candidate.outputs:
+            if o not in self.coefficients:
+                continue
+            sigma = np.sqrt(np.maximum(np.diag(self.covariance[o]), 0.0))
+            out += [(next(keys), float(v), float(e)) for v, e in zip(self.coefficients[o], sigma)]
+        return out
+
     def prediction(self, base: Mapping[str, np.ndarray], additions: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """The model's prediction with this term: `base` (the simulation model's) plus `additions` plus its own."""
         built = self.candidate.build(self.value)

@@ -29,6 +29,7 @@ __all__ = [
     "FlightContext",
     "Regressors",
     "Prediction",
+    "SIGN_SIGMAS",
     "THRUST_GAIN",
     "Term",
     "averaged",
@@ -90,11 +91,16 @@ class Coefficient:
         Reported name (``drag_x``, ``thrust_effectiveness_change``).
     unit : str
         SI unit (``1`` for a ratio).
+    sign : {0, 1, -1}, optional
+        The sign the physics gives it (0: either). A fit that puts it on the other side, beyond
+        :data:`SIGN_SIGMAS` of its uncertainty, is another effect's shape (a thrust "lost" above a
+        ceiling that grows instead is the thrust's curvature, no saturation).
     """
 
     key: str
     name: str
     unit: str
+    sign: int = 0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -170,7 +176,8 @@ class Term:
         The flight that shows it apart from the terms it may be confused with (for an ambiguous finding).
     shown_on : tuple of str
         Outputs on which the term must by itself remove a held-out share above its threshold (empty: any):
-        a rotor's drag is a force first, and its hub moment alone (a flapping rotor) is not one.
+        a rotor's drag is a force first, and its hub moment alone (a flapping rotor) is not one; a thrust
+        ceiling is thrust that stops growing, and a roll moment lost above a command alone is not one.
     """
 
     effect: str
@@ -189,6 +196,19 @@ class Term:
         """The coefficient of column `key` (a key the term does not list is reported as it is, unit 1)."""
         return next((c for c in self.coefficients if c.key == key), Coefficient(key=key, name=key, unit="1"))
 
+    def against_physics(self, values: Sequence[tuple[str, float, float]]) -> bool:
+        """Whether a fitted coefficient is on the side of zero its physics rules out.
+
+        Parameters
+        ----------
+        values : sequence of (str, float, float)
+            Its coefficients as (key, value, standard deviation) (:meth:`TermFit.coefficient_values`).
+        """
+        return any(self.coefficient(k).sign * v < -SIGN_SIGMAS * e for k, v, e in values)
+
+
+#: Standard deviations beyond which a coefficient on the wrong side of zero rules its term out.
+SIGN_SIGMAS = 2.0
 
 #: The thrust gain beside a term's shape on az (the real thrust per input may differ by a constant factor).
 THRUST_GAIN = Coefficient(key="gain", name="thrust_gain_change", unit="1")
@@ -214,14 +234,16 @@ def input_transform(
     grid_parameter : str
         Its name and unit (``delay_s``).
     change : callable
-        ``change(series, command, value)``: one mixer input changed (delayed, lagged), shape (n,).
+        ``change(series, command, value)``: one mixer input changed (delayed, lagged), shape (n,); linear and
+        time-invariant within each piece, holding the piece's first value before it (see
+        :meth:`~sysid.discrepancy.baseline.BaselineModel.changed`).
     """
     series = context.series
-    predict = context.baseline.predictor(series)  # the states' part once for the whole grid
+    predict = context.baseline.changed(series)  # the inputs' and states' parts once for the whole grid
 
     @cache
     def build(value: float) -> Prediction:
-        return predict({c: change(series, series[c], value) for c in COMMANDS})
+        return predict(lambda x: change(series, x, value))
 
     return Candidate(
         effect=effect, outputs=OUTPUTS, kind="transform", grid=grid, grid_parameter=grid_parameter, build=build

@@ -75,9 +75,10 @@ TERM = Term(
     make=_make,
     what=_what,
     coefficients=(
-        Coefficient(key="share", name="saturated_share", unit="1"),
-        Coefficient(key="roll_share", name="roll_moment_change_above_ceiling", unit="1"),
-        Coefficient(key="pitch_share", name="pitch_moment_change_above_ceiling", unit="1"),
+        Coefficient(key="share", name="saturated_share", unit="1", sign=1),
+        Coefficient(key="roll_share", name="roll_moment_change_above_ceiling", unit="1", sign=-1),
+        Coefficient(key="pitch_share", name="pitch_moment_change_above_ceiling", unit="1", sign=-1),
     ),
     separated_by="thrust steps approaching full throttle",
+    shown_on=("az",),  # motors at a ceiling stop adding thrust first: lost moments alone are no ceiling
 )

@@ -91,3 +91,14 @@ def test_a_rotor_drag_narrowed_to_its_force_keeps_its_force_columns_and_names(co
         np.testing.assert_array_equal(built[o], full[o])
     moment = narrowed(whole, ("ax", "q_dot"))
     assert moment.coefficients == ("d_x_s_m", "m_u_rad_m")
+
+
+def test_a_coefficient_on_the_side_its_physics_rules_out_rules_its_term_out() -> None:
+    """A saturation's lost thrust share is positive and its lost moments negative; beyond 2 sigma the other way, no."""
+    saturation = term_of("thrust_saturation")
+    assert saturation.against_physics([("share", -0.265, 0.019)])  # more thrust above the "ceiling": curvature
+    assert not saturation.against_physics([("share", -0.03, 0.019)])  # within 2 sigma of zero: not ruled out
+    assert not saturation.against_physics([("share", 0.9, 0.05), ("roll_share", -0.5, 0.14)])
+    assert saturation.against_physics([("share", 0.9, 0.05), ("pitch_share", 0.5, 0.14)])
+    unsigned = [t for t in CATALOGUE if all(c.sign == 0 for c in t.coefficients)]
+    assert unsigned and all(not t.against_physics([("gain", -5.0, 0.01)]) for t in unsigned)

@@ -12,10 +12,12 @@ vehicle (the nulls). The rates asserted are the issue's:
 
 The thrust ceiling is left out of the rates, as in :mod:`test_open_world` (named first, not alone).
 
-Measured on 2026-11-28 (the first run on these seeds, after the code's last change): named alone 34 of
-36 (94.4 %), outside ``unexplained`` on a primary output at least 11 of 12 (its test passed), nulls ``none`` 10 of 12 (83 %). The
-misses share one SIM flight (7200) and one term (``thrust_saturation``, and the worn thrust it hides):
-open, the two rates below xfail with their figures.
+SIM 7100-7400, the seeds of the first measurement (2026-11-28: named alone 94.4 %, nulls 83 %, the
+misses all ``thrust_saturation`` on SIM 7200 and 7300), became tuning flights when those misses were
+analysed (:mod:`test_thrust_range`); the seeds below replaced them. Measured on 2026-11-29, the first
+run on them, after the code's last change: named alone 36 of 36, outside ``unexplained`` on a primary
+output 12 of 12, nulls ``none`` 12 of 12 (10.5 min on an idle core). Each test records its share and
+misses (``record_property``: ``--junitxml`` with ``-o junit_family=legacy`` shows them).
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ pytestmark = [
     pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning"),
 ]
 
-SIM_SEEDS = (7100, 7200, 7300, 7400)  # held out: never read before these rates were first measured
+SIM_SEEDS = (8100, 8200, 8300, 8400)  # held out: never read before these rates were first measured
 NULLS_PER_SIM = 3
 
 #: Per case name, its outcome on each SIM seed.
@@ -73,33 +75,32 @@ def _tally(
     return 1.0 - len(wrong) / total, wrong
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="open (issue 30): measured 94.4 % on 2026-11-28 (34 of 36): the worn motors' 30 % thrust loss read "
-    "unexplained (SIM 7200) and thrust_saturation (SIM 7300), the same with the session's starting code",
-)
-def test_catalogue_effects_are_named_alone_in_95_percent(outcomes: Outcomes) -> None:
+def test_catalogue_effects_are_named_alone_in_95_percent(
+    outcomes: Outcomes, record_property: Callable[[str, object], None]
+) -> None:
     share, wrong = _tally(outcomes, list(NAMED), lambda name, r: [f.effect for f in r.findings] == [NAMED[name][0]])
+    record_property("named_alone", f"{share:.4f} {wrong}")
     assert share >= 0.95, (share, wrong)
 
 
-def test_effects_outside_the_catalogue_are_unexplained_in_90_percent(outcomes: Outcomes) -> None:
+def test_effects_outside_the_catalogue_are_unexplained_in_90_percent(
+    outcomes: Outcomes, record_property: Callable[[str, object], None]
+) -> None:
     def right(name: str, result: DiscrepancyResult) -> bool:
         effects = [f.effect for f in result.findings]
         return effects == ["unexplained"] and bool(set(result.findings[0].outputs) & set(OUTSIDE[name].primary_outputs))
 
     share, wrong = _tally(outcomes, list(OUTSIDE), right)
+    record_property("outside_unexplained", f"{share:.4f} {wrong}")
     assert share >= 0.90, (share, wrong)
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="open (issue 30): measured 83 % on 2026-11-28 (10 of 12): two nulls against SIM 7200 named "
-    "thrust_saturation (2.7 and 3.0 % held-out share, threshold 1 %), the same with the session's starting code",
-)
-def test_nulls_under_the_nuisances_find_nothing_in_95_percent(outcomes: Outcomes) -> None:
+def test_nulls_under_the_nuisances_find_nothing_in_95_percent(
+    outcomes: Outcomes, record_property: Callable[[str, object], None]
+) -> None:
     wrong = [f"null {k}: {[f.effect for f in r.findings]}" for k, r in enumerate(outcomes["none"]) if r.findings]
     share = 1.0 - len(wrong) / len(outcomes["none"])
+    record_property("nulls_none", f"{share:.4f} {wrong}")
     assert share >= 0.95, (share, wrong)
 
 
