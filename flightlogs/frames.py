@@ -6,7 +6,7 @@ import numpy as np
 
 _CHUNK = 1 << 16  # samples rotated at a time
 
-__all__ = ["quaternion_to_euler", "earth_to_body", "air_velocity_body", "wind_to_body_axes"]
+__all__ = ["quaternion_to_euler", "earth_to_body", "euler_rates_to_body", "air_velocity_body", "wind_to_body_axes"]
 
 
 def quaternion_to_euler(quaternion: np.ndarray) -> np.ndarray:
@@ -87,6 +87,36 @@ def earth_to_body(vectors_ned: np.ndarray, phi: np.ndarray, theta: np.ndarray, p
         matrices = _earth_to_body_matrices(*(a[part] for a in angles))
         np.einsum("nij,nj->ni", matrices, vectors_ned[part], out=out[part])
     return out
+
+
+def euler_rates_to_body(
+    phi: np.ndarray, theta: np.ndarray, phi_dot: np.ndarray, theta_dot: np.ndarray, psi_dot: np.ndarray
+) -> np.ndarray:
+    """Body rates ``p q r`` from 3-2-1 Euler angles and their rates of change (the attitude's kinematics).
+
+    Parameters
+    ----------
+    phi, theta : ndarray, shape (n_samples,)
+        Roll and pitch, rad.
+    phi_dot, theta_dot, psi_dot : ndarray, shape (n_samples,)
+        Rates of change of roll, pitch and yaw, rad/s.
+
+    Returns
+    -------
+    ndarray, shape (n_samples, 3)
+        ``p q r``, rad/s.
+
+    Examples
+    --------
+    >>> zero = np.zeros(1)
+    >>> euler_rates_to_body(np.array([np.pi / 2]), zero, zero, zero, np.ones(1)).round(12)
+    array([[0., 1., 0.]])
+    """
+    cf, sf = np.cos(phi), np.sin(phi)
+    ct, st = np.cos(theta), np.sin(theta)
+    return np.column_stack(
+        [phi_dot - psi_dot * st, theta_dot * cf + psi_dot * sf * ct, -theta_dot * sf + psi_dot * cf * ct]
+    )
 
 
 def air_velocity_body(

@@ -69,7 +69,7 @@ def discrepancy(
     DataFlash; or one model from `sysid fit -o` or `--model-out`, evaluated along the real flights) with real flights of the same vehicle: locate where they differ, name the physics the
     simulation leaves out from a catalogue of terms (ground_effect, rotor_drag, wind, time_delay, actuator_lag,
     battery_sag, mass_change, cg_offset, control_effectiveness, parasitic_drag, inflow, translational_lift,
-    thrust_saturation), fit it with its uncertainty and show the residual it removes on held-out data. What no
+    thrust_saturation, sensor_scale), fit it with its uncertainty and show the residual it removes on held-out data. What no
     term explains is "unexplained": located, and modelled by a sparse combination of the flight's own states and
     inputs; terms that explain a residual equally are listed as alternatives. "none" is an answer: nothing
     beyond what noise gives on held-out simulated flight."""

@@ -1,5 +1,10 @@
 """Discrepancy discovery: where a real flight departs from its simulation, which physics explains it, by how much.
 
+0. **Sensors.** A sensor's error that no model of the vehicle can tell from the physics it measures (a
+   gyro's scale: a roll moment per command as strong) is measured first, against the kinematics of the
+   flights' other signals (a term's ``calibrate``: :mod:`.catalogue.sensor_scale`); REAL is corrected
+   where it is off, and the finding's cut is the residual of its outputs against the simulation's model
+   as logged and as corrected.
 1. **Baseline and noise floor.** The simulation's model (:mod:`.baseline`) is
    fitted on half of SIM's time blocks and its residual on the other half is
    each output's noise floor: what noise and model error alone leave. Every
@@ -44,7 +49,16 @@ import numpy as np
 
 from sysid.discrepancy._filters import welch_density
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
-from sysid.discrepancy.catalogue import Candidate, Derivation, FlightContext, Term, candidate_terms, term_of
+from sysid.discrepancy.catalogue import (
+    CATALOGUE,
+    Calibration,
+    Candidate,
+    Derivation,
+    FlightContext,
+    Term,
+    candidate_terms,
+    term_of,
+)
 from sysid.discrepancy.catalogue._air import air_velocity, climb_rate
 from sysid.discrepancy.corrected import UNEXPLAINED, CorrectedModel, ModelTerm
 from sysid.discrepancy.describe import describe_finding, parameters_of, summary_of
@@ -54,6 +68,7 @@ from sysid.discrepancy.result import (
     DiscrepancyResult,
     Finding,
     FindingTraces,
+    FittedParameter,
     Regime,
     Screening,
 )
@@ -156,6 +171,12 @@ def discover(
     """
     simulated, flown = _joined(sim), _joined(real)
     simulated = simulated.without([s for s in simulated.signals if s not in flown])  # a model of what both logged
+    logged, calibrations = flown, []
+    for sensor in CATALOGUE:  # a sensor's error, before any physics
+        calibration = sensor.calibrate(simulated, flown) if sensor.calibrate is not None else None
+        if calibration is not None:
+            calibrations.append((sensor, calibration))
+            flown = calibration.corrected
     scale, null = _noise_floor(simulated)
     _report(progress, "simulation model", 1, 3)
     # the moments and side forces read the thrust command about the real vehicle's own hover (see recentred)
@@ -174,6 +195,7 @@ def discover(
     held_out = combined(base, additions)  # the baseline is fitted on SIM: on REAL its prediction is held out already
     first = FlightContext(series=flown, baseline=baseline, thrust=-(base["az"] + trim))
     library = generic_library(first)
+    search = _Search(y=y, scale=scale, library=library, options=options, held_out=held_out, terms=terms)
     # a delay's or lag's re-predictions read no thrust: built once, reused by every round of the selection
     transforms = {c.effect: c for c in candidate_terms(first) if c.kind == "transform"}
     generic_null = options.null_margin * max(null.get("unexplained", 0.0), 0.0)
@@ -265,7 +287,7 @@ def discover(
             # only a residual that stays far above the floor is then unexplained (see _far_left)
             if not kept:
                 rivals = (Alternative(effect=best.candidate.effect, explained_variance=round(best.score, 4)), *rivals)
-                kept.append(_unexplained(generic, y, base, additions, scale, held_out, rivals, terms))
+                kept.append(_unexplained(search, generic, base, additions, rivals))
             break
         before = dict(held_out)
         for o in best.fit.candidate.outputs:
@@ -293,13 +315,11 @@ def discover(
     if not kept:
         current = combined(base, additions)
         generic = fit_generic(context, y, current, scale, library=library)
-        if _generic_passes(generic, y, current, scale, first_floor, options, flown["t_flight"]):
-            kept.append(_unexplained(generic, y, base, additions, scale, held_out, (), terms))
-    kept, additions = _instead_of_weak(
-        kept, y, base, additions, scale, held_out, library, context, first_floor, options, terms
-    )
-    kept = _far_left(kept, y, base, additions, scale, held_out, library, context, terms)
-    level = _thrust_level(kept, gain, thrust, y["az"] - combined(base, additions)["az"], base, additions, y, scale)
+        if _generic_passes(search, generic, current, first_floor, flown["t_flight"]):
+            kept.append(_unexplained(search, generic, base, additions))
+    kept, additions = _instead_of_weak(search, kept, base, additions, context, first_floor)
+    kept = _far_left(search, kept, base, additions, context)
+    level = _thrust_level(kept, gain, thrust, base, additions, y)
     corrected = CorrectedModel(
         baseline=baseline,
         thrust_trim=gain,
@@ -311,19 +331,23 @@ def discover(
     _report(progress, "done", 3, 3)
     gains = {id(k.fit): _thrust_gain(k.fit) for k in kept}
     findings = sorted(
-        (  # each term's thrust level: the trim and the other terms' gains (collinear: only their sum is known)
-            _finding(
-                k,
-                y,
-                flown,
-                scale,
-                terms.get(id(k.fit)) or term_of(k.fit.candidate.effect),
-                Derivation(
-                    thrust_scale=1.0 + gain + sum(gains.values()) - gains[id(k.fit)],
-                    rotor_radius_m=options.rotor_radius_m,
-                ),
-            )
-            for k in kept
+        (
+            *(_calibrated(t, c, logged, flown, baseline, scale) for t, c in calibrations),
+            # each term's thrust level: the trim and the other terms' gains (collinear: only their sum is known)
+            *(
+                _finding(
+                    k,
+                    y,
+                    flown,
+                    scale,
+                    terms.get(id(k.fit)) or term_of(k.fit.candidate.effect),
+                    Derivation(
+                        thrust_scale=1.0 + gain + sum(gains.values()) - gains[id(k.fit)],
+                        rotor_radius_m=options.rotor_radius_m,
+                    ),
+                )
+                for k in kept
+            ),
         ),
         key=lambda f: -f.improvement_percent,
     )
@@ -358,34 +382,24 @@ def _model_term(kept: _Kept) -> ModelTerm | None:
 
 
 def _generic_passes(
-    generic: GenericFit,
-    y: Mapping[str, np.ndarray],
-    current: Mapping[str, np.ndarray],
-    scale: Mapping[str, float],
-    threshold: float,
-    options: DiscrepancyOptions,
-    clock: np.ndarray,
+    search: _Search, generic: GenericFit, current: Mapping[str, np.ndarray], threshold: float, clock: np.ndarray
 ) -> bool:
     """Whether the model of the unknown passes a first term's screen: `threshold` on the whole flight, the floor
     where it acts, and a sustained support (`clock`: the flight's time, s, shape (n,))."""
     if not generic.chosen or generic.score <= threshold:
         return False
-    local = _local_score(y, generic.predicted, current, scale, generic.outputs)
-    return local > options.min_improvement and _sustained(_support(generic.predicted, current, scale), clock)
+    local = _local_score(search.y, generic.predicted, current, search.scale, generic.outputs)
+    sustained = _sustained(_support(generic.predicted, current, search.scale), clock)
+    return local > search.options.min_improvement and sustained
 
 
 def _instead_of_weak(
+    search: _Search,
     kept: list[_Kept],
-    y: Mapping[str, np.ndarray],
     base: Mapping[str, np.ndarray],
     additions: dict[str, np.ndarray],
-    scale: Mapping[str, float],
-    held_out: dict[str, np.ndarray],
-    library: list[Regressor],
     context: FlightContext,
     threshold: float,
-    options: DiscrepancyOptions,
-    terms: dict[int, Term],
 ) -> tuple[list[_Kept], dict[str, np.ndarray]]:
     """`kept` and the additions, with the model of the unknown in the place of names that are all weak.
 
@@ -401,15 +415,16 @@ def _instead_of_weak(
         return kept, additions
     without = _without(additions, [k.fit for k in kept])
     current = combined(base, without)
-    generic = fit_generic(context, y, current, scale, library=library)
-    if not _generic_passes(generic, y, current, scale, threshold, options, context.series["t_flight"]):
+    generic = fit_generic(context, search.y, current, search.scale, library=search.library)
+    if not _generic_passes(search, generic, current, threshold, context.series["t_flight"]):
         return kept, additions
     before = kept[0].before
-    if _removed(y, generic.predicted, before, scale) <= _removed(y, held_out, before, scale):
+    removed = _removed(search.y, generic.predicted, before, search.scale)
+    if removed <= _removed(search.y, search.held_out, before, search.scale):
         return kept, additions
-    held_out.update(before)  # the names' share goes back to the residual
+    search.held_out.update(before)  # the names' share goes back to the residual
     alternatives = tuple(Alternative(effect=k.fit.candidate.effect, explained_variance=round(k.score, 4)) for k in kept)
-    return [_unexplained(generic, y, base, without, scale, held_out, alternatives, terms)], without
+    return [_unexplained(search, generic, base, without, alternatives)], without
 
 
 def _removed(
@@ -423,15 +438,11 @@ def _removed(
 
 
 def _far_left(
+    search: _Search,
     kept: list[_Kept],
-    y: Mapping[str, np.ndarray],
     base: Mapping[str, np.ndarray],
     additions: Mapping[str, np.ndarray],
-    scale: Mapping[str, float],
-    held_out: dict[str, np.ndarray],
-    library: list[Regressor],
     context: FlightContext,
-    terms: dict[int, Term],
 ) -> list[_Kept]:
     """`kept`, with what stays far above the noise floor reported as ``unexplained`` and the weak names on it dropped.
 
@@ -443,7 +454,8 @@ def _far_left(
     such an output took up a sliver of it: a guess, not a finding. The rest is located as ``unexplained``
     on those outputs, with what the model of the unknown can say of it (perhaps nothing).
     """
-    floor = {o: float(np.sqrt(scale[o])) for o in OUTPUTS}
+    y, held_out = search.y, search.held_out
+    floor = {o: float(np.sqrt(search.scale[o])) for o in OUTPUTS}
     owned = {o for k in kept if k.score >= _OWNS for o in k.fit.candidate.outputs}  # a strong name's shape error
     far = tuple(o for o in OUTPUTS if o not in owned and _spread(y[o] - held_out[o]) > _FAR_LEFT * floor[o])
     if not far or any(k.fit.candidate.effect == "unexplained" for k in kept):
@@ -453,8 +465,8 @@ def _far_left(
     if weak:
         held_out.update(weak[0].before)  # the weak terms' share goes back to the residual
     current = {o: held_out[o] for o in OUTPUTS}
-    generic = fit_generic(context, y, current, scale, outputs=far, library=library)
-    kept.append(_unexplained(generic, y, base, additions, scale, held_out, (), terms, outputs=far))
+    generic = fit_generic(context, y, current, search.scale, outputs=far, library=search.library)
+    kept.append(_unexplained(search, generic, base, additions, outputs=far))
     return kept
 
 
@@ -467,11 +479,9 @@ def _thrust_level(
     kept: Sequence[_Kept],
     gain: float,
     thrust: np.ndarray,
-    residual: np.ndarray,
     base: Mapping[str, np.ndarray],
     additions: Mapping[str, np.ndarray],
     y: Mapping[str, np.ndarray],
-    scale: Mapping[str, float],
 ) -> _Kept | None:
     """The thrust per command's change as a finding (``control_effectiveness``), when the trim itself is one.
 
@@ -484,6 +494,8 @@ def _thrust_level(
     """
     if abs(gain) <= _LEVEL_CHANGE or any("az" in k.fit.candidate.outputs for k in kept):
         return None
+    after = combined(base, additions)
+    residual = y["az"] - after["az"]
     inflation = residual.size / max(effective_samples(residual), 1.0)
     sigma = float(np.sqrt(np.mean(residual**2) * inflation / max(float(np.dot(thrust, thrust)), 1e-300)))
     column = -thrust[:, None]
@@ -503,12 +515,26 @@ def _thrust_level(
         covariance={"az": np.array([[sigma**2]])},
         value_uncertainty=float("nan"),
     )
-    after = combined(base, additions)
     before = {**after, "az": np.asarray(base["az"])}
     removed = 1.0 - float(np.sum((y["az"] - after["az"]) ** 2)) / max(
         float(np.sum((y["az"] - before["az"]) ** 2)), 1e-300
     )
     return _Kept(fit, removed, before, after, (Alternative(effect="mass", explained_variance=round(removed, 4)),))
+
+
+@dataclass(frozen=True, slots=True)
+class _Search:
+    """What the steps of one search read: the real flight's outputs and noise floors, the model of the unknown's
+    library and the thresholds; and what they write: the held-out prediction with every kept term (`held_out`,
+    updated in place) and the model of the unknown's term per kept fit (`terms`, by ``id`` of the fit).
+    """
+
+    y: Mapping[str, np.ndarray]
+    scale: Mapping[str, float]
+    library: list[Regressor]
+    options: DiscrepancyOptions
+    held_out: dict[str, np.ndarray]
+    terms: dict[int, Term]
 
 
 @dataclass(frozen=True, slots=True)
@@ -551,34 +577,31 @@ def _generic_wins(best: _Scored, generic: GenericFit, options: DiscrepancyOption
 
 
 def _unexplained(
+    search: _Search,
     generic: GenericFit,
-    y: Mapping[str, np.ndarray],
     base: Mapping[str, np.ndarray],
     additions: Mapping[str, np.ndarray],
-    scale: Mapping[str, float],
-    held_out: dict[str, np.ndarray],
-    alternatives: tuple[Alternative, ...],
-    terms: dict[int, Term],
+    alternatives: tuple[Alternative, ...] = (),
     *,
     outputs: tuple[str, ...] = (),
 ) -> _Kept:
-    """The model of the unknown as a kept term (fitted on all samples), `held_out` updated with its prediction.
+    """The model of the unknown as a kept term (fitted on all samples), the search's `held_out` updated with it.
 
     `outputs`: where it is located when the model of the unknown keeps no regressor there (it is then a
     residual located, not modelled).
     """
     candidate = generic.candidate(outputs)
     if generic.chosen:
-        fit = fit_term(candidate, y, base, additions, scale)
+        fit = fit_term(candidate, search.y, base, additions, search.scale)
     else:
         fit = TermFit(
             candidate=candidate, value=float("nan"), coefficients={}, covariance={}, value_uncertainty=float("nan")
         )
-    terms[id(fit)] = generic_term(generic, outputs)
-    before = dict(held_out)
+    search.terms[id(fit)] = generic_term(generic, outputs)
+    before = dict(search.held_out)
     for o in generic.outputs:
-        held_out[o] = generic.predicted[o]
-    return _Kept(fit, generic.score, before, dict(held_out), alternatives)
+        search.held_out[o] = generic.predicted[o]
+    return _Kept(fit, generic.score, before, dict(search.held_out), alternatives)
 
 
 def _thrust_gain(fit: TermFit) -> float:
@@ -767,30 +790,95 @@ def _finding(
 ) -> Finding:
     fit, before, after = kept.fit, kept.before, kept.after
     outputs = fit.candidate.outputs
-    rms_before = {o: float(np.sqrt(np.mean((y[o] - before[o]) ** 2))) for o in outputs}
-    rms_after = {o: float(np.sqrt(np.mean((y[o] - after[o]) ** 2))) for o in outputs}
-    weighted_before = sum(rms_before[o] ** 2 / scale[o] for o in outputs)
-    weighted_after = sum(rms_after[o] ** 2 / scale[o] for o in outputs)
-    improvement = 100.0 * (1.0 - np.sqrt(weighted_after / weighted_before)) if weighted_before > 0 else 0.0
     contribution = {o: after[o] - before[o] for o in outputs}
     if not any(np.any(c) for c in contribution.values()):  # located, not modelled: the residual says where
         contribution = {o: y[o] - before[o] for o in outputs}
     regime = _regime(contribution, flown, fit.candidate.regime)
     if fit.candidate.grid_parameter == "time_s":  # a change at an instant acts from then on
         regime = Regime(variable="time", unit="s", low=round(fit.value, 3), high=round(float(flown["t_flight"][-1]), 3))
+    return _described(
+        term,
+        _Residuals(before={o: y[o] - before[o] for o in outputs}, after={o: y[o] - after[o] for o in outputs}),
+        contribution,
+        regime,
+        flown,
+        scale,
+        explained_variance=kept.score,
+        parameters=parameters_of(fit, term, derivation),
+        alternatives=kept.alternatives,
+    )
+
+
+def _calibrated(
+    term: Term,
+    calibration: Calibration,
+    logged: FlightSeries,
+    flown: FlightSeries,
+    baseline: BaselineModel,
+    scale: Mapping[str, float],
+) -> Finding:
+    """A sensor's error as a finding: the residual of its outputs against the simulation's model, as `logged`
+    and as corrected (`flown`). Its parameters come from the flights' kinematics, not from that residual: the
+    cut is held out of their measurement."""
+    outputs = calibration.outputs
+    before, after = baseline.predict(logged), baseline.predict(flown)
+    residuals = _Residuals(
+        before={o: logged[o] - before[o] for o in outputs}, after={o: flown[o] - after[o] for o in outputs}
+    )
+    contribution = {o: residuals.before[o] - residuals.after[o] for o in outputs}
+    weighted = [sum(float(np.mean(r[o] ** 2)) / scale[o] for o in outputs) for r in (residuals.before, residuals.after)]
+    return _described(
+        term,
+        residuals,
+        contribution,
+        _regime(contribution, flown, None),
+        flown,
+        scale,
+        explained_variance=1.0 - weighted[1] / weighted[0] if weighted[0] > 0 else 0.0,
+        parameters=calibration.parameters,
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class _Residuals:
+    """Each of a finding's outputs' held-out residual without (`before`) and with (`after`) it, shape (n,)."""
+
+    before: dict[str, np.ndarray]
+    after: dict[str, np.ndarray]
+
+
+def _described(
+    term: Term,
+    residuals: _Residuals,
+    contribution: Mapping[str, np.ndarray],
+    regime: Regime,
+    flown: FlightSeries,
+    scale: Mapping[str, float],
+    *,
+    explained_variance: float,
+    parameters: tuple[FittedParameter, ...],
+    alternatives: tuple[Alternative, ...] = (),
+) -> Finding:
+    """The finding of `term` with its residuals' figures, band, traces and sentence."""
+    outputs = tuple(residuals.before)
+    rms_before = {o: float(np.sqrt(np.mean(residuals.before[o] ** 2))) for o in outputs}
+    rms_after = {o: float(np.sqrt(np.mean(residuals.after[o] ** 2))) for o in outputs}
+    weighted_before = sum(rms_before[o] ** 2 / scale[o] for o in outputs)
+    weighted_after = sum(rms_after[o] ** 2 / scale[o] for o in outputs)
+    improvement = 100.0 * (1.0 - np.sqrt(weighted_after / weighted_before)) if weighted_before > 0 else 0.0
     finding = Finding(
-        effect=fit.candidate.effect,
+        effect=term.effect,
         outputs=outputs,
         band_rad_s=_band(contribution, flown.rate_hz),
         regime=regime,
-        explained_variance=round(max(kept.score, 0.0), 4),
-        parameters=parameters_of(fit, term, derivation),
+        explained_variance=round(max(explained_variance, 0.0), 4),
+        parameters=parameters,
         rmse_before=rms_before,
         rmse_after=rms_after,
         improvement_percent=round(float(improvement), 2),
         evidence="",
-        alternatives=kept.alternatives,
-        traces=_traces(flown, regime, {o: y[o] - before[o] for o in outputs}, {o: y[o] - after[o] for o in outputs}),
+        alternatives=alternatives,
+        traces=_traces(flown, regime, residuals.before, residuals.after),
     )
     return replace(finding, evidence=describe_finding(finding, term))
 

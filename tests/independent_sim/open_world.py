@@ -8,10 +8,11 @@ from __future__ import annotations
 
 from independent_sim.effects import GroundCushion, OffsetCentre
 from independent_sim.effects_more import AirframeDrag, ClimbInflow, MotorWear, ThrustCeiling, TranslationalLift
+from independent_sim.effects_more import GyroScale as _GyroScale  # a sensor: not physics
 from independent_sim.effects_outside import MixerCrossCoupling, SpeedPitchMoment, SwingingPayload
 from independent_sim.pairs import delayed, scaled
 
-__all__ = ["NAMED", "OUTSIDE", "CEILING", "open_world_cases"]
+__all__ = ["NAMED", "SENSORS", "CATALOGUED", "OUTSIDE", "CEILING", "open_world_cases"]
 
 #: Catalogue effects: name -> (the effect concealed, the REAL vehicle's effects, its plant changes).
 NAMED = {
@@ -29,6 +30,10 @@ NAMED = {
     "time_delay": ("time_delay", (), delayed(0.015)),
     "actuator_lag": ("actuator_lag", (), scaled(1.6, "T_a")),
 }
+#: A sensor's error, flown after every other case (the earlier cases keep the seeds they were first read with).
+SENSORS = {"gyro_scale": ("sensor_scale", (_GyroScale(),), ())}  # p +4 %, q -3 %, r +5 %
+#: Every case the catalogue names: the physics, then the sensors.
+CATALOGUED = NAMED | SENSORS
 #: Effects outside the catalogue: the right answer is ``unexplained`` on one of their primary outputs.
 OUTSIDE = {
     "swinging_payload": SwingingPayload(),
@@ -49,7 +54,9 @@ def open_world_cases(
     nulls : int, optional
         How many REAL flights of the same vehicle (``none``, ``none-1`` ...).
     ceiling : bool, optional
-        Add the thrust ceiling last.
+        Add the thrust ceiling after the outside effects.
+
+    The sensors' cases come last (:data:`SENSORS`).
     """
     cases: dict[str, tuple[tuple[object, ...], tuple[tuple[str, float], ...]]] = {
         ("none" if j == 0 else f"none-{j}"): ((), ()) for j in range(nulls)
@@ -58,4 +65,5 @@ def open_world_cases(
     cases |= {name: ((effect,), ()) for name, effect in OUTSIDE.items()}
     if ceiling:
         cases["thrust_ceiling"] = ((CEILING,), ())
+    cases |= {name: (effects, changes) for name, (_, effects, changes) in SENSORS.items()}
     return cases

@@ -19,16 +19,18 @@ from sysid.discrepancy.catalogue import (
     mass_change,
     parasitic_drag,
     rotor_drag,
+    sensor_scale,
     thrust_saturation,
     time_delay,
     translational_lift,
     wind,
 )
-from sysid.discrepancy.catalogue._term import Candidate, Coefficient, Derivation, FlightContext, Term
+from sysid.discrepancy.catalogue._term import Calibration, Candidate, Coefficient, Derivation, FlightContext, Term
 
 __all__ = [
     "CATALOGUE",
     "EFFECTS",
+    "Calibration",
     "Candidate",
     "Coefficient",
     "Derivation",
@@ -53,6 +55,7 @@ CATALOGUE: tuple[Term, ...] = (
     inflow.TERM,
     translational_lift.TERM,
     thrust_saturation.TERM,
+    sensor_scale.TERM,
 )
 
 #: The effects the catalogue can name.

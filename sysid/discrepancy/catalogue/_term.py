@@ -23,6 +23,7 @@ from sysid.discrepancy.result import Finding, FittedParameter
 from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries
 
 __all__ = [
+    "Calibration",
     "Candidate",
     "Coefficient",
     "Derivation",
@@ -77,6 +78,25 @@ class Candidate:
     build: Callable[[float], Regressors | Prediction]
     coefficients: tuple[str, ...] = ()
     regime: str | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Calibration:
+    """A sensor of the real flight measured against the kinematics of the others, and the flight corrected.
+
+    Parameters
+    ----------
+    parameters : tuple of FittedParameter
+        Each axis measured, with its standard deviation.
+    outputs : tuple of str
+        Outputs whose logged values the correction changes.
+    corrected : FlightSeries
+        The real flight with the sensor's signals (and those derived from them) corrected.
+    """
+
+    parameters: tuple[FittedParameter, ...]
+    outputs: tuple[str, ...]
+    corrected: FlightSeries
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -178,6 +198,11 @@ class Term:
         Outputs on which the term must by itself remove a held-out share above its threshold (empty: any):
         a rotor's drag is a force first, and its hub moment alone (a flapping rotor) is not one; a thrust
         ceiling is thrust that stops growing, and a roll moment lost above a command alone is not one.
+    calibrate : callable or None
+        ``calibrate(sim, real)``: for a sensor's error, measured on the flights themselves before any model
+        (a gyro against the attitude's kinematics), its :class:`Calibration`, or None where the real
+        flight's sensor agrees with the simulated one's. Such a term builds no candidate (``make`` gives
+        None): no model of the vehicle can tell a sensor's scale from the physics it measures.
     """
 
     effect: str
@@ -191,6 +216,7 @@ class Term:
     rivals: tuple[str, ...] = ()
     separated_by: str = ""
     shown_on: tuple[str, ...] = ()
+    calibrate: Callable[[FlightSeries, FlightSeries], Calibration | None] | None = None
 
     def coefficient(self, key: str) -> Coefficient:
         """The coefficient of column `key` (a key the term does not list is reported as it is, unit 1)."""

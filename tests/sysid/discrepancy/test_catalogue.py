@@ -14,7 +14,14 @@ from sysid.discrepancy.series import FlightSeries
 
 from builders import synthetic_series
 
-NEW_TERMS = ("control_effectiveness", "parasitic_drag", "inflow", "translational_lift", "thrust_saturation")
+NEW_TERMS = (
+    "control_effectiveness",
+    "parasitic_drag",
+    "inflow",
+    "translational_lift",
+    "thrust_saturation",
+    "sensor_scale",
+)
 
 
 @pytest.fixture(scope="module", name="context")
@@ -40,7 +47,9 @@ def test_every_term_is_one_module_with_its_term_and_one_registry_line() -> None:
 
 def test_each_terms_candidate_acts_on_its_outputs_with_its_named_coefficients(context: FlightContext) -> None:
     candidates = {c.effect: c for c in candidate_terms(context)}
-    assert set(candidates) == set(EFFECTS) - {"wind"}  # no wind logged
+    calibrated = {t.effect for t in CATALOGUE if t.calibrate is not None}  # a sensor's, measured before any model
+    assert calibrated == {"sensor_scale"}
+    assert set(candidates) == set(EFFECTS) - {"wind"} - calibrated  # no wind logged
     for effect, candidate in candidates.items():
         term = term_of(effect)
         assert set(candidate.outputs) <= set(term.outputs), effect

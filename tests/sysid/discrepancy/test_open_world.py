@@ -14,10 +14,14 @@ Tuning and assertions are apart: the search's new thresholds (the model of the u
 far-from-floor rule, the interleaved folds, the anti-alias filter, the thrust re-centring) were set on
 SIM seed 3000 and REAL seeds 3001 on; every assertion runs on SIM seed 5000 and REAL seeds 5001 on.
 
+A gyro's scale error (``sensor_scale``, tuned on SIM 3000 and 3200) is flown after every other case,
+so that their seeds stay those they were first read with.
+
 Limits, said here rather than hidden: one seed per case here (the issue's rates over many seeds are
-:mod:`test_open_world_rates`'s, on seeds of their own); the catalogue's ``sensor_scale`` is not built,
-so the generator's gyro and accelerometer scale errors are not asserted; a hard per-motor thrust
-ceiling is named first but not alone (the lost moments leave a second, smaller finding).
+:mod:`test_open_world_rates`'s, on seeds of their own); the accelerometers' scale is not measured (see
+:mod:`sysid.discrepancy.catalogue.sensor_scale`), so the generator's accelerometer scale errors are not
+asserted; a hard per-motor thrust ceiling is named first but not alone (the lost moments leave a
+second, smaller finding).
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ import statistics
 
 import pytest
 from independent_sim.corpus import write_case
-from independent_sim.open_world import NAMED, OUTSIDE, open_world_cases
+from independent_sim.open_world import CATALOGUED, OUTSIDE, open_world_cases
 from independent_sim.pairs import open_pair_case
 
 from sysid.discrepancy import DiscrepancyResult, discover
@@ -59,9 +63,9 @@ def test_nothing_is_found_where_nothing_is_missing_under_the_nuisances(results: 
     assert results["none"].verdict == "none" and results["none"].findings == (), results["none"].summary
 
 
-@pytest.mark.parametrize("name", list(NAMED))
+@pytest.mark.parametrize("name", list(CATALOGUED))
 def test_a_catalogue_effect_is_named_alone(results: dict[str, DiscrepancyResult], name: str) -> None:
-    result, effect = results[name], NAMED[name][0]
+    result, effect = results[name], CATALOGUED[name][0]
     assert [f.effect for f in result.findings] == [effect], result.summary
     assert result.findings[0].improvement_percent > 0.0
 
@@ -84,7 +88,7 @@ def test_the_held_out_improvements_reach_the_issues_floors(results: dict[str, Di
     effect, acting for 20 s, to 98.9 worn thrust), unexplained 35.5 %; with the idle outputs kept the named
     median was 49.2 % (the worn moments 45.1 % on four outputs, 60.7 % on the two it changes).
     """
-    named = [f.improvement_percent for n in NAMED for f in results[n].findings if f.effect == NAMED[n][0]]
+    named = [f.improvement_percent for n in CATALOGUED for f in results[n].findings if f.effect == CATALOGUED[n][0]]
     unknown = [f.improvement_percent for n in OUTSIDE for f in results[n].findings if f.effect == "unexplained"]
     assert statistics.median(named) >= 50.0, named
     assert statistics.median(unknown) >= 30.0, unknown
