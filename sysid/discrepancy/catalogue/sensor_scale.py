@@ -10,7 +10,7 @@ where a differentiated attitude is noise), its uncertainty by leaving out one of
 4 s blocks at a time (jackknife). The real flight's scale is taken relative to the simulated one's, which holds
 whatever both estimators share; an axis off by more than 3 standard deviations and 2 % is corrected
 (``p`` and ``p_dot`` divided by ``1 + error``) before the search looks for physics. The 2 % is a real
-PX4 flight's: its two halves, one gyro, read 0.9 % apart at 3.2 standard deviations (the jackknife
+PX4 flight's: its two halves, one gyro, read 0.9 % apart at 3.4 standard deviations (the jackknife
 does not see what changes between flights, an estimator's slow corrections), so a smaller error is
 not told from none.
 
@@ -42,9 +42,7 @@ _BAND_HZ = (0.3, 3.0)  # where the slope is read: above bias drift and attitude 
 _FOLDS = 20  # folds the jackknife leaves out one at a time ...
 _BLOCK_S = 4.0  # ... each of interleaved blocks this long (the band-passed residual's correlation is shorter)
 _SIGMAS = 3.0  # an axis whose relative error is beyond this many standard deviations ...
-_MIN_ERROR = (
-    0.02  # ... and this share is corrected: a real PX4 flight's two halves, one gyro, read 0.9 % apart at 3.2 σ
-)
+_MIN_ERROR = 0.02  # ... and this share is corrected (a real flight's two halves: 0.9 % apart at 3.4 σ)
 _SLOPE_WINDOW_S = 0.1  # Savitzky-Golay window of the attitude's derivative (as the rates')
 
 

@@ -123,7 +123,7 @@ def test_a_real_flights_two_halves_share_one_gyro(real_data: Path) -> None:
     """One PX4 gyro read against its own attitude in the first and second half: no scale error is claimed.
 
     A regression check, not held-out evidence: this flight set the 2 % floor (its halves read 0.9 % apart
-    on q at 3.2 σ); the only other real logs here lack the mixer inputs or 10 s of flight.
+    on q at 3.4 σ); the only other real logs here lack the mixer inputs or 10 s of flight.
     """
     from sysid.discrepancy.catalogue.sensor_scale import TERM
 
