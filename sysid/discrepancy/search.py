@@ -171,11 +171,11 @@ def discover(
     """
     simulated, flown = _joined(sim), _joined(real)
     simulated = simulated.without([s for s in simulated.signals if s not in flown])  # a model of what both logged
-    logged, calibrations = flown, []
+    calibrations = []  # (the sensor's term, the flight it was measured on, its calibration)
     for sensor in CATALOGUE:  # a sensor's error, before any physics
         calibration = sensor.calibrate(simulated, flown) if sensor.calibrate is not None else None
         if calibration is not None:
-            calibrations.append((sensor, calibration))
+            calibrations.append((sensor, flown, calibration))
             flown = calibration.corrected
     scale, null = _noise_floor(simulated)
     _report(progress, "simulation model", 1, 3)
@@ -332,7 +332,7 @@ def discover(
     gains = {id(k.fit): _thrust_gain(k.fit) for k in kept}
     findings = sorted(
         (
-            *(_calibrated(t, c, logged, flown, baseline, scale) for t, c in calibrations),
+            *(_calibrated(t, c, measured_on, flown, baseline, scale) for t, measured_on, c in calibrations),
             # each term's thrust level: the trim and the other terms' gains (collinear: only their sum is known)
             *(
                 _finding(
@@ -812,18 +812,18 @@ def _finding(
 def _calibrated(
     term: Term,
     calibration: Calibration,
-    logged: FlightSeries,
+    measured_on: FlightSeries,
     flown: FlightSeries,
     baseline: BaselineModel,
     scale: Mapping[str, float],
 ) -> Finding:
-    """A sensor's error as a finding: the residual of its outputs against the simulation's model, as `logged`
-    and as corrected (`flown`). Its parameters come from the flights' kinematics, not from that residual: the
-    cut is held out of their measurement."""
-    outputs = calibration.outputs
-    before, after = baseline.predict(logged), baseline.predict(flown)
+    """A sensor's error as a finding: the residual of its outputs against the simulation's model, as the flight
+    it was `measured_on` has them and as corrected. Its parameters come from the flights' kinematics, not from
+    that residual: the cut is held out of their measurement. `flown`: the flight the search read (its regime)."""
+    outputs, corrected = calibration.outputs, calibration.corrected
+    before, after = baseline.predict(measured_on), baseline.predict(corrected)
     residuals = _Residuals(
-        before={o: logged[o] - before[o] for o in outputs}, after={o: flown[o] - after[o] for o in outputs}
+        before={o: measured_on[o] - before[o] for o in outputs}, after={o: corrected[o] - after[o] for o in outputs}
     )
     contribution = {o: residuals.before[o] - residuals.after[o] for o in outputs}
     weighted = [sum(float(np.mean(r[o] ** 2)) / scale[o] for o in outputs) for r in (residuals.before, residuals.after)]

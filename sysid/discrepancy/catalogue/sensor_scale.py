@@ -21,6 +21,8 @@ specific forces of a hovering vehicle in x and y), so a claim on them would be a
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from flightlogs.frames import euler_rates_to_body
@@ -149,10 +151,7 @@ def _calibrate(sim: FlightSeries, real: FlightSeries) -> Calibration | None:
             signals[rate] = real[rate] / (1.0 + off[name])
             signals[derivative] = real[derivative] / (1.0 + off[name])
             outputs.append(derivative)
-    corrected = FlightSeries(
-        name=real.name, time_s=real.time_s, piece=real.piece, signals=signals, rate_hz=real.rate_hz
-    )
-    return Calibration(parameters=measured, outputs=tuple(outputs), corrected=corrected)
+    return Calibration(parameters=measured, outputs=tuple(outputs), corrected=replace(real, signals=signals))
 
 
 def _what(finding: Finding) -> str:
