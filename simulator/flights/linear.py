@@ -4,6 +4,16 @@ A small, exact-truth flight generator: the identified octocopter model of
 Table 3.3 (calm), optionally with the wind terms of Table 3.5, flown by an LQR
 hover controller with excitation summed at the mixer input. The full
 nonlinear simulator builds on the same outputs.
+
+The model's axes are the body's: ``u`` along the nose, ``v`` to the right. The
+wind (north, east) reaches them turned by the yaw state ``psi``, and the ground
+velocity is logged turned back, so a log read with its own heading gives the
+airspeeds the dynamics used. (The yaw sweep turns the vehicle by up to 30 deg.
+The airframe used to feel the wind as if it kept heading north while the logged
+heading turned: in a fleet flight's 1.4 m/s wind the lateral airspeed read from
+the log carried about 0.07 m/s RMS the airframe never felt, a model fitted on
+that log had its ``L_v`` and ``Y_v`` 6.5 % short, and the same vehicle in another
+wind was named a CG offset.)
 """
 
 from __future__ import annotations
@@ -17,6 +27,7 @@ import numpy as np
 from scipy import linalg
 from scipy import signal as sps
 
+from flightlogs.frames import wind_to_body_axes
 from simulator.autopilot.excitation import Axis, Maneuver, excitation_signal, sweep
 from simulator.vehicle.identified import CALM_HOVER, G
 
@@ -200,6 +211,7 @@ def simulate_hover(
 _SLICES = {"lat": slice(0, 4), "lon": slice(4, 8), "yaw": slice(8, 10), "thr": slice(10, 13)}
 _N_STATES = 13
 _U, _V, _W = _SLICES["lon"].start, _SLICES["lat"].start, _SLICES["thr"].start  # the velocity states
+_PSI = _SLICES["yaw"].start + 1  # the heading from the trim, rad
 
 
 def simulate_hovers(
@@ -242,6 +254,7 @@ def simulate_hovers(
         [s.wind.sample(t_fine, rng) if s.wind is not None else np.zeros((n_fine, 2)) for s, rng in zip(setups, rngs)]
     )
     terms = [dict(s.wind_terms or {}) for s in setups]
+    wind_terms = any(terms)
     x_w, z_w = (np.array([t.get(name, 0.0) for t in terms]) for name in ("X_w_lon", "Z_w_lon"))
     w_lon_delay, w_thr_delay = (
         np.array([int(round(t.get(name, 0.0) / dt)) for t in terms]) for name in ("tau_w_lon", "tau_w_thr")
@@ -272,12 +285,14 @@ def simulate_hovers(
     everyone = np.arange(n_flights)
     for k in range(n_fine):
         # the controller holds ground velocity: airspeed plus the wind along each axis
+        psi = states[:, _PSI]
         feedback = states.copy()
-        feedback[:, _U] += wind_ne[:, k, 0]
-        feedback[:, _V] += wind_ne[:, k, 1]
+        feedback[:, [_U, _V]] += wind_to_body_axes(wind_ne[:, k], psi)
         history[k] = excitation[k] - np.matmul(gains, feedback[:, :, None])[:, :, 0]
-        wind_lon_u = wind_ne[everyone, np.maximum(k - w_lon_delay, 0), 0]
-        wind_lon_w = wind_ne[everyone, np.maximum(k - w_thr_delay, 0), 0]
+        wind_lon_u = wind_lon_w = np.zeros(n_flights)
+        if wind_terms:  # Table 3.5's terms on the wind along the nose, each its own delay earlier
+            wind_lon_u = wind_to_body_axes(wind_ne[everyone, np.maximum(k - w_lon_delay, 0)], psi)[:, 0]
+            wind_lon_w = wind_to_body_axes(wind_ne[everyone, np.maximum(k - w_thr_delay, 0)], psi)[:, 0]
         if k % substeps == 0:
             j = k // substeps
             logged[j] = states
@@ -338,8 +353,10 @@ def _flight(
     for j, axis in enumerate(_AXES):
         signals[f"delta_{axis}"] = np.convolve(history[:, j], boxcar, mode="same")[pick]
     signals = {name: np.ascontiguousarray(values) for name, values in signals.items()}
-    signals["vn"] = signals["u"] + wind_ne[pick, 0]
-    signals["ve"] = signals["v"] + wind_ne[pick, 1]
+    # the body-axis airspeeds turned back to north and east by the heading, plus the wind
+    ground_ne = wind_to_body_axes(np.column_stack([signals["u"], signals["v"]]), -signals["psi"])
+    signals["vn"] = ground_ne[:, 0] + wind_ne[pick, 0]
+    signals["ve"] = ground_ne[:, 1] + wind_ne[pick, 1]
     signals["vd"] = signals["w"]
     _add_sensor_noise(signals, rng)
     return SimulatedFlight(
