@@ -27,6 +27,7 @@ __all__ = [
     "Candidate",
     "Coefficient",
     "Derivation",
+    "FASTER_SWEEPS",
     "FlightContext",
     "Regressors",
     "Prediction",
@@ -235,6 +236,9 @@ class Term:
 
 #: Standard deviations beyond which a coefficient on the wrong side of zero rules its term out.
 SIGN_SIGMAS = 2.0
+
+#: The flight that tells a delay from a lag (both terms say it in these words, so an ambiguity says it once).
+FASTER_SWEEPS = "sweeps to higher frequency (a delay's phase keeps falling, a lag's magnitude rolls off)"
 
 #: The thrust gain beside a term's shape on az (the real thrust per input may differ by a constant factor).
 THRUST_GAIN = Coefficient(key="gain", name="thrust_gain_change", unit="1")

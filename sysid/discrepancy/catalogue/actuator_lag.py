@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from sysid.discrepancy.catalogue._term import (
+    FASTER_SWEEPS,
     Candidate,
     FlightContext,
     Term,
@@ -42,5 +43,5 @@ TERM = Term(
     make=_make,
     what=_what,
     rivals=("time_delay", "control_effectiveness"),
-    separated_by="sweeps to higher frequency (a lag's magnitude rolls off, a delay's does not)",
+    separated_by=FASTER_SWEEPS,
 )

@@ -4,7 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from sysid.discrepancy.catalogue._term import Candidate, FlightContext, Term, delayed, input_transform, parameter, pm
+from sysid.discrepancy.catalogue._term import (
+    FASTER_SWEEPS,
+    Candidate,
+    FlightContext,
+    Term,
+    delayed,
+    input_transform,
+    parameter,
+    pm,
+)
 from sysid.discrepancy.result import Finding
 from sysid.discrepancy.series import OUTPUTS
 
@@ -31,5 +40,5 @@ TERM = Term(
     make=_make,
     what=_what,
     rivals=("actuator_lag", "control_effectiveness"),
-    separated_by="sweeps to higher frequency (a delay's phase keeps falling, a lag's magnitude rolls off)",
+    separated_by=FASTER_SWEEPS,
 )
