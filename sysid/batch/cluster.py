@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
+import threading
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from typing import Any
 
 from flightlogs.errors import SysidError
@@ -51,15 +53,41 @@ def batch_client(scheduler: str | None = None, workers: int | None = None) -> It
             client.close()  # type: ignore[no-untyped-call]
         return
     n = workers or os.cpu_count() or 1
-    with (
-        LocalCluster(  # type: ignore[no-untyped-call]
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            silence_logs=level,
-            env={"FLIGHT_SYSID_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
-        ) as cluster,
-        Client(cluster) as client,  # type: ignore[no-untyped-call]
-    ):
+    with ExitStack() as started:
+        with _signals_held():  # delivered once the cluster is up, inside `started`: it is closed like any other
+            cluster = started.enter_context(
+                LocalCluster(  # type: ignore[no-untyped-call]
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=level,
+                    env={"FLIGHT_SYSID_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
+                )
+            )
+            client = started.enter_context(Client(cluster))  # type: ignore[no-untyped-call]
         yield client
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM while the block runs, then deliver the first one caught to the handlers in force.
+
+    A local cluster interrupted while its workers start cannot be closed: ``distributed``'s exit handler
+    then fails on a worker still starting and prints its traceback after the one-line "interrupted"
+    (Ctrl-C 2.5-3.1 s into ``sysid batch`` on two workers). Held, the signal arrives a second or two later,
+    when the cluster is up and closes cleanly. Outside the main thread (no signal handlers there): nothing held.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    held = (signal.SIGINT, signal.SIGTERM)
+    previous = {s: signal.signal(s, lambda signum, _frame: caught.append(signum)) for s in held}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+    if caught:
+        signal.raise_signal(caught[0])
