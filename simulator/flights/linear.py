@@ -282,14 +282,14 @@ def simulate_hovers(
     logged = np.zeros((n_logged, n_flights, _N_STATES))
     accel = np.zeros((n_logged, n_flights, 3))
     flight, axis_index = np.arange(n_flights)[:, None], np.arange(len(_AXES))[None, :]
-    everyone = np.arange(n_flights)
+    everyone, still = np.arange(n_flights), np.zeros(n_flights)  # still: no wind terms, no wind along the nose
     for k in range(n_fine):
         # the controller holds ground velocity: airspeed plus the wind along each axis
         psi = states[:, _PSI]
         feedback = states.copy()
         feedback[:, [_U, _V]] += wind_to_body_axes(wind_ne[:, k], psi)
         history[k] = excitation[k] - np.matmul(gains, feedback[:, :, None])[:, :, 0]
-        wind_lon_u = wind_lon_w = np.zeros(n_flights)
+        wind_lon_u = wind_lon_w = still
         if wind_terms:  # Table 3.5's terms on the wind along the nose, each its own delay earlier
             wind_lon_u = wind_to_body_axes(wind_ne[everyone, np.maximum(k - w_lon_delay, 0)], psi)[:, 0]
             wind_lon_w = wind_to_body_axes(wind_ne[everyone, np.maximum(k - w_thr_delay, 0)], psi)[:, 0]

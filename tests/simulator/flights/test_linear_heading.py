@@ -11,9 +11,9 @@ import numpy as np
 
 from flightlogs.frames import wind_to_body_axes
 from simulator.autopilot.excitation import Maneuver
-from simulator.flights.linear import WindField, simulate_hover
+from simulator.flights.linear import _NOISE, WindField, simulate_hover
 
-_NOISE_M_S = 0.02  # the logged ground velocity's noise per axis, m/s (``simulator.flights.linear._NOISE``)
+_NOISE_M_S = _NOISE["vn"]  # the logged ground velocity's noise per axis, m/s
 
 
 def test_the_logged_ground_velocity_read_on_the_logged_heading_is_the_airspeed_flown() -> None:
