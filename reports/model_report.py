@@ -31,6 +31,7 @@ from .html import render_html, write_html
 from .model_figures import correlation_figure, pole_map_figure, response_figures
 from .svg import figure_svg
 from .verify_section import sized_svg, verification_context
+from .wind_figures import clock_offset_figure
 
 __all__ = ["CORRELATION_FLAG", "model_report_html", "write_model_report"]
 
@@ -52,9 +53,22 @@ def _wind_text(model: IdentifiedModel) -> str:
             for o, b, a in zip(model.wind.outputs, model.wind.rms_before, model.wind.rms_after)
         )
         text += f"; wind terms G_w fitted on the residual of eq. 3.14 (RMS {change})"
+        clock = model.wind.clock_offset
+        if clock is not None and clock.measured:
+            text += (
+                f"; anemometer clock offset {clock.clock_offset_s:+.2f} ± {clock.sigma_s:.2f} s, measured from that "
+                f"residual ({clock.used_clock_offset_s:+.2f} s before)"
+            )
+        elif clock is not None:
+            text += f"; anemometer clock offset not measured: {clock.reason}"
     elif any(p.stage == "wind" for p in model.parameters):
         text += "; the structure's wind terms were not fitted"
     return text
+
+
+def _clock_offset(model: IdentifiedModel) -> tuple[str, str, float] | None:
+    clock = model.wind.clock_offset if model.wind is not None else None
+    return _shown(clock_offset_figure(clock), "") if clock is not None else None
 
 
 def _card(
@@ -289,6 +303,7 @@ def model_report_html(
         "n_correlated": len(names),
         "modes": _mode_rows(found),
         "poles": _shown(pole_map_figure(found), "") if found else None,
+        "clock_offset": _clock_offset(model),
         "guidelines": verdict.guidelines,
         "correlation_flag": CORRELATION_FLAG,
         "options": _flatten(model.provenance.options),

@@ -99,8 +99,12 @@ def validate(
 
     identified = read_model(model_path)
     segments = segments_from(segments_file)
+    measured = identified.measured_clock_offset_s if wind_paths and wind_offset is None else None
     conditioning = ConditioningOptions(
-        wind_offset_s=wind_offset, wind_distance_m=wind_distance, transport_delay_s=transport_delay, segments=segments
+        wind_offset_s=wind_offset if measured is None else measured,
+        wind_distance_m=wind_distance,
+        transport_delay_s=transport_delay,
+        segments=segments,
     )
     log_only = {
         "--wind": wind_paths,
@@ -136,6 +140,10 @@ def validate(
         write_verification(out, verification, model=model_path.name, options=saved, created_utc=created)
     if report is not None:
         write_model_report(report, identified, verification=verification, verification_options=saved)
+    if measured is not None:
+        notes.insert(
+            0, f"anemometer clock offset {measured:+.2f} s, as the model's fit measured it (--wind-offset to override)"
+        )
     summary = _summary(verification, model_path, logs, report, notes) | {"output": str(out) if out else None}
     if not quiet:
         _print(summary)

@@ -30,9 +30,16 @@ from flightlogs.writers.jsonio import jsonable
 from sysid.fit.axes import merge_axes, partial_warning, structure_axes, unidentified_message
 from sysid.fit.engine import FitOptions, FrequencyFit, fit_frequency_responses
 from sysid.fit.reduce import ReductionStep
-from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance
-from sysid.fit.wind import WindStepResult, fit_wind, unfitted_wind
-from sysid.fit.wind_alignment import wind_misalignment
+from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance, WindClockOffset
+from sysid.fit.wind import (
+    WindStepResult,
+    fit_wind,
+    speed_derivatives,
+    step_one_spread,
+    unfitted_wind,
+    with_spread,
+)
+from sysid.fit.wind_offset import moved_flights, moved_wind, offset_given, timed_wind, untimed_wind
 from sysid.freqresp import (
     FrequencyResponse,
     ResponseOptions,
@@ -253,7 +260,10 @@ def _identified(
     options: IdentifyOptions,
     files: Sequence[str | Path],
     progress: Progress | None,
+    *,
+    timed: tuple[WindClockOffset, list[str]] | None = None,
 ) -> IdentifiedModel:
+    """The identification; `timed` is the clock offset scanned and applied to the flights by an earlier pass."""
     if isinstance(structure, str):
         structure = load_structure(structure)
     structure.check_constants(options.constants or {})
@@ -302,24 +312,63 @@ def _identified(
         _report(progress, "wind step", len(_AXES) + 1, len(_AXES) + 2)
         signals = {c.signal for c in structure.wind_inputs}
         records = [r for axis in options.wind_axes for r in used.get(axis, [])]
-        misaligned = wind_misalignment(flights, structure)
-        if misaligned:
-            wind = unfitted_wind(structure, misaligned)
-        elif any(signals <= set(r.signals) for r in records):
-            wind = fit_wind(
-                structure,
-                fit.values,
-                constants,
-                records,
-                outputs=options.wind_outputs,
-                reduce=options.fit.reduce,
-                max_cr_percent=options.fit.max_cr_percent,
-                max_insensitivity_percent=options.fit.max_insensitivity_percent,
-            )
+        if any(signals <= set(r.signals) for r in records):
+            if timed is None:
+                records, clock, said = timed_wind(
+                    structure, fit.values, constants, records, flights, options.wind_outputs
+                )
+                if clock is not None and clock.measured and _moves(clock, flights):  # step 1 again, u v w in time
+                    moved = moved_flights(flights, clock.best_shift_s)
+                    return _identified(moved, structure, options, files, progress, timed=(clock, said))
+            else:
+                (clock, said), records = timed, moved_wind(records, flights, 0.0)  # smoothed as in the first pass
+            notes += said
+            untimed = untimed_wind(clock)
+            if untimed:
+                wind = unfitted_wind(structure, untimed)
+            else:
+                estimated = [n for n, status in fit.status.items() if status == "estimated"]
+                speed, speed_accuracy = speed_derivatives(
+                    structure, fit.values, constants, records, estimated, outputs=options.wind_outputs
+                )
+                wind = fit_wind(
+                    structure,
+                    dict(fit.values) | speed,
+                    constants,
+                    records,
+                    outputs=options.wind_outputs,
+                    reduce=options.fit.reduce,
+                    max_cr_percent=options.fit.max_cr_percent,
+                    max_insensitivity_percent=options.fit.max_insensitivity_percent,
+                )
+                delays = {n: v for n, v in wind.values.items() if n in structure.wind_parameters and math.isfinite(v)}
+                spread = step_one_spread(
+                    structure,
+                    fit.values,
+                    constants,
+                    records,
+                    estimated,
+                    fit.accuracy,
+                    delays=delays,
+                    outputs=options.wind_outputs,
+                )
+                wind = dataclasses.replace(
+                    wind,
+                    accuracy=with_spread(wind.accuracy, spread),
+                    speed_values=speed,
+                    speed_accuracy=with_spread(speed_accuracy, spread) if speed else None,
+                )
+            if wind.fit is not None:
+                wind = dataclasses.replace(wind, fit=dataclasses.replace(wind.fit, clock_offset=clock))
         else:
             notes.append(f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give --wind)")
     _report(progress, "done", len(_AXES) + 2, len(_AXES) + 2)
     return model_from_fit(fit, wind, trim=trim, provenance=_provenance(files, options), notes=notes)
+
+
+def _moves(clock: WindClockOffset, flights: Sequence[ConditionedFlight]) -> bool:
+    """Whether the offset measured is applied and moves the wind by more than its own uncertainty."""
+    return not offset_given(flights) and abs(clock.best_shift_s) > max(2 * clock.sigma_s, 0.02)
 
 
 def identify_logs(
@@ -431,15 +480,20 @@ def model_from_fit(
     cr = dict(zip(fit.accuracy.names, fit.accuracy.cramer_rao_percent.tolist()))
     ins = dict(zip(fit.accuracy.names, fit.accuracy.insensitivity_percent.tolist()))
     if wind is not None:
-        cr |= dict(zip(wind.accuracy.names, wind.accuracy.cramer_rao_percent.tolist()))
-        ins |= dict(zip(wind.accuracy.names, wind.accuracy.insensitivity_percent.tolist()))
+        for again in (wind.accuracy, wind.speed_accuracy):
+            if again is not None:
+                kept = [k for k, n in enumerate(again.names) if n in wind.speed_values or again is wind.accuracy]
+                cr |= {again.names[k]: float(again.cramer_rao_percent[k]) for k in kept}
+                ins |= {again.names[k]: float(again.insensitivity_percent[k]) for k in kept}
     for p in structure.parameters:
         stage: Literal["frequency", "wind"]
         unit = p.unit
         for signal, text in units.items():
             unit = unit.replace("{" + signal + "}", text)
         unit = unit.replace("{", "unit of ").replace("}", "")  # an input with no response: its unit is not known
-        if p.name in fit.status:
+        if wind is not None and p.name in wind.speed_values:  # estimated again with G_w
+            status, value, stage = fit.status[p.name], wind.speed_values[p.name], "wind"
+        elif p.name in fit.status:
             status, value, stage = fit.status[p.name], fit.values[p.name], "frequency"
         elif wind is not None:
             status, value, stage = wind.status[p.name], wind.values[p.name], "wind"

@@ -34,7 +34,14 @@ from sysid.fit.axes import AxisStatus
 from sysid.fit.cost import CostSummary
 from sysid.fit.guidelines import Guidelines
 from sysid.fit.reduce import ReductionStep
-from sysid.fit.result import PARAMETER_STATUSES, IdentifiedModel, ParameterEstimate, Provenance, WindFit
+from sysid.fit.result import (
+    PARAMETER_STATUSES,
+    IdentifiedModel,
+    ParameterEstimate,
+    Provenance,
+    WindClockOffset,
+    WindFit,
+)
 from sysid.freqresp import FrequencyResponse
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "model_to_dict", "model_from_dict", "write_model", "read_model", "write_mat"]
@@ -98,6 +105,7 @@ def model_to_dict(model: IdentifiedModel) -> dict[str, Any]:
             "rms_before": [_num(v) for v in model.wind.rms_before],
             "rms_after": [_num(v) for v in model.wind.rms_after],
             "samples": model.wind.samples,
+            "clock_offset": _clock_offset_doc(model.wind.clock_offset),
         },
         "provenance": {
             "files": list(model.provenance.files),
@@ -286,6 +294,44 @@ def _wind(doc: Mapping[str, Any], f: _Fields) -> WindFit | None:
         rms_before=tuple(float(v) for v in before),
         rms_after=tuple(float(v) for v in after),
         samples=f.get(wind, "samples", "wind", int),
+        clock_offset=_clock_offset(wind, f),
+    )
+
+
+def _clock_offset_doc(clock: WindClockOffset | None) -> dict[str, Any] | None:
+    if clock is None:
+        return None
+    return {
+        "clock_offset_s": _num(clock.clock_offset_s),
+        "sigma_s": _num(clock.sigma_s),
+        "measured": clock.measured,
+        "reason": clock.reason,
+        "used_clock_offset_s": _num(clock.used_clock_offset_s),
+        "transport_delay_s": _num(clock.transport_delay_s),
+        "best_shift_s": _num(clock.best_shift_s),
+        "shift_s": [_num(v) for v in clock.shift_s],
+        "cost": [_num(v) for v in clock.cost],
+        "cost_without_wind": _num(clock.cost_without_wind),
+        "samples": clock.samples,
+    }
+
+
+def _clock_offset(wind: Mapping[str, Any], f: _Fields) -> WindClockOffset | None:
+    if wind.get("clock_offset") is None:
+        return None
+    doc, where = f.get(wind, "clock_offset", "wind", dict), "wind.clock_offset"
+    shift = f.numbers(doc, "shift_s", where, finite=True)
+    return WindClockOffset(
+        shift_s=shift,
+        cost=f.numbers(doc, "cost", where, size=shift.size),
+        cost_without_wind=f.number(doc, "cost_without_wind", where),
+        best_shift_s=f.number(doc, "best_shift_s", where),
+        sigma_s=f.number(doc, "sigma_s", where),
+        used_clock_offset_s=f.number(doc, "used_clock_offset_s", where, finite=True),
+        transport_delay_s=f.number(doc, "transport_delay_s", where),
+        measured=f.get(doc, "measured", where, bool),
+        reason=f.get(doc, "reason", where, str),
+        samples=f.get(doc, "samples", where, int),
     )
 
 

@@ -22,7 +22,15 @@ from sysid.model.statespace import DelayedStateSpace
 from sysid.model.structure import InputChannel, ModelStructure
 from sysid.model.toml_format import parse_structure
 
-__all__ = ["ParameterStatus", "PARAMETER_STATUSES", "ParameterEstimate", "WindFit", "Provenance", "IdentifiedModel"]
+__all__ = [
+    "ParameterStatus",
+    "PARAMETER_STATUSES",
+    "ParameterEstimate",
+    "WindClockOffset",
+    "WindFit",
+    "Provenance",
+    "IdentifiedModel",
+]
 
 ParameterStatus = Literal["estimated", "fixed", "dropped", "unidentified"]
 #: Every parameter status, in the order tables list them.
@@ -94,6 +102,74 @@ class ParameterEstimate:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class WindClockOffset:
+    """The anemometer clock offset measured from the wind step's residual.
+
+    Parameters
+    ----------
+    shift_s : ndarray, shape (n_trial,)
+        Trial moves of the wind along the log's clock, s (positive: the
+        vehicle meets the air later than the conditioning placed it), in
+        increasing order: the coarse and the fine pass together.
+    cost : ndarray, shape (n_trial,)
+        Weighted residual sum of squares per sample left after the best G_w
+        gains at each trial (dimensionless: each output weighted by its own
+        residual level).
+    cost_without_wind : float
+        The same with no wind term.
+    best_shift_s : float
+        The trial of least cost, refined by a parabola through its
+        neighbours, s.
+    sigma_s : float
+        Its standard deviation from the cost's curvature, s (inf when the
+        cost has no minimum there).
+    used_clock_offset_s : float
+        Anemometer clock minus reference clock the conditioning used, s
+        (the median over the flights).
+    transport_delay_s : float
+        Anemometer-to-vehicle delay the conditioning applied (distance /
+        mean speed, or given), s, the median over the flights: the scan
+        moves the wind on top of it, and cannot tell a clock offset from an
+        error of it.
+    measured : bool
+        Whether the wind carries the information to claim the offset.
+    reason : str
+        Why it is not claimed ("" when it is).
+    samples : int
+        Samples in the cost.
+    """
+
+    shift_s: np.ndarray
+    cost: np.ndarray
+    cost_without_wind: float
+    best_shift_s: float
+    sigma_s: float
+    used_clock_offset_s: float
+    transport_delay_s: float
+    measured: bool
+    reason: str
+    samples: int
+
+    @property
+    def clock_offset_s(self) -> float:
+        """Anemometer clock minus reference clock the residual points to, s."""
+        return self.used_clock_offset_s - self.best_shift_s
+
+    @property
+    def contrast(self) -> float:
+        """How much the timing of the wind matters: the residual at the best move below its median over the scan.
+
+        A fraction of that median: 0 when the cost is flat (calm air, no wind information).
+        """
+        median = float(np.median(self.cost))
+        return 1.0 - self.cost_at(self.best_shift_s) / median if median > 0 else 0.0
+
+    def cost_at(self, shift_s: float) -> float:
+        """Cost at a move of the wind, interpolated between trials."""
+        return float(np.interp(shift_s, self.shift_s, self.cost))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindFit:
     """How well the wind terms explain the one-step-prediction residual of eq. 3.14.
 
@@ -107,12 +183,16 @@ class WindFit:
         RMS with them.
     samples : int
         Samples used.
+    clock_offset : WindClockOffset or None
+        The anemometer clock offset scanned from the same residual, when the
+        records carry the wind to move.
     """
 
     outputs: tuple[str, ...]
     rms_before: tuple[float, ...]
     rms_after: tuple[float, ...]
     samples: int
+    clock_offset: WindClockOffset | None = None
 
     def __post_init__(self) -> None:
         if not len(self.outputs) == len(self.rms_before) == len(self.rms_after):
@@ -274,6 +354,12 @@ class IdentifiedModel:
             if p.name == name:
                 return p
         raise ModelError(f"model {self.structure_name} has no parameter {name!r}")
+
+    @property
+    def measured_clock_offset_s(self) -> float | None:
+        """Anemometer clock offset the wind step measured, s; None when it did not (or had no wind)."""
+        clock = self.wind.clock_offset if self.wind is not None else None
+        return clock.clock_offset_s if clock is not None and clock.measured else None
 
     def linear_model(self, *, include_wind: bool = True) -> DelayedStateSpace:
         """The identified model as a :class:`DelayedStateSpace`.

@@ -23,23 +23,21 @@ the residual's autocorrelation by an effective number of independent
 samples (N_eff = N / (1 + 2 sum rho_k), Bartlett); insensitivities come from
 the diagonal of the same information matrix.
 
-The regression needs the wind where the vehicle meets it. When the
-anemometer's clock is off by more than the wind delays can take up (the
-conditioning measures the residual offset against the autopilot's wind
-estimate, but applies it only when asked), the wind and the residual do not
-line up: every G_w term comes out insensitive and would be dropped as if the
-wind did nothing. :func:`sysid.fit.wind_alignment.wind_misalignment` detects
-it, and the wind parameters are then left ``unidentified``
-(:func:`unfitted_wind`) with the offset to give. Outputs of an unidentified axis have no residual to fit; a
-wind parameter that only they would inform is unidentified too.
+The regression needs the wind where the vehicle meets it. An anemometer
+clock off by more than the wind delays can take up puts the wind and the
+residual apart, and every G_w term would come out insensitive as if the
+wind did nothing: :mod:`sysid.fit.wind_offset` finds the offset from this
+same residual (:func:`wind_cost`) before the step. Outputs of an
+unidentified axis have no residual to fit; a wind parameter that only they
+would inform is unidentified too (:func:`unfitted_wind` when none is left).
 """
 
 from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Literal
 
@@ -56,7 +54,16 @@ from sysid.model.assemble import Assembler, SystemMatrices
 from sysid.model.axes import axis_parts
 from sysid.model.structure import ModelStructure
 
-__all__ = ["WindStepResult", "fit_wind", "unfitted_wind"]
+__all__ = [
+    "WindStepResult",
+    "fit_wind",
+    "residual_inflation",
+    "speed_derivatives",
+    "step_one_spread",
+    "with_spread",
+    "unfitted_wind",
+    "wind_cost",
+]
 
 WindStatus = Literal["estimated", "dropped", "unidentified"]
 
@@ -81,6 +88,10 @@ class WindStepResult:
     reduction : tuple of ReductionStep
         Wind parameters dropped (J_ave columns hold the weighted residual
         sum of squares per sample).
+    speed_values : Mapping[str, float]
+        Step 1 parameters estimated again with G_w (:func:`speed_derivatives`): they replace step 1's.
+    speed_accuracy : Accuracy or None
+        Their accuracy (the G_w gains solved beside them included).
     """
 
     values: Mapping[str, float]
@@ -88,6 +99,8 @@ class WindStepResult:
     accuracy: Accuracy
     fit: WindFit | None
     reduction: tuple[ReductionStep, ...] = ()
+    speed_values: Mapping[str, float] = field(default_factory=dict)
+    speed_accuracy: Accuracy | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -246,17 +259,21 @@ class _Normal:
         self.e = np.array([dm.d[k][rows][:, columns] for k in self.gains]).reshape(len(self.gains), *self.d0.shape)
         self.weight = problem.data.scale**2
         residual = np.vstack(problem.data.residual)
-        self.rr = np.einsum("nr,nr->r", residual, residual)
         self.residual = residual
 
     def solve(self, theta: np.ndarray) -> tuple[np.ndarray, float]:
         """Least-squares gains at the delays of `theta` (entries linear in their gains) and the cost."""
         delays = self.problem.assembler.matrices(theta).delays[self.problem.columns]
         winds = np.column_stack([np.concatenate(self.problem.shifted(k, tau)) for k, tau in enumerate(delays)])
+        return self.solve_for(theta, winds, self.residual)
+
+    def solve_for(self, theta: np.ndarray, winds: np.ndarray, residual: np.ndarray) -> tuple[np.ndarray, float]:
+        """As :meth:`solve`, with the delayed winds (n, n_wind) and the residual (n, n_out) given."""
         gram = winds.T @ winds  # (n_wind, n_wind)
-        cross = winds.T @ self.residual  # (n_wind, n_out)
+        cross = winds.T @ residual  # (n_wind, n_out)
+        rr = np.einsum("nr,nr->r", residual, residual)
         # target per output: residual - w d0^T; regressor g per output: w e_g^T
-        tt = self.rr - 2 * np.einsum("rc,cr->r", self.d0, cross) + np.einsum("rc,cd,rd->r", self.d0, gram, self.d0)
+        tt = rr - 2 * np.einsum("rc,cr->r", self.d0, cross) + np.einsum("rc,cd,rd->r", self.d0, gram, self.d0)
         out = theta.copy()
         cost = float(self.weight @ tt)
         if self.gains:
@@ -290,8 +307,19 @@ def _scan(problem: _Problem) -> np.ndarray:
     return theta
 
 
-def _inflation(residual: np.ndarray) -> float:
-    """N / N_eff of the weighted residual (Bartlett) times its variance: what J^T J is divided by."""
+def residual_inflation(residual: np.ndarray) -> float:
+    """N / N_eff of a weighted residual (Bartlett) times its variance: what J^T J is divided by.
+
+    Parameters
+    ----------
+    residual : ndarray, shape (n_samples, n_outputs)
+        Weighted residual, one column per output.
+
+    Returns
+    -------
+    float
+        The largest over the outputs of ``(1 + 2 sum rho_k) mean(e^2)``, summed while rho_k >= 0.05.
+    """
     factor = 0.0
     for column in residual.T:
         c = column - column.mean()
@@ -329,7 +357,7 @@ def _fit_free(
     after = [r - w @ d_w.T for r, w in zip(data.residual, winds)]
     stacked = np.vstack(after)
     if free:
-        acc = accuracy(solved.jac / math.sqrt(_inflation(stacked * data.scale)), theta, tuple(free))
+        acc = accuracy(solved.jac / math.sqrt(residual_inflation(stacked * data.scale)), theta, tuple(free))
     cost = float(np.mean(np.sum((stacked * data.scale) ** 2, axis=1)))
     return out, acc, cost, after
 
@@ -393,7 +421,7 @@ def fit_wind(
     usable = [r for r in records if needed <= set(r.signals)]
     if not usable:
         raise FitError(f"no record has every signal the wind step needs ({', '.join(sorted(needed))})")
-    current = dict(values) | {n: values.get(n, structure.parameter(n).value) for n in names}
+    current = _with_wind_defaults(structure, values)
     data = _prediction_data(structure, current, constants, usable, outputs)
     informed = _informed(structure, current, constants, data.rows, names)
     status: dict[str, WindStatus] = {n: "estimated" if n in informed else "unidentified" for n in names}
@@ -439,6 +467,345 @@ def fit_wind(
         fit=fit,
         reduction=tuple(steps),
     )
+
+
+#: States whose measured values carry the wind (eq. 3.1: air-relative velocities).
+_AIR_STATES = ("u", "v", "w")
+
+
+def _gains_problem(
+    structure: ModelStructure, current: Mapping[str, float], constants: Mapping[str, float], data: _Data
+) -> tuple[_Problem, _Normal, list[int], list[int]]:
+    """The least-squares problem of the G_w gains the fitted rows read, at `current`'s delays.
+
+    Returns the problem, its normal equations, and the indices of its delays and of its gains in ``problem.free``.
+    """
+    names = structure.wind_parameters
+    free = sorted(_informed(structure, current, constants, data.rows, names), key=names.index)
+    problem = _Problem(structure, current, constants, data, free)
+    delays, gains = problem.delay_and_gain_index()
+    return problem, _Normal(problem, problem.start, gains), delays, gains
+
+
+def _with_wind_defaults(structure: ModelStructure, values: Mapping[str, float]) -> dict[str, float]:
+    """`values` with each wind parameter it lacks at the structure's starting value."""
+    return dict(values) | {n: values.get(n, structure.parameter(n).value) for n in structure.wind_parameters}
+
+
+def wind_cost(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    constants: Mapping[str, float],
+    records: Sequence[Record],
+    outputs: Sequence[str] = ("ax", "az"),
+) -> Callable[[Sequence[Mapping[str, np.ndarray]]], tuple[float, float, np.ndarray]] | None:
+    """The eq. 3.14 residual's cost after the best G_w gains, as a function of the records' wind and u v w.
+
+    The residual of `records` is computed once; a call gives new values of
+    some of their signals (the wind and the air-relative velocities, moved
+    along the clock) and the residual changes by their terms in the output
+    rows. States the records lack (the actuator lags) keep the values
+    simulated for `records`: in ``hover-wind`` they read no velocity. The
+    wind delays stay at their values in `values` (or the structure's), the
+    gains are solved by linear least squares, and each output is weighted
+    by its residual level in `records`.
+
+    Parameters
+    ----------
+    structure : ModelStructure
+        A structure with wind inputs.
+    values : Mapping[str, float]
+        F and G_u values (step 1).
+    constants : Mapping[str, float]
+        Trim constants, SI.
+    records : sequence of Record
+        Records with the structure's measured states, outputs, inputs and wind signals.
+    outputs : sequence of str, optional
+        Outputs whose residual is fitted.
+
+    Returns
+    -------
+    callable or None
+        None when every output belongs to an unidentified axis; else
+        ``cost(changed) -> (cost with the gains, cost without wind, weighted residual after)`` with
+        ``changed`` one mapping of signal name to new values per record: the costs are weighted sums of
+        squares per sample (dimensionless), the residual has shape (n_samples, n_outputs).
+    """
+    values, outputs, _ = _identified_outputs(structure, values, outputs)
+    if not outputs:
+        return None
+    current = _with_wind_defaults(structure, values)
+    data = _prediction_data(structure, current, constants, records, outputs)
+    problem, normal, _, _ = _gains_problem(structure, current, constants, data)
+    m = problem.assembler.matrices(problem.start)
+    delays = m.delays[problem.columns]
+    signals = [c.signal for c in structure.wind_inputs]
+    moving = [k for k, s in enumerate(structure.states) if s in _AIR_STATES]
+    c_moving = m.c[data.rows][:, moving]  # (n_out, n_moving): the outputs' rows read the velocities so
+    base = [record.time_s for record in records]
+
+    def cost(changed: Sequence[Mapping[str, np.ndarray]]) -> tuple[float, float, np.ndarray]:
+        residual, winds = [], []
+        for record, t, r0, new in zip(records, base, data.residual, changed):
+            states = [structure.states[k] for k in moving]
+            if any(s in new for s in states):
+                dx = np.column_stack([new[s] - record[s] if s in new else np.zeros(t.size) for s in states])
+                r = r0 - dx @ c_moving.T
+                r0 = r - r.mean(axis=0)
+            residual.append(r0)
+            w = np.column_stack([np.interp(t - tau, t, new.get(s, record[s])) for s, tau in zip(signals, delays)])
+            winds.append(w - w.mean(axis=0))
+        stacked, wind = np.vstack(residual), np.vstack(winds)
+        theta, left = normal.solve_for(problem.start, wind, stacked)
+        d_w = problem.assembler.matrices(theta).d[data.rows][:, problem.columns]
+        after = (stacked - wind @ d_w.T) * data.scale
+        n = stacked.shape[0]
+        return left / n, float(np.sum((stacked * data.scale) ** 2)) / n, after
+
+    return cost
+
+
+def speed_derivatives(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    constants: Mapping[str, float],
+    records: Sequence[Record],
+    estimated: Sequence[str],
+    *,
+    outputs: Sequence[str] = ("ax", "az"),
+    delays: Mapping[str, float] | None = None,
+    with_accuracy: bool = True,
+) -> tuple[dict[str, float], Accuracy]:
+    """The speed derivatives of the fitted outputs, estimated again with G_w from the residual of eq. 3.14.
+
+    Under position hold the air-relative velocity is the wind less a little
+    ground speed, and the position loop's feedback biases a speed damping
+    fitted to closed-loop frequency responses (X_u came out 13-72 % short on
+    the independent generator's windy flights). An error of X_u leaves
+    ``dX_u u`` in the ax residual, and with u close to minus the wind G_w takes
+    it up: X_w_lon came out short by the same amount. The gusts excite the
+    airspeed apart from the loop, so the residual measures both: each
+    step 1 parameter the fitted outputs' rows read through u, v or w alone
+    (``X_u`` in ax, ``Z_w`` in az) is solved for with the G_w gains by linear
+    least squares, each output weighted by its residual level, at the wind
+    delays that leave the least residual (every 10 ms over each delay's
+    bounds, then every 2 ms about the best, coordinate-wise, twice: u carries the wind undelayed, so the
+    split between X_u and X_w_lon follows the delay); the Cramér–Rao
+    bounds are corrected for the residual's autocorrelation as the wind
+    step's.
+
+    Parameters
+    ----------
+    structure : ModelStructure
+        A structure with wind inputs.
+    values : Mapping[str, float]
+        Step 1's values.
+    constants : Mapping[str, float]
+        Trim constants, SI.
+    records : sequence of Record
+        Records of the wind step, the wind where the vehicle met it.
+    estimated : sequence of str
+        Parameters step 1 estimated (a dropped one stays dropped).
+    outputs : sequence of str, optional
+        Outputs whose residual is fitted.
+    delays : Mapping[str, float], optional
+        Wind delays to solve at instead of scanning them, s.
+    with_accuracy : bool, optional
+        Compute the bounds (else they are left infinite: the values alone are wanted).
+
+    Returns
+    -------
+    tuple
+        New values of those parameters, and the accuracy of the joint solution (the G_w gains solved beside
+        them); no values when the structure has none of them, nothing when it cannot be solved.
+    """
+    empty = accuracy(np.zeros((1, 0)), np.zeros(0), ())
+    names = structure.wind_parameters
+    known, outputs, _ = _identified_outputs(structure, values, outputs)
+    moving = [k for k, s in enumerate(structure.states) if s in _AIR_STATES]
+    if not outputs or not moving or not all({structure.states[k] for k in moving} <= set(r.signals) for r in records):
+        return {}, empty
+    current = _with_wind_defaults(structure, known)
+    free = tuple(n for n in estimated if n not in names and math.isfinite(values.get(n, math.nan)))
+    plain = Assembler(
+        structure,
+        free=free,
+        fixed={k: v for k, v in current.items() if k not in free and k not in names},
+        constants=constants,
+        include_wind=False,
+    )
+    theta = np.array([current[n] for n in free])
+    rows = [structure.outputs.index(o) for o in outputs]
+    dm = plain.derivatives(theta, plain.matrices(theta))
+    others = [k for k in range(len(structure.states)) if k not in moving]
+    chosen = [
+        k
+        for k in range(len(free))
+        if np.any(dm.c[k][np.ix_(rows, moving)] != 0)
+        and not np.any(dm.c[k][np.ix_(rows, others)] != 0)
+        and not np.any(dm.d[k][rows] != 0)
+    ]
+    data = _prediction_data(structure, current, constants, records, outputs)
+    problem, normal, delay_index, gains = _gains_problem(structure, current, constants, data)
+    states = np.vstack(
+        [np.column_stack([r[structure.states[k]] - r[structure.states[k]].mean() for k in moving]) for r in records]
+    )
+    speeds = [states @ dm.c[k][np.ix_(rows, moving)].T for k in chosen]  # (n, n_out) per parameter
+
+    residual = np.vstack(data.residual)
+    weighted_speeds = np.column_stack([(c * data.scale).ravel() for c in speeds]) if speeds else None
+
+    def solved(at: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+        """Cost, solution, weighted residual after and design at the wind delays of `at` (normal equations)."""
+        delays = problem.assembler.matrices(at).delays[problem.columns]
+        wind = np.column_stack([np.concatenate(problem.shifted(k, tau)) for k, tau in enumerate(delays)])
+        gains_part = np.column_stack([((wind @ normal.e[g].T) * data.scale).ravel() for g in range(len(gains))])
+        design = gains_part if weighted_speeds is None else np.hstack([weighted_speeds, gains_part])
+        target = ((residual - wind @ normal.d0.T) * data.scale).ravel()
+        solution = np.linalg.lstsq(design.T @ design, design.T @ target, rcond=None)[0]
+        after = (target - design @ solution).reshape(residual.shape)
+        return float(np.sum(after**2)), solution, after, design
+
+    # u carries the wind undelayed: the split between X_u and X_w_lon follows the wind delay, so it is scanned,
+    # every 10 ms then every 2 ms about the best
+    at = problem.start.copy()
+    for k in delay_index if delays is not None else ():
+        at[k] = (delays or {}).get(problem.free[k], at[k])
+    best = solved(at)[0]
+    for _ in range(2 if delay_index and delays is None else 0):
+        for k in delay_index:
+            p = structure.parameter(problem.free[k])
+            lo, hi = max(p.lower, 0.0), min(p.upper, 0.5)
+            for grid in (np.arange(lo, hi + 1e-12, 5 * _SCAN_STEP_S), None):
+                points = np.clip(at[k] + np.arange(-5, 6) * _SCAN_STEP_S, lo, hi) if grid is None else grid
+                for tau in points:
+                    trial = at.copy()
+                    trial[k] = tau
+                    cost = solved(trial)[0]
+                    if cost < best:
+                        at, best = trial, cost
+    _, solution, after, design = solved(at)
+    labels = tuple(free[k] for k in chosen) + tuple(problem.free[g] for g in gains)
+    estimates = np.concatenate([theta[chosen] + solution[: len(chosen)], solution[len(chosen) :]])
+    inflation = residual_inflation(after) if with_accuracy else math.inf
+    acc = accuracy(design / math.sqrt(inflation), estimates, labels)
+    return {free[k]: float(estimates[j]) for j, k in enumerate(chosen)}, acc
+
+
+def step_one_spread(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    constants: Mapping[str, float],
+    records: Sequence[Record],
+    estimated: Sequence[str],
+    step_one: Accuracy,
+    *,
+    delays: Mapping[str, float],
+    outputs: Sequence[str] = ("ax", "az"),
+) -> dict[str, float]:
+    """One standard deviation of each wind-step estimate from step 1's own uncertainty.
+
+    The residual of eq. 3.14 is computed with step 1's F and G_u, whose
+    errors the wind step takes for wind: under closed loop the thrust and
+    pitch commands answer the gusts, so a Z_thr 3 % off moves Z_w_lon by
+    several %. Each step 1 estimate is moved by its Cramér–Rao bound, the
+    joint solution (:func:`speed_derivatives` at the wind delays found) is
+    solved again, and the changes are combined with step 1's correlation.
+
+    Parameters
+    ----------
+    structure : ModelStructure
+        A structure with wind inputs.
+    values : Mapping[str, float]
+        Step 1's values (the speed derivatives as step 1 left them).
+    constants : Mapping[str, float]
+        Trim constants, SI.
+    records : sequence of Record
+        Records of the wind step.
+    estimated : sequence of str
+        Parameters step 1 estimated.
+    step_one : Accuracy
+        Step 1's accuracy (CR bounds, correlation).
+    delays : Mapping[str, float]
+        Wind delays the wind step found, s.
+    outputs : sequence of str, optional
+        Outputs whose residual is fitted.
+
+    Returns
+    -------
+    dict
+        Standard deviation of each parameter of the joint solution (speed derivatives and G_w gains), in its
+        unit; empty when nothing could be solved.
+    """
+    speed, base = speed_derivatives(
+        structure, values, constants, records, estimated, outputs=outputs, delays=delays, with_accuracy=False
+    )
+    read = _read_by_residual(structure, values, constants, records, outputs)
+    moved = [
+        k
+        for k, n in enumerate(step_one.names)
+        if n in read and n not in speed and math.isfinite(step_one.cramer_rao[k]) and step_one.cramer_rao[k] > 0
+    ]
+    if not base.names or not moved:
+        return {}
+    changes = []
+    for k in moved:
+        nudged = dict(values) | {step_one.names[k]: values[step_one.names[k]] + float(step_one.cramer_rao[k])}
+        _, again = speed_derivatives(
+            structure, nudged, constants, records, estimated, outputs=outputs, delays=delays, with_accuracy=False
+        )
+        changes.append(again.values - base.values if again.names == base.names else np.zeros(len(base.names)))
+    sensitivity = np.array(changes)  # (n_moved, n_joint): the change for a 1-sigma move of each
+    correlation = np.nan_to_num(step_one.correlation[np.ix_(moved, moved)], nan=0.0)
+    np.fill_diagonal(correlation, 1.0)
+    variance = np.einsum("ij,ik,jk->k", correlation, sensitivity, sensitivity)
+    return {n: float(np.sqrt(max(v, 0.0))) for n, v in zip(base.names, variance)}
+
+
+def _read_by_residual(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    constants: Mapping[str, float],
+    records: Sequence[Record],
+    outputs: Sequence[str],
+) -> set[str]:
+    """Step 1 parameters the residual of `outputs` reads: in their rows of C or D, in the rows of the states
+    a record lacks (simulated: the actuator lags), or as an input delay."""
+    known, outputs, _ = _identified_outputs(structure, values, outputs)
+    free = tuple(n for n in known if n not in structure.wind_parameters and n in structure.parameter_names)
+    plain = Assembler(structure, free=free, fixed={}, constants=constants, include_wind=False)
+    theta = np.array([known[n] for n in free])
+    dm = plain.derivatives(theta, plain.matrices(theta))
+    rows = [structure.outputs.index(o) for o in outputs]
+    logged = set.intersection(*(set(r.signals) for r in records)) if records else set()
+    hidden = [k for k, s in enumerate(structure.states) if s not in logged]
+    return {
+        n
+        for k, n in enumerate(free)
+        if np.any(dm.c[k][rows] != 0)
+        or np.any(dm.d[k][rows] != 0)
+        or np.any(dm.a[k][hidden] != 0)
+        or np.any(dm.b[k][hidden] != 0)
+        or np.any(dm.delays[k] != 0)
+    }
+
+
+def with_spread(acc: Accuracy, spread: Mapping[str, float]) -> Accuracy:
+    """`acc` with each parameter's Cramér–Rao bound and `spread` added in quadrature.
+
+    Parameters
+    ----------
+    acc : Accuracy
+        An accuracy.
+    spread : Mapping[str, float]
+        Further standard deviations, by name, in the parameters' units.
+
+    Returns
+    -------
+    Accuracy
+    """
+    extra = np.array([spread.get(n, 0.0) for n in acc.names])
+    return replace(acc, cramer_rao=np.sqrt(acc.cramer_rao**2 + extra**2))
 
 
 def _identified_outputs(

@@ -1,4 +1,4 @@
-"""Helpers both log writers use: sampling a flight at a topic's rate, motors, battery, GPS, quaternions."""
+"""Helpers both log writers use: sampling a flight at a topic's rate, motors, battery, GPS, quaternions, wind estimate."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import numpy as np
 from independent_sim._mixer import PITCH_ARM, ROLL_ARM, YAW_SPIN
 from independent_sim.effects import pack_current, pack_voltage
 from independent_sim.flight import Flight
+from independent_sim.wind import ESTIMATE_NOISE_M_S, lagged_estimate
 
 __all__ = [
     "sample_indices",
@@ -16,6 +17,7 @@ __all__ = [
     "battery",
     "geodetic",
     "quaternion",
+    "wind_estimate",
     "HOME_LAT_DEG",
     "HOME_LON_DEG",
     "HOME_ALT_M",
@@ -141,3 +143,32 @@ def quaternion(phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> np.ndarra
             cr * cp * sy - sr * sp * cy,
         ]
     )
+
+
+def wind_estimate(flight: Flight, index: np.ndarray) -> np.ndarray | None:
+    """The autopilot's wind estimate at some fine-grid samples, or None when the case logs none.
+
+    Parameters
+    ----------
+    flight : Flight
+        The flown case.
+    index : ndarray of int, shape (m,)
+        Fine-grid samples (a topic's).
+
+    Returns
+    -------
+    ndarray, shape (m, 2), or None
+        North and east wind, m/s: the true wind at the vehicle (``truth["wind_n"]``,
+        ``truth["wind_e"]``) low-passed on the fine grid with the case's
+        ``estimate_time_constant_s`` (:func:`~independent_sim.wind.lagged_estimate`),
+        sampled, plus white noise of :data:`~independent_sim.wind.ESTIMATE_NOISE_M_S`
+        (a generator of its own: the other streams of the case are unchanged).
+    """
+    model = flight.case.wind
+    if model is None or model.estimate_time_constant_s is None:
+        return None
+    true = np.column_stack([flight.truth["wind_n"], flight.truth["wind_e"]])
+    lagged = lagged_estimate(flight.time_s, true, model.estimate_time_constant_s)[index]
+    rng = np.random.default_rng((flight.case.seed, 0x77E5))
+    noisy: np.ndarray = lagged + ESTIMATE_NOISE_M_S * rng.standard_normal(lagged.shape)
+    return noisy

@@ -7,6 +7,7 @@ Messages and rates (400 Hz grid and loop)::
     ATT    100 Hz   DesRoll Roll DesPitch Pitch DesYaw Yaw (deg, 0.01 deg resolution)
     RCOU   100 Hz   C1..C8 PWM (1100-1900 µs)
     XKF1    50 Hz   VN VE VD, PN PE PD (EKF3 core 0)
+    XKF2    25 Hz   VWN VWE wind estimate (core 0; only when the case's wind model asks for one)
     CTUN    25 Hz   ThO, ThH, DAlt, Alt (above home; no rangefinder), CRt
     BAT     10 Hz   Volt, Curr
     RCIN    25 Hz   C1..C4 sticks (roll, pitch, throttle, yaw; 1100-1900 µs), C5 mode switch
@@ -26,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from flightlogs.writers import MessageBlock, MessageSpec, standard_block, write_dataflash
-from independent_sim._common import HOME_ALT_M, battery, geodetic, motor_commands, sample_indices
+from independent_sim._common import HOME_ALT_M, battery, geodetic, motor_commands, sample_indices, wind_estimate
 from independent_sim.flight import Flight
 from independent_sim.nuisances import keep_mask
 
@@ -39,6 +40,7 @@ ARDUPILOT_RATES: Mapping[str, tuple[float, float]] = {
     "ATT": (100.0, 0.0025),
     "RCOU": (100.0, 0.0),
     "XKF1": (50.0, 0.005),
+    "XKF2": (25.0, 0.005),
     "CTUN": (25.0, 0.0075),
     "BAT": (10.0, 0.0125),
     "GPS": (5.0, 0.0),
@@ -165,6 +167,7 @@ def _navigation(flight: Flight, expected: Expected) -> list[MessageBlock]:
     ]
     for name, column in (("vn", "VN"), ("ve", "VE"), ("vd", "VD")):
         expected[name] = (stamp / 1e6, velocity[column])
+    blocks += _wind(flight, expected)
     i, stamp = _pick(flight, "CTUN")
     alt = m["height"][i].astype(_F32)
     climb = np.round(-t["vd"][i] * 100.0)
@@ -186,6 +189,17 @@ def _navigation(flight: Flight, expected: Expected) -> list[MessageBlock]:
     expected["height_agl"] = (stamp / 1e6, alt)
     blocks.append(_gps(flight))
     return blocks
+
+
+def _wind(flight: Flight, expected: Expected) -> list[MessageBlock]:
+    """XKF2 of core 0: the EKF's wind estimate VWN, VWE (0.01 m/s as logged), when the case logs one."""
+    i, stamp = _pick(flight, "XKF2")
+    estimate = wind_estimate(flight, i)
+    if estimate is None:
+        return []
+    north, east = np.round(estimate, 2).T
+    expected["est_wind_n"], expected["est_wind_e"] = (stamp / 1e6, north), (stamp / 1e6, east)
+    return [standard_block("XKF2", TimeUS=stamp, C=np.zeros(i.size), VWN=north, VWE=east)]
 
 
 def _gps(flight: Flight) -> MessageBlock:

@@ -5,11 +5,19 @@ only; tests assert on :data:`HELDOUT_CASES`. The two lists share no case,
 and each covers PX4 and ArduPilot logs, calm and strong wind, sweeps of
 every design, doublets, 3-2-1-1s, multisines, piloted sweeps, a hover with
 no maneuver and a log with one axis never excited.
+
+The ``*-wind-clock-*`` cases fly in wind with an anemometer whose logger's
+clock is off (``WindModel.clock_offset_s``, one of them by 0.0 s: nothing to
+find) and a log that carries the autopilot's own wind estimate, lagging the
+air by a first-order time constant (``WindModel.estimate_time_constant_s``);
+``heldout-wind-calm`` is the calm airframe in a breath of wind (0.8 m/s,
+turbulence 0.05 m/s): no G_w to find.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Literal
 
 from independent_sim.maneuvers import (
     Axis,
@@ -43,9 +51,14 @@ def _flight(
     wind: WindModel | None = None,
     hover_s: float = 0.0,
     repositions: tuple[Reposition, ...] = (),
+    condition: Literal["calm", "light", "strong"] | None = None,
     **options: object,
 ) -> Case:
-    """A case whose maneuvers follow each other; a bare number in `steps` is a pause (s)."""
+    """A case whose maneuvers follow each other; a bare number in `steps` is a pause (s).
+
+    The airframe is Table 3.3's strong-wind column when the case has `wind`, else the calm one,
+    unless `condition` says otherwise (the calm airframe in a light breeze: ``"calm"`` with wind).
+    """
     maneuvers, at = [], _FIRST_S
     for step in steps:
         if isinstance(step, (int, float)):
@@ -60,7 +73,7 @@ def _flight(
         fmt=fmt,
         plan=FlightPlan(duration_s=duration, repositions=repositions, log_start_us=30_000_000 + 1_250_000 * seed),
         maneuvers=tuple(maneuvers),
-        condition="strong" if wind is not None else "calm",
+        condition=condition or ("strong" if wind is not None else "calm"),
         wind=wind,
         heading_deg=heading_deg,
         seed=seed,
@@ -79,6 +92,20 @@ def _doublets(axes: Sequence[Axis], amplitude: float = 0.06, width_s: float = 1.
 
 _LOG = Chirp()  # 0.1-10 Hz, 34 s, fade-in 3 s: the dissertation's sweep
 _STRONG = WindModel(mean_speed_m_s=5.4, from_deg=250.0)
+
+
+def _clock_steps(second_lon: Design, thrust: Design) -> list[_Step]:
+    """Two lon sweeps around a thrust sweep, then doublets lon, thr, lon, thr (the clock cases' plan)."""
+    return [
+        ("lon", _LOG, 0.06, "mixer"),
+        8.0,
+        ("thr", thrust, 0.05, "mixer"),
+        8.0,
+        ("lon", second_lon, 0.07, "mixer"),
+        8.0,
+        *_doublets(["lon", "thr", "lon", "thr"]),
+    ]
+
 
 TUNING_CASES: tuple[Case, ...] = (
     _flight(
@@ -166,6 +193,43 @@ TUNING_CASES: tuple[Case, ...] = (
         seed=107,
         wind=_STRONG,
         description="PX4 in strong wind (5.4 m/s, Dryden): lon and thr sweeps, doublets; anemometer CSV",
+    ),
+    _flight(
+        "tune-wind-clock-px4-ahead",
+        "ulog",
+        _clock_steps(Chirp(duration_s=36.0, law="linear", f_max_hz=6.0), Chirp(duration_s=30.0, f_max_hz=8.0)),
+        seed=301,
+        wind=WindModel(
+            mean_speed_m_s=5.0, from_deg=135.0, sigma_m_s=0.7, clock_offset_s=1.7, estimate_time_constant_s=2.5
+        ),
+        description="PX4 in wind 5.0 m/s, anemometer clock 1.7 s ahead, wind estimate lagging 2.5 s: "
+        "two lon sweeps, a thr sweep, doublets",
+    ),
+    _flight(
+        "tune-wind-clock-ap-behind",
+        "dataflash",
+        _clock_steps(
+            Chirp(duration_s=40.0, direction="down", fade_in_s=1.0, fade_out_s=3.0),
+            Chirp(duration_s=30.0, f_max_hz=8.0, law="linear"),
+        ),
+        seed=302,
+        wind=WindModel(
+            mean_speed_m_s=5.6, from_deg=315.0, sigma_m_s=0.8, clock_offset_s=-0.9, estimate_time_constant_s=3.5
+        ),
+        description="ArduPilot in wind 5.6 m/s, anemometer clock 0.9 s behind, wind estimate lagging 3.5 s: "
+        "two lon sweeps, a thr sweep, doublets",
+    ),
+    _flight(
+        "tune-wind-calm",
+        "dataflash",
+        _clock_steps(Chirp(duration_s=34.0), Chirp(duration_s=30.0, f_max_hz=8.0)),
+        seed=303,
+        wind=WindModel(
+            mean_speed_m_s=1.0, from_deg=40.0, sigma_m_s=0.08, clock_offset_s=-0.7, estimate_time_constant_s=2.5
+        ),
+        condition="calm",
+        description="ArduPilot, the calm airframe in 1 m/s of wind (turbulence 0.08 m/s; no G_w), anemometer clock "
+        "0.7 s behind, wind estimate lagging 2.5 s: two lon sweeps, a thr sweep, doublets",
     ),
 )
 
@@ -318,6 +382,70 @@ HELDOUT_CASES: tuple[Case, ...] = (
         seed=209,
         wind=WindModel(mean_speed_m_s=5.4, from_deg=290.0, sigma_m_s=0.75),
         description="PX4 in strong wind: lon and lat sweeps, doublets; anemometer CSV",
+    ),
+    _flight(
+        "heldout-wind-clock-ap-ahead",
+        "dataflash",
+        _clock_steps(Chirp(duration_s=36.0), Chirp(duration_s=30.0, f_max_hz=8.0)),
+        seed=311,
+        wind=WindModel(
+            mean_speed_m_s=4.6, from_deg=60.0, sigma_m_s=0.65, clock_offset_s=2.6, estimate_time_constant_s=3.0
+        ),
+        description="ArduPilot in wind 4.6 m/s, anemometer clock 2.6 s ahead, wind estimate lagging 3 s: "
+        "two lon sweeps, a thr sweep, doublets",
+    ),
+    _flight(
+        "heldout-wind-clock-px4-behind",
+        "ulog",
+        _clock_steps(
+            Chirp(duration_s=34.0, law="linear", f_min_hz=0.15, f_max_hz=8.0),
+            Chirp(duration_s=30.0, f_max_hz=8.0, direction="down", fade_in_s=1.0, fade_out_s=3.0),
+        ),
+        seed=312,
+        wind=WindModel(
+            mean_speed_m_s=5.8, from_deg=200.0, sigma_m_s=0.9, clock_offset_s=-2.3, estimate_time_constant_s=2.0
+        ),
+        description="PX4 in wind 5.8 m/s, anemometer clock 2.3 s behind, wind estimate lagging 2 s: "
+        "two lon sweeps, a thr sweep, doublets",
+    ),
+    _flight(
+        "heldout-wind-clock-px4-slight",
+        "ulog",
+        _clock_steps(
+            Chirp(duration_s=40.0, direction="down", fade_in_s=1.0, fade_out_s=3.0),
+            Chirp(duration_s=30.0, f_max_hz=8.0, law="linear"),
+        ),
+        seed=313,
+        wind=WindModel(
+            mean_speed_m_s=5.2, from_deg=340.0, sigma_m_s=0.75, clock_offset_s=0.4, estimate_time_constant_s=4.0
+        ),
+        description="PX4 in wind 5.2 m/s, anemometer clock 0.4 s ahead, wind estimate lagging 4 s: "
+        "two lon sweeps, a thr sweep, doublets",
+    ),
+    _flight(
+        "heldout-wind-clock-ap-none",
+        "dataflash",
+        _clock_steps(
+            Chirp(duration_s=36.0, law="linear", f_max_hz=6.0), Chirp(duration_s=30.0, f_min_hz=0.2, f_max_hz=6.0)
+        ),
+        seed=314,
+        wind=WindModel(
+            mean_speed_m_s=5.4, from_deg=100.0, sigma_m_s=0.6, clock_offset_s=0.0, estimate_time_constant_s=2.5
+        ),
+        description="ArduPilot in wind 5.4 m/s, anemometer clock right (0.0 s: no false alarm), wind estimate "
+        "lagging 2.5 s: two lon sweeps, a thr sweep, doublets",
+    ),
+    _flight(
+        "heldout-wind-calm",
+        "ulog",
+        _clock_steps(Chirp(duration_s=36.0), Chirp(duration_s=30.0, f_max_hz=8.0)),
+        seed=315,
+        wind=WindModel(
+            mean_speed_m_s=0.8, from_deg=170.0, sigma_m_s=0.05, clock_offset_s=1.2, estimate_time_constant_s=3.0
+        ),
+        condition="calm",
+        description="PX4, the calm airframe in a breath of wind (0.8 m/s, turbulence 0.05 m/s; no G_w), anemometer "
+        "clock 1.2 s ahead, wind estimate lagging 3 s: two lon sweeps, a thr sweep, doublets",
     ),
 )
 

@@ -81,9 +81,15 @@ class Truth:
         Airborne span on the log clock, s.
     controller : Mapping[str, float]
         Gains and rate of the closed loop (not logged as such).
-    wind : Mapping[str, float] or None
-        Mean speed, direction, turbulence, anemometer distance, transport
-        delay (s) and noise, when the case has wind.
+    wind : Mapping[str, float or None] or None
+        When the case has wind: ``mean_speed_m_s``, ``from_deg``,
+        ``sigma_m_s``, ``distance_m``, ``transport_delay_s`` (s),
+        ``anemometer_rate_hz``, ``speed_noise_m_s``, ``direction_noise_deg``;
+        ``clock_offset_s``, the anemometer logger's clock minus UTC, s
+        (positive: it runs ahead; its stamps are true UTC plus this); and
+        ``estimate_time_constant_s``, the time constant of the first-order lag
+        of the autopilot's logged wind estimate behind the true wind at the
+        vehicle, s (None, JSON null: the log has no estimate).
     utc_offset_s : float
         UTC minus log clock, s.
     """
@@ -100,7 +106,7 @@ class Truth:
     takeoff_s: float
     touchdown_s: float
     controller: Mapping[str, float]
-    wind: Mapping[str, float] | None
+    wind: Mapping[str, float | None] | None
     utc_offset_s: float
 
     def to_json(self) -> dict[str, Any]:
@@ -170,7 +176,7 @@ def truth_of(flight: Flight) -> Truth:
     case, plant = flight.case, flight.plant
     structure: Literal["hover", "hover-wind"] = "hover-wind" if plant.has_wind_terms else "hover"
     trim = plant.trim
-    wind = None
+    wind: dict[str, float | None] | None = None
     if case.wind is not None:
         model = case.wind
         wind = {
@@ -182,6 +188,8 @@ def truth_of(flight: Flight) -> Truth:
             "anemometer_rate_hz": model.anemometer_rate_hz,
             "speed_noise_m_s": model.speed_noise_m_s,
             "direction_noise_deg": model.direction_noise_deg,
+            "clock_offset_s": model.clock_offset_s,
+            "estimate_time_constant_s": model.estimate_time_constant_s,
         }
     airborne = np.flatnonzero(flight.airborne)
     return Truth(

@@ -11,6 +11,8 @@ Topics, rates and phases (1 kHz grid, rate loop at 250 Hz)::
     vehicle_attitude           125 Hz  +2 ms   q (estimate)
     vehicle_attitude_setpoint   50 Hz  +0 ms   q_d
     vehicle_local_position      50 Hz  +3 ms   x y z vx vy vz (estimate), no rangefinder
+    wind                        10 Hz  +6 ms   windspeed_north, windspeed_east (EKF estimate; only when
+                                               the case's wind model asks for one)
     manual_control_setpoint     50 Hz  +5 ms   roll pitch yaw throttle (a pilot's sweep; centred otherwise)
     actuator_motors            100 Hz  +0 ms   8 motors, control[8..11] NaN
     sensor_gps                  10 Hz  +7 ms   time_utc_usec, position
@@ -33,7 +35,15 @@ from pathlib import Path
 import numpy as np
 
 from flightlogs.writers import TopicData, write_ulog
-from independent_sim._common import HOME_ALT_M, battery, geodetic, motor_commands, quaternion, sample_indices
+from independent_sim._common import (
+    HOME_ALT_M,
+    battery,
+    geodetic,
+    motor_commands,
+    quaternion,
+    sample_indices,
+    wind_estimate,
+)
 from independent_sim.flight import Flight
 from independent_sim.nuisances import keep_mask
 
@@ -49,6 +59,7 @@ PX4_RATES: Mapping[str, tuple[float, float]] = {
     "vehicle_attitude": (125.0, 0.002),
     "vehicle_attitude_setpoint": (50.0, 0.0),
     "vehicle_local_position": (50.0, 0.003),
+    "wind": (10.0, 0.006),
     "manual_control_setpoint": (50.0, 0.005),
     "actuator_motors": (100.0, 0.0),
     "sensor_gps": (10.0, 0.007),
@@ -160,7 +171,36 @@ def _estimates(flight: Flight, expected: Expected) -> list[TopicData]:
     )
     expected.update({name: (stamp / 1e6, velocity[name]) for name in velocity})
     expected["height_agl"] = (stamp / 1e6, -z)
-    return topics
+    return topics + _wind(flight, expected)
+
+
+def _wind(flight: Flight, expected: Expected) -> list[TopicData]:
+    """``wind`` (v1.14): the EKF's wind estimate, when the case logs one; no airspeed sensor, so no innovations."""
+    i, stamp = _stamps(flight, "wind")
+    estimate = wind_estimate(flight, i)
+    if estimate is None:
+        return []
+    north, east = estimate.astype(_F32).T
+    variance = np.full(i.size, 0.04, _F32)  # (0.2 m/s)²
+    zero = np.zeros(i.size, _F32)
+    expected["est_wind_n"], expected["est_wind_e"] = (stamp / 1e6, north), (stamp / 1e6, east)
+    return [
+        TopicData(
+            "wind",
+            {
+                "timestamp": stamp,
+                "timestamp_sample": stamp,
+                "windspeed_north": north,
+                "windspeed_east": east,
+                "variance_north": variance,
+                "variance_east": variance,
+                "tas_innov": zero,
+                "tas_innov_var": zero,
+                "beta_innov": zero,
+                "beta_innov_var": zero,
+            },
+        )
+    ]
 
 
 def _setpoints(flight: Flight, expected: Expected) -> list[TopicData]:

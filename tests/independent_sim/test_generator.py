@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from pyulog import ULog
 from scipy.integrate import solve_ivp
-from scipy.signal import csd, welch
+from scipy.signal import bilinear, csd, lfilter, lfilter_zi, welch
 
 import flightlogs.signals
 from flightlogs.conditioning.lag import transport_delay
@@ -439,6 +439,151 @@ def test_wind_truth_is_hover_wind(wind_files) -> None:
     assert truth.parameters["X_w_lon"] == -0.3560 and truth.parameters["Z_w_lon"] == 1.323
     assert truth.hover_parameters.keys() <= truth.parameters.keys()
     assert truth.trim["theta0"] == pytest.approx(math.radians(-4.36))
+
+
+# ------------------------------------------------------- wind: the anemometer's clock, the autopilot's estimate
+
+
+def _clock_case(fmt: str, offset_s: float, tau_s: float | None = 2.0, duration_s: float = 40.0) -> Case:
+    """A short flight in wind, the anemometer's logger `offset_s` ahead of UTC, the estimate lagging `tau_s`."""
+    wind = WindModel(
+        mean_speed_m_s=5.4, from_deg=250.0, sigma_m_s=0.75, clock_offset_s=offset_s, estimate_time_constant_s=tau_s
+    )
+    return Case(
+        name=f"short-clock-{fmt}",
+        fmt=fmt,  # type: ignore[arg-type]
+        plan=FlightPlan(duration_s=duration_s, log_start_us=47_500_000),
+        maneuvers=(Maneuver(axis="lon", design=Doublet(), start_s=12.0, amplitude=0.06),),
+        condition="strong",
+        wind=wind,
+        seed=14,
+    )
+
+
+@pytest.mark.parametrize("offset_s", [1.7, -2.3])
+def test_anemometer_stamps_are_true_utc_plus_the_logger_clock_offset(offset_s: float, tmp_path: Path) -> None:
+    """Placed at stamp - offset the CSV's wind is the true air at the anemometer within the sensor's bound;
+    taken at its stamp it is the air of another moment, clearly off."""
+    case = _clock_case("dataflash", offset_s, duration_s=30.0)
+    files = write_case(case, tmp_path)
+    flight = simulate(case)
+    model, field_ = case.wind, flight.wind
+    assert model is not None and field_ is not None and files.anemometer_csv is not None
+    measured = read_anemometer_csv(files.anemometer_csv)
+    assert files.truth.wind is not None and files.truth.wind["clock_offset_s"] == offset_s
+    logged = np.column_stack([measured.wind_n, measured.wind_e])
+
+    def true_at(utc_s: np.ndarray) -> np.ndarray:
+        log_s = utc_s - flight.utc_offset_s
+        return np.column_stack([np.interp(log_s, field_.time_s, field_.wind_ne[:, k]) for k in range(2)])
+
+    right = np.hypot(*(logged - true_at(measured.utc_s - offset_s)).T)
+    wrong = np.hypot(*(logged - true_at(measured.utc_s)).T)
+    # uniform speed error ±0.3 m/s, direction ±2° of up to (speed + 0.3) m/s; 0.001 m/s, 0.01° of rounding
+    bound = model.speed_noise_m_s + (measured.speed_m_s + 0.3) * math.radians(model.direction_noise_deg) + 0.002
+    assert np.all(right <= bound)
+    assert np.mean(wrong > bound) > 0.1 and np.sqrt(np.mean(wrong**2)) > 1.5 * np.sqrt(np.mean(right**2))
+    # the record covers, in true time, the log plus the transport delay and 5 s (less one or two samples) each side
+    log = read_log(files.log)
+    start, end = np.array(log.time_range_s) + log.utc_offset_s
+    assert measured.utc_s[0] - offset_s <= start - model.transport_delay_s - 5.0
+    assert measured.utc_s[-1] - offset_s >= end + 5.0 - 2.0 / model.anemometer_rate_hz
+
+
+def _first_order_lag(time_s: np.ndarray, values: np.ndarray, tau_s: float) -> np.ndarray:
+    """1 / (tau s + 1) by the bilinear transform, at rest at the first value."""
+    b, a = bilinear([1.0], [tau_s, 1.0], fs=1.0 / (time_s[1] - time_s[0]))
+    return lfilter(b, a, values, zi=lfilter_zi(b, a) * values[0])[0]
+
+
+@pytest.mark.parametrize("fmt", ["ulog", "dataflash"])
+def test_autopilot_wind_estimate_is_the_true_wind_lagged(fmt: str, tmp_path: Path) -> None:
+    """est_wind_n/e read back by the workbench: the true wind at the vehicle through 1 / (tau s + 1), plus noise
+    of 0.05 m/s, and late by a good part of tau. The cross-correlation of a first-order lag with Dryden
+    turbulence of time scale L / V peaks at ln(2 / (1 + r)) / (1 - r) tau, r = tau V / L (0.61 tau here);
+    over 40 s of flight the peak falls at 0.4-0.75 tau (seeds 40-69: 29 of 30 at 0.5 tau or more)."""
+    tau = 2.0
+    files = write_case(_clock_case(fmt, 0.0, tau), tmp_path)
+    flight = simulate(_clock_case(fmt, 0.0, tau))
+    log = read_log(files.log)
+    assert not log.warnings
+    assert files.truth.wind is not None and files.truth.wind["estimate_time_constant_s"] == tau
+    north, east = log["est_wind_n"], log["est_wind_e"]
+    assert north.rate_hz == pytest.approx(10.0 if fmt == "ulog" else 25.0, rel=1e-3)
+    np.testing.assert_array_equal(north.time_s, files.expected["est_wind_n"][0])
+    np.testing.assert_allclose(east.values, files.expected["est_wind_e"][1], atol=1e-6)
+    index = np.rint((north.time_s - flight.time_s[0]) * 1e6 / flight.step_us).astype(int)
+    true = np.column_stack([flight.truth["wind_n"], flight.truth["wind_e"]])
+    lagged = np.column_stack([_first_order_lag(flight.time_s, true[:, k], tau) for k in range(2)])[index]
+    estimate = np.column_stack([north.values, east.values])
+    assert np.sqrt(np.mean((estimate - lagged) ** 2)) < 0.15
+    assert np.sqrt(np.mean((estimate - true[index]) ** 2)) > 0.15  # the lag shows (0.5 m/s RMS here)
+    airborne = flight.airborne[index]
+    x, y, rate = true[index][airborne], estimate[airborne], north.rate_hz
+
+    def correlation(k: int) -> float:  # Pearson, both components, estimate k samples after the truth
+        a, b = x[: x.shape[0] - k], y[k:]
+        a, b = a - a.mean(axis=0), b - b.mean(axis=0)
+        return float(np.sum(a * b) / np.sqrt(np.sum(a * a) * np.sum(b * b)))
+
+    lags = np.arange(int(4 * tau * rate) + 1)
+    peak = lags[np.argmax([correlation(int(k)) for k in lags])] / rate
+    assert 0.5 * tau <= peak < 1.5 * tau
+
+
+@pytest.mark.parametrize("fmt", ["ulog", "dataflash"])
+def test_wind_model_without_a_clock_offset_or_estimate_writes_the_same_bytes(fmt: str, tmp_path: Path) -> None:
+    """clock_offset_s=0.0 and estimate_time_constant_s=None are the defaults: the log and CSV do not change."""
+    plain = _wind_case()
+    assert plain.wind is not None
+    explicit = replace(plain, wind=replace(plain.wind, clock_offset_s=0.0, estimate_time_constant_s=None))
+    (tmp_path / "plain").mkdir()
+    (tmp_path / "explicit").mkdir()
+    first = write_case(plain, tmp_path / "plain", fmt)  # type: ignore[arg-type]
+    second = write_case(explicit, tmp_path / "explicit", fmt)  # type: ignore[arg-type]
+    assert first.anemometer_csv is not None and second.anemometer_csv is not None
+    assert first.log.read_bytes() == second.log.read_bytes()
+    assert first.anemometer_csv.read_bytes() == second.anemometer_csv.read_bytes()
+    assert "est_wind_n" not in read_log(first.log).signals
+    assert first.truth.wind is not None
+    assert (first.truth.wind["clock_offset_s"], first.truth.wind["estimate_time_constant_s"]) == (0.0, None)
+
+
+def test_wind_model_rejects_a_wild_clock_or_a_time_constant_not_positive() -> None:
+    for bad in ({"clock_offset_s": 30.5}, {"clock_offset_s": -31.0}, {"clock_offset_s": math.nan}):
+        with pytest.raises(ValueError, match="clock_offset_s"):
+            WindModel(**bad)
+    for tau in (0.0, -1.0, math.inf):
+        with pytest.raises(ValueError, match="estimate_time_constant_s"):
+            WindModel(estimate_time_constant_s=tau)
+    assert WindModel(clock_offset_s=-30.0, estimate_time_constant_s=0.5).clock_offset_s == -30.0
+
+
+def test_clock_cases_of_the_catalogue() -> None:
+    """Windy with the CSV, two lon sweeps, a thr sweep, four doublets; seeds of their own; the calm one calm."""
+    existing = {c.seed for c in TUNING_CASES + HELDOUT_CASES if "wind-c" not in c.name}
+    tuning = {c.name: c for c in TUNING_CASES if c.name.startswith("tune-wind-clock-")}
+    heldout = {c.name: c for c in HELDOUT_CASES if c.name.startswith(("heldout-wind-clock-", "heldout-wind-calm"))}
+    offsets = [sorted(c.wind.clock_offset_s for c in cases.values() if c.wind) for cases in (tuning, heldout)]
+    assert offsets == [[-0.9, 1.7], [-2.3, 0.0, 0.4, 1.2, 2.6]]
+    cases = [*tuning.values(), *heldout.values()]
+    assert {c.fmt for c in tuning.values()} == {c.fmt for c in heldout.values()} == {"ulog", "dataflash"}
+    seeds = [c.seed for c in cases]
+    assert len(set(seeds)) == len(seeds) and all(300 <= s < 400 for s in seeds) and not set(seeds) & existing
+    for case in cases:
+        model = case.wind
+        assert model is not None and model.estimate_time_constant_s is not None
+        assert 2.0 <= model.estimate_time_constant_s <= 4.0
+        sweeps = [m.axis for m in case.maneuvers if m.design.kind == "sweep"]
+        doublets = [m.axis for m in case.maneuvers if m.design.kind == "doublet"]
+        assert sweeps.count("lon") >= 2 and "thr" in sweeps, case.name
+        assert doublets.count("lon") >= 2 and doublets.count("thr") >= 2, case.name
+        if case.name == "heldout-wind-calm":
+            assert (model.mean_speed_m_s, model.sigma_m_s, model.clock_offset_s) == (0.8, 0.05, 1.2)
+            assert case.condition == "calm" and not hover_plant(case.condition).has_wind_terms
+        else:
+            assert 4.0 <= model.mean_speed_m_s <= 6.0 and 0.6 <= model.sigma_m_s <= 0.9, case.name
+            assert case.condition == "strong" and hover_plant(case.condition).has_wind_terms
 
 
 # ----------------------------------------------------------------------------- catalogue

@@ -5,7 +5,13 @@ measures at time ``t`` reaches the vehicle, ``distance_m`` downstream, at
 ``t + distance_m / mean_speed_m_s``. The anemometer samples it at 20 Hz with
 bounded noise (±0.3 m/s, ±2°) and its record is written as a CSV the
 workbench's :func:`flightlogs.readers.read_anemometer_csv` accepts: ISO-8601
-UTC time, speed and the direction the wind comes FROM.
+UTC time, speed and the direction the wind comes FROM. The anemometer's logger
+may keep its own clock (``clock_offset_s``): each sample is stamped with the
+logger's time, not UTC.
+
+The autopilot may log its own wind estimate (``estimate_time_constant_s``):
+the true wind at the vehicle through a first-order low-pass
+(:func:`lagged_estimate`), what an EKF's slowly wandering wind states give.
 """
 
 from __future__ import annotations
@@ -20,7 +26,20 @@ from scipy.signal import bilinear, butter, lfilter, sosfiltfilt
 
 from flightlogs.writers import atomic_output
 
-__all__ = ["WindModel", "WindField", "wind_field", "write_anemometer_csv"]
+__all__ = [
+    "WindModel",
+    "WindField",
+    "wind_field",
+    "write_anemometer_csv",
+    "lagged_estimate",
+    "MAX_CLOCK_OFFSET_S",
+    "ESTIMATE_NOISE_M_S",
+]
+
+#: Largest anemometer clock error a case may have, s.
+MAX_CLOCK_OFFSET_S = 30.0
+#: Standard deviation of the white noise on each logged sample of the autopilot's wind estimate, m/s.
+ESTIMATE_NOISE_M_S = 0.05
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -49,6 +68,16 @@ class WindModel:
         Bound of the anemometer's uniform speed error, m/s.
     direction_noise_deg : float
         Bound of its uniform direction error, degrees.
+    clock_offset_s : float
+        The anemometer logger's clock minus UTC, s (positive: the logger runs
+        ahead); the air measured at UTC ``t`` is stamped ``t + clock_offset_s``.
+        At most :data:`MAX_CLOCK_OFFSET_S` in magnitude.
+    estimate_time_constant_s : float or None
+        When given, the log carries the autopilot's wind estimate: the true
+        wind at the vehicle through a first-order low-pass of this time
+        constant, s (PX4 ``wind``, ArduPilot ``XKF2``), plus white noise of
+        :data:`ESTIMATE_NOISE_M_S` on each logged sample; None: no estimate
+        logged.
     """
 
     mean_speed_m_s: float = 5.4
@@ -60,6 +89,8 @@ class WindModel:
     anemometer_rate_hz: float = 20.0
     speed_noise_m_s: float = 0.3
     direction_noise_deg: float = 2.0
+    clock_offset_s: float = 0.0
+    estimate_time_constant_s: float | None = None
 
     def __post_init__(self) -> None:
         if self.mean_speed_m_s <= 0.5:
@@ -68,6 +99,11 @@ class WindModel:
             raise ValueError(f"{self.sigma_m_s=} must be < 0.5 × mean speed (Taylor's hypothesis)")
         if self.distance_m <= 0.0 or self.anemometer_rate_hz <= 0.0 or self.scale_m <= 0.0:
             raise ValueError("distance_m, anemometer_rate_hz and scale_m must be > 0")
+        if not abs(self.clock_offset_s) <= MAX_CLOCK_OFFSET_S:
+            raise ValueError(f"{self.clock_offset_s=} s must be within ±{MAX_CLOCK_OFFSET_S:g} s")
+        tau = self.estimate_time_constant_s
+        if tau is not None and not (math.isfinite(tau) and tau > 0.0):
+            raise ValueError(f"{self.estimate_time_constant_s=} s must be > 0 (or None: no estimate logged)")
 
     @property
     def transport_delay_s(self) -> float:
@@ -181,17 +217,19 @@ def wind_field(
 def write_anemometer_csv(
     path: Path, field: WindField, *, log_start_s: float, log_end_s: float, utc_offset_s: float, rng: np.random.Generator
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Sample the anemometer over a log and write its CSV.
+    """Sample the anemometer over a log and write its CSV, stamped by the logger's clock.
 
     Parameters
     ----------
     path : Path
         Destination ``.csv``.
     field : WindField
-        The wind at the anemometer.
+        The wind at the anemometer; ``field.model.clock_offset_s`` is the
+        logger's clock error.
     log_start_s, log_end_s : float
-        Log span on the log's clock, s; the record starts a transport delay
-        plus 5 s before and ends 5 s after.
+        Log span on the log's clock, s; the record covers, in true time, from
+        a transport delay plus 5 s before the start to 5 s after the end,
+        whatever the logger's clock error.
     utc_offset_s : float
         UTC minus log clock, s.
     rng : numpy.random.Generator
@@ -200,19 +238,23 @@ def write_anemometer_csv(
     Returns
     -------
     tuple of ndarray
-        UTC of each sample (UNIX s) and the measured ``wind_ne`` (shape (n, 2), m/s).
+        Each sample's stamp on the logger's clock, i.e. its true UTC plus
+        ``clock_offset_s`` (UNIX s, shape (n,)), and the measured ``wind_ne``
+        (shape (n, 2), m/s).
 
     Notes
     -----
     Columns ``time_utc`` (ISO-8601 with milliseconds and ``Z``),
-    ``speed_m_s`` and ``direction_deg`` (meteorological, FROM).
+    ``speed_m_s`` and ``direction_deg`` (meteorological, FROM). The stamps
+    start on a whole second of the logger's clock.
     """
     model = field.model
     step = 1.0 / model.anemometer_rate_hz
-    first_utc = math.floor(log_start_s + utc_offset_s - model.transport_delay_s - 5.0)
-    utc = first_utc + step * np.arange(int((log_end_s + utc_offset_s + 5.0 - first_utc) / step))
+    ahead = model.clock_offset_s
+    first_utc = math.floor(log_start_s + utc_offset_s - model.transport_delay_s - 5.0 + ahead)
+    utc = first_utc + step * np.arange(int((log_end_s + utc_offset_s + 5.0 + ahead - first_utc) / step))
     utc = np.round(utc, 3)
-    true = np.column_stack([np.interp(utc - utc_offset_s, field.time_s, field.wind_ne[:, k]) for k in range(2)])
+    true = np.column_stack([np.interp(utc - ahead - utc_offset_s, field.time_s, field.wind_ne[:, k]) for k in range(2)])
     speed = np.hypot(true[:, 0], true[:, 1]) + rng.uniform(-1, 1, utc.size) * model.speed_noise_m_s
     speed = np.round(np.clip(speed, 0.0, None), 3)
     toward = np.degrees(np.arctan2(true[:, 1], true[:, 0]))
@@ -226,3 +268,35 @@ def write_anemometer_csv(
     with atomic_output(path) as tmp:
         tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return utc, measured
+
+
+def lagged_estimate(time_s: np.ndarray, wind_ne: np.ndarray, time_constant_s: float) -> np.ndarray:
+    """An estimator's view of the wind: a causal first-order low-pass started at the first sample.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (n,)
+        Uniform grid, s.
+    wind_ne : ndarray, shape (n, 2)
+        True wind at the vehicle, north and east, m/s.
+    time_constant_s : float
+        Time constant of the low-pass, s.
+
+    Returns
+    -------
+    ndarray, shape (n, 2)
+        ``y[k] = y[k-1] + (1 - exp(-dt / tau)) (x[k] - y[k-1])``, ``y[0] = x[0]``, m/s.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 10.0, 0.01)
+    >>> step = np.column_stack([np.r_[0.0, np.ones(t.size - 1)], np.zeros(t.size)])
+    >>> round(float(lagged_estimate(t, step, 2.0)[200, 0]), 3)  # one time constant after the step
+    0.632
+    """
+    dt = float(time_s[1] - time_s[0])
+    alpha = -math.expm1(-dt / time_constant_s)
+    x = np.asarray(wind_ne, dtype=np.float64)
+    return np.column_stack(
+        [lfilter([alpha], [1.0, alpha - 1.0], x[:, k], zi=[(1.0 - alpha) * x[0, k]])[0] for k in range(x.shape[1])]
+    )

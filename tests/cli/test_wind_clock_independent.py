@@ -1,0 +1,161 @@
+"""Issue 31: the wind step on data as it comes, on the independent generator's held-out windy cases.
+
+An anemometer logger's clock off by 0-2.6 s (either sign), an autopilot wind
+estimate lagging the air by a 2-4 s time constant, PX4 and ArduPilot; the
+thresholds of :mod:`sysid.fit.wind_offset` were set on the chapter 3
+campaign and the generator's ``tune-wind-clock-*`` cases, never on these.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from independent_sim.corpus import CaseFiles, Truth
+from independent_sim.fixtures import independent_corpus_fixture  # noqa: F401 (registers the fixture)
+
+from sysid_cli.main import cli
+
+WINDY = (
+    "heldout-wind-clock-ap-ahead",
+    "heldout-wind-clock-px4-behind",
+    "heldout-wind-clock-px4-slight",
+    "heldout-wind-clock-ap-none",
+)
+
+
+def _wind(files: CaseFiles) -> list[str]:
+    """The anemometer, its distance, and the maneuvers (sweeps in 6 m/s of wind are not all detected: issue 32)."""
+    return ["--segments", str(files.segments_csv), "--wind", str(files.anemometer_csv), "--wind-distance", "4.6"]
+
+
+def _fit(files: CaseFiles, folder: Path, *extra: str) -> tuple[dict, str]:
+    """``sysid fit`` of the case's log with its anemometer: the model file's document and what went to stderr."""
+    model = folder / "model.json"
+    done = CliRunner().invoke(
+        cli, ["fit", str(files.log), *_wind(files), *extra, "--model", "hover-wind", "--partial", "-o", str(model)]
+    )
+    assert done.exit_code == 0, done.output
+    return json.loads(model.read_text()), done.stderr
+
+
+@dataclass(frozen=True)
+class _Outcome:
+    """One held-out case fitted and validated: its truth, its model file and its validation summary."""
+
+    truth: Truth
+    model: dict
+    validation: dict
+    report: str
+
+
+@pytest.fixture(scope="module", name="outcomes")
+def outcomes_fixture(independent_corpus, tmp_path_factory: pytest.TempPathFactory) -> dict[str, _Outcome]:  # type: ignore[no-untyped-def]
+    """Each windy held-out case fitted, then validated with that model (the offset the fit measured)."""
+    out = {}
+    for name in WINDY:
+        files, folder = independent_corpus.files(name), tmp_path_factory.mktemp(name)
+        model, _ = _fit(files, folder, "--report", str(folder / "report.html"))
+        summary = folder / "validation.json"
+        checked = CliRunner().invoke(
+            cli, ["validate", str(folder / "model.json"), str(files.log), *_wind(files), "--json", str(summary), "-q"]
+        )
+        assert checked.exit_code == 0, checked.output
+        report = (folder / "report.html").read_text(encoding="utf-8")
+        out[name] = _Outcome(truth=files.truth, model=model, validation=json.loads(summary.read_text()), report=report)
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", WINDY)
+def test_the_clock_offset_and_the_transport_delay_are_found(outcomes: dict[str, _Outcome], name: str) -> None:
+    """Measured on the four: offsets within 0.03 s of +2.6, -2.3, +0.4, 0.0; delays within 0.01 s."""
+    truth, clock = outcomes[name].truth.wind, outcomes[name].model["wind"]["clock_offset"]
+    assert truth is not None and clock["measured"], clock["reason"]
+    assert abs(clock["clock_offset_s"] - truth["clock_offset_s"]) <= 0.2, (clock["clock_offset_s"], truth)
+    assert abs(clock["transport_delay_s"] - truth["transport_delay_s"]) <= 0.15, (clock["transport_delay_s"], truth)
+    assert any("as the model's fit measured it" in note for note in outcomes[name].validation["notes"])
+
+
+@pytest.mark.slow
+def test_the_report_draws_the_cost_against_the_offset(outcomes: dict[str, _Outcome]) -> None:
+    outcome = outcomes["heldout-wind-clock-ap-ahead"]
+    section = outcome.report.split('id="clock-offset"', 1)[1].split("<h2", 1)[0]
+    found = outcome.model["wind"]["clock_offset"]
+    assert "<svg" in section and f"Found {found['clock_offset_s']:+.2f} ± {found['sigma_s']:.2f} s." in section
+    assert f"anemometer clock offset {found['clock_offset_s']:+.2f}" in outcome.report  # the card's wind line
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", WINDY)
+def test_the_wind_terms_come_within_15_percent(outcomes: dict[str, _Outcome], name: str) -> None:
+    """Measured: X_w_lon -3 to -12 %, Z_w_lon -1 to -11 % (X_u estimated again with them: -3 to -10 %)."""
+    parameters, truth = outcomes[name].model["parameters"], outcomes[name].truth.parameters
+    for term in ("X_w_lon", "Z_w_lon", "X_u"):
+        assert parameters[term]["status"] == "estimated", (term, parameters[term])
+        assert abs(parameters[term]["value"] / truth[term] - 1) <= 0.15, (term, parameters[term], truth[term])
+    assert parameters["X_u"]["stage"] == "wind"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", WINDY)
+def test_the_wind_term_cuts_the_doublets_ax_error(outcomes: dict[str, _Outcome], name: str) -> None:
+    """Measured: ax -65 to -84 %; az -15 to -77 % (the floor of 20 % on az: below)."""
+    correction = outcomes[name].validation["wind_correction"]
+    assert correction["ax"]["reduction_percent"] >= 20.0, correction
+    assert correction["az"]["reduction_percent"] > 0.0, correction
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="az cut 19.7 % and 14.7 % on the two ArduPilot cases (77 % and 28 % on PX4): issue 31 stays open on it",
+)
+def test_the_wind_term_cuts_every_cases_az_error_by_20_percent(outcomes: dict[str, _Outcome]) -> None:
+    cuts = {n: o.validation["wind_correction"]["az"]["reduction_percent"] for n, o in outcomes.items()}
+    assert min(cuts.values()) >= 20.0, cuts
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="the bounds are too tight: X_w_lon's truth is inside 2 CR on 1 of 4 cases, Z_w_lon's on 3 of 4 (the "
+    "estimates all fall short, by 1-12 %, at CR 1.7-3.4 % with step 1's uncertainty carried in): issue 31 stays open",
+)
+def test_the_truth_is_inside_2_cr(outcomes: dict[str, _Outcome]) -> None:
+    for outcome in outcomes.values():
+        for term in ("X_w_lon", "Z_w_lon"):
+            parameter, truth = outcome.model["parameters"][term], outcome.truth.parameters[term]
+            assert abs(parameter["value"] / truth - 1) * 100 <= 2 * parameter["cr_percent"], (term, parameter, truth)
+
+
+@pytest.mark.slow
+def test_the_true_offset_given_raises_no_warning(independent_corpus, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """On the held-out case whose logger keeps UTC, and on one whose clock runs 2.6 s ahead, given as such."""
+    for name in ("heldout-wind-clock-ap-none", "heldout-wind-clock-ap-ahead"):
+        files = independent_corpus.files(name)
+        assert files.truth.wind is not None
+        given = f"{files.truth.wind['clock_offset_s']:.2f}"
+        folder = tmp_path / name
+        folder.mkdir()
+        doc, stderr = _fit(files, folder, "--wind-offset", given)
+        assert "clock offset given" not in stderr and "not identified" not in stderr, stderr
+        clock = doc["wind"]["clock_offset"]
+        assert clock["measured"] and abs(clock["clock_offset_s"] - float(given)) <= 0.2, clock
+
+
+@pytest.mark.slow
+def test_calm_air_claims_no_wind_term(independent_corpus, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """A breath of wind (0.8 m/s, turbulence 0.05 m/s) on the calm airframe: the clock cannot be timed, no G_w.
+
+    Before the gate, X_w_lon came out -0.29 ± 0.02 here: X_u's share of the anemometer's noise, which reaches
+    the residual through u (the tuning case ``tune-wind-calm`` showed it first)."""
+    files = independent_corpus.files("heldout-wind-calm")
+    doc, stderr = _fit(files, tmp_path)
+    assert "the anemometer's wind cannot be timed against the flight" in stderr, stderr
+    for term in ("X_w_lon", "Z_w_lon"):
+        assert doc["parameters"][term]["status"] == "unidentified", doc["parameters"][term]
+    assert any("anemometer clock offset not measured" in note for note in doc["notes"]), doc["notes"]
