@@ -25,8 +25,12 @@ at their starting values), over all the campaign's wind records at once
 The scan claims an offset only when the wind carries information: the
 minimum inside the scanned range, sharp (sigma at most
 :data:`MAX_SIGMA_S`), and deep (the residual there at least
-:data:`MIN_CONTRAST` below its median over the scan). In calm air none holds and the offset
-in use is kept, with the reason said.
+:data:`MIN_CONTRAST` below its median over the scan). Otherwise the offset
+in use is kept, with the reason said; and when the wind cannot be timed at
+all (too shallow, or at the scan's edge: calm air) the G_w terms are not
+fitted either (:func:`untimed_wind`). The wind the scan and the wind step
+regress on is low-passed at :data:`SMOOTHING_HZ` (zero phase): the
+anemometer's own noise would otherwise shrink every estimate on it.
 """
 
 from __future__ import annotations
