@@ -31,7 +31,7 @@ from .html import render_html, write_html
 from .model_figures import correlation_figure, pole_map_figure, response_figures
 from .svg import figure_svg
 from .verify_section import sized_svg, verification_context
-from .wind_figures import clock_offset_figure
+from .wind_figures import clock_offset_figure, wind_trace_figure
 
 __all__ = ["CORRELATION_FLAG", "model_report_html", "write_model_report"]
 
@@ -69,6 +69,11 @@ def _wind_text(model: IdentifiedModel) -> str:
 def _clock_offset(model: IdentifiedModel) -> tuple[str, str, float] | None:
     clock = model.wind.clock_offset if model.wind is not None else None
     return _shown(clock_offset_figure(clock), "") if clock is not None else None
+
+
+def _wind_trace(model: IdentifiedModel) -> tuple[str, str, float] | None:
+    trace = model.wind.trace if model.wind is not None else None
+    return _shown(wind_trace_figure(trace), "") if trace is not None else None
 
 
 def _card(
@@ -304,6 +309,7 @@ def model_report_html(
         "modes": _mode_rows(found),
         "poles": _shown(pole_map_figure(found), "") if found else None,
         "clock_offset": _clock_offset(model),
+        "wind_trace": _wind_trace(model),
         "guidelines": verdict.guidelines,
         "correlation_flag": CORRELATION_FLAG,
         "options": _flatten(model.provenance.options),

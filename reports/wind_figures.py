@@ -1,4 +1,4 @@
-"""Figures of the wind step: the residual of eq. 3.14 against the anemometer's clock offset (issue 31)."""
+"""Figures of the wind step: the residual of eq. 3.14 against the anemometer's clock offset, and the wind's timing."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from sysid.fit.result import WindClockOffset
+from sysid.fit.result import WindClockOffset, WindTrace
 
 from .svg import new_figure
 
-__all__ = ["clock_offset_figure"]
+__all__ = ["clock_offset_figure", "wind_trace_figure"]
 
 
 def clock_offset_figure(clock: WindClockOffset) -> Figure:
@@ -53,6 +53,59 @@ def clock_offset_figure(clock: WindClockOffset) -> Figure:
         )
     ax.set_xlabel("anemometer clock offset, s")
     ax.set_ylabel("residual / median")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    figure.tight_layout()
+    return figure
+
+
+def wind_trace_figure(trace: WindTrace) -> Figure:
+    """One record's along-nose wind at the anemometer, where the vehicle met it, and as its accelerations felt it.
+
+    Parameters
+    ----------
+    trace : WindTrace
+        The record's winds (m/s, less their mean) against the log's clock (s).
+
+    Returns
+    -------
+    Figure
+        One panel: the anemometer's reading (thin, grey), the same air at the vehicle after the transport
+        delay, and the accelerometer's residual of eq. 3.14 read as wind through the G_w gain; the
+        correlation of each reading with the accelerations in the legend.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 30.0, 0.1)
+    >>> air = np.sin(0.7 * t) + 0.3 * np.sin(2.1 * t)
+    >>> trace = WindTrace(record="lon sweep", time_s=t, at_anemometer_m_s=np.roll(air, -9), at_vehicle_m_s=air,
+    ...     from_accelerations_m_s=air + 0.05, output="ax", gain=-0.36, transport_delay_s=0.9, smoothing_hz=2.0)
+    >>> len(wind_trace_figure(trace).axes)
+    1
+    """
+    figure, created = new_figure(1, 1, width_in=7.0, height_in=2.8)
+    ax = cast(Axes, created)
+    felt = trace.from_accelerations_m_s
+
+    def agreement(wind: np.ndarray) -> str:
+        return f"r = {float(np.corrcoef(wind, felt)[0, 1]):.2f}"
+
+    lines = (
+        (trace.at_anemometer_m_s, f"at the anemometer ({agreement(trace.at_anemometer_m_s)})", "0.6", 0.9, "-"),
+        (
+            trace.at_vehicle_m_s,
+            f"at the vehicle, {trace.transport_delay_s:.2f} s later ({agreement(trace.at_vehicle_m_s)})",
+            "C0",
+            1.2,
+            "-",
+        ),
+        (felt, f"from {trace.output}: residual / G_w {trace.gain:.3g} 1/s", "C3", 1.0, "--"),
+    )
+    for wind, label, color, width, style in lines:
+        ax.plot(trace.time_s, wind, color=color, lw=width, ls=style, label=label)
+    ax.set_xlabel(f"log time, s ({trace.record})")
+    ax.set_ylabel("along-nose wind less mean, m/s")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="best")
     figure.tight_layout()

@@ -27,19 +27,23 @@ from flightlogs.errors import FitError, FitWarning, collected_warnings
 from flightlogs.record import Record
 from flightlogs.store.dataset import file_sha256
 from flightlogs.writers.jsonio import jsonable
+from sysid.fit.accuracy import Accuracy
 from sysid.fit.axes import merge_axes, partial_warning, structure_axes, unidentified_message
 from sysid.fit.engine import FitOptions, FrequencyFit, fit_frequency_responses
+from sysid.fit.guidelines import Guidelines
 from sysid.fit.reduce import ReductionStep
 from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance, WindClockOffset
 from sysid.fit.wind import (
     WindStepResult,
     fit_wind,
     speed_derivatives,
+    speed_spread,
     step_one_spread,
     unfitted_wind,
     with_spread,
 )
 from sysid.fit.wind_offset import moved_flights, moved_wind, offset_given, timed_wind, untimed_wind
+from sysid.fit.wind_trace import wind_trace
 from sysid.freqresp import (
     FrequencyResponse,
     ResponseOptions,
@@ -327,43 +331,107 @@ def _identified(
             if untimed:
                 wind = unfitted_wind(structure, untimed)
             else:
-                estimated = [n for n, status in fit.status.items() if status == "estimated"]
-                speed, speed_accuracy = speed_derivatives(
-                    structure, fit.values, constants, records, estimated, outputs=options.wind_outputs
-                )
-                wind = fit_wind(
-                    structure,
-                    dict(fit.values) | speed,
-                    constants,
-                    records,
-                    outputs=options.wind_outputs,
-                    reduce=options.fit.reduce,
-                    max_cr_percent=options.fit.max_cr_percent,
-                    max_insensitivity_percent=options.fit.max_insensitivity_percent,
-                )
-                delays = {n: v for n, v in wind.values.items() if n in structure.wind_parameters and math.isfinite(v)}
-                spread = step_one_spread(
-                    structure,
-                    fit.values,
-                    constants,
-                    records,
-                    estimated,
-                    fit.accuracy,
-                    delays=delays,
-                    outputs=options.wind_outputs,
-                )
-                wind = dataclasses.replace(
-                    wind,
-                    accuracy=with_spread(wind.accuracy, spread),
-                    speed_values=speed,
-                    speed_accuracy=with_spread(speed_accuracy, spread) if speed else None,
-                )
+                wind = _wind_step(structure, fit, constants, records, options)
             if wind.fit is not None:
-                wind = dataclasses.replace(wind, fit=dataclasses.replace(wind.fit, clock_offset=clock))
+                identified = dict(fit.values) | dict(wind.speed_values) | dict(wind.values)
+                trace = wind_trace(structure, identified, constants, records, flights)
+                wind = dataclasses.replace(wind, fit=dataclasses.replace(wind.fit, clock_offset=clock, trace=trace))
         else:
             notes.append(f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give --wind)")
     _report(progress, "done", len(_AXES) + 2, len(_AXES) + 2)
     return model_from_fit(fit, wind, trim=trim, provenance=_provenance(files, options), notes=notes)
+
+
+def _wind_step(
+    structure: ModelStructure,
+    fit: FrequencyFit,
+    constants: Mapping[str, float],
+    records: Sequence[Record],
+    options: IdentifyOptions,
+) -> WindStepResult:
+    """G_w at the speed derivatives estimated again with it; the bounds carry step 1's uncertainty and theirs.
+
+    A speed derivative the joint solution cannot measure (its I% and its CR%
+    both beyond the guidelines, from the solution's own information: Z_w
+    where the thrust loop holds w, CR 100-118 % on the generator's flights)
+    is dropped, as step 1's reduction would (unless reduction is off), and
+    the rest solved again without it.
+    """
+    estimated = [n for n, status in fit.status.items() if status == "estimated"]
+    values, dropped = dict(fit.values), []
+    while True:
+        speed, speed_accuracy = speed_derivatives(
+            structure, values, constants, records, estimated, outputs=options.wind_outputs
+        )
+        step = (
+            _unmeasured(structure, speed, speed_accuracy, options.fit.guidelines, fit) if options.fit.reduce else None
+        )
+        if step is None:
+            break
+        dropped.append(step)
+        values[step.parameter], estimated = step.value, [n for n in estimated if n != step.parameter]
+
+    def fitted(speeds: Mapping[str, float]) -> WindStepResult:
+        return fit_wind(
+            structure,
+            values | dict(speeds),
+            constants,
+            records,
+            outputs=options.wind_outputs,
+            reduce=options.fit.reduce,
+            max_cr_percent=options.fit.max_cr_percent,
+            max_insensitivity_percent=options.fit.max_insensitivity_percent,
+        )
+
+    wind = fitted(speed)
+    delays = {n: v for n, v in wind.values.items() if n in structure.wind_parameters and math.isfinite(v)}
+    spread = step_one_spread(
+        structure, values, constants, records, estimated, fit.accuracy, delays=delays, outputs=options.wind_outputs
+    )
+    speed_accuracy = with_spread(speed_accuracy, spread)
+    at_speeds = speed_spread(wind, speed, speed_accuracy, fitted)
+    return dataclasses.replace(
+        wind,
+        accuracy=with_spread(with_spread(wind.accuracy, spread), at_speeds),
+        reduction=(*dropped, *wind.reduction),
+        speed_values=speed | {s.parameter: s.value for s in dropped},
+        speed_accuracy=speed_accuracy if speed else None,
+        speed_dropped=tuple(s.parameter for s in dropped),
+    )
+
+
+def _unmeasured(
+    structure: ModelStructure,
+    speed: Mapping[str, float],
+    speed_accuracy: Accuracy,
+    guidelines: Guidelines,
+    fit: FrequencyFit,
+) -> ReductionStep | None:
+    """The speed derivative of the joint solution furthest beyond both guidelines (I% and CR%), or None."""
+    worst, worst_ins = None, 0.0
+    for k, name in enumerate(speed_accuracy.names):
+        ins, cr = float(speed_accuracy.insensitivity_percent[k]), float(speed_accuracy.cramer_rao_percent[k])
+        if name in speed and ins > guidelines.max_insensitivity_percent and cr > guidelines.max_cr_percent:
+            if ins > worst_ins:
+                worst, worst_ins = (name, speed[name], cr, ins), ins
+    if worst is None:
+        return None
+    name, estimate, cr, ins = worst
+    return ReductionStep(
+        step=0,
+        parameter=name,
+        action="dropped",
+        value=structure.parameter(name).drop_value,
+        estimate=estimate,
+        cr_percent=cr,
+        insensitivity_percent=ins,
+        reason=(
+            f"I% = {ins:.3g} > {guidelines.max_insensitivity_percent:g} and CR% = {cr:.3g} > "
+            f"{guidelines.max_cr_percent:g} when estimated again with G_w (wind step)"
+        ),
+        cost_average=fit.cost.average,
+        cost_average_after=fit.cost.average,
+    )
 
 
 def _moves(clock: WindClockOffset, flights: Sequence[ConditionedFlight]) -> bool:
@@ -492,7 +560,8 @@ def model_from_fit(
             unit = unit.replace("{" + signal + "}", text)
         unit = unit.replace("{", "unit of ").replace("}", "")  # an input with no response: its unit is not known
         if wind is not None and p.name in wind.speed_values:  # estimated again with G_w
-            status, value, stage = fit.status[p.name], wind.speed_values[p.name], "wind"
+            status = "dropped" if p.name in wind.speed_dropped else fit.status[p.name]
+            value, stage = wind.speed_values[p.name], "wind"
         elif p.name in fit.status:
             status, value, stage = fit.status[p.name], fit.values[p.name], "frequency"
         elif wind is not None:

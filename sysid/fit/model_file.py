@@ -41,6 +41,7 @@ from sysid.fit.result import (
     Provenance,
     WindClockOffset,
     WindFit,
+    WindTrace,
 )
 from sysid.freqresp import FrequencyResponse
 
@@ -106,6 +107,7 @@ def model_to_dict(model: IdentifiedModel) -> dict[str, Any]:
             "rms_after": [_num(v) for v in model.wind.rms_after],
             "samples": model.wind.samples,
             "clock_offset": _clock_offset_doc(model.wind.clock_offset),
+            "trace": _trace_doc(model.wind.trace),
         },
         "provenance": {
             "files": list(model.provenance.files),
@@ -295,6 +297,7 @@ def _wind(doc: Mapping[str, Any], f: _Fields) -> WindFit | None:
         rms_after=tuple(float(v) for v in after),
         samples=f.get(wind, "samples", "wind", int),
         clock_offset=_clock_offset(wind, f),
+        trace=_trace(wind, f),
     )
 
 
@@ -332,6 +335,40 @@ def _clock_offset(wind: Mapping[str, Any], f: _Fields) -> WindClockOffset | None
         measured=f.get(doc, "measured", where, bool),
         reason=f.get(doc, "reason", where, str),
         samples=f.get(doc, "samples", where, int),
+    )
+
+
+def _trace_doc(trace: WindTrace | None) -> dict[str, Any] | None:
+    if trace is None:
+        return None
+    return {
+        "record": trace.record,
+        "output": trace.output,
+        "gain": _num(trace.gain),
+        "transport_delay_s": _num(trace.transport_delay_s),
+        "smoothing_hz": _num(trace.smoothing_hz),
+        "time_s": [_num(v) for v in trace.time_s],
+        "at_anemometer_m_s": [_num(v) for v in trace.at_anemometer_m_s],
+        "at_vehicle_m_s": [_num(v) for v in trace.at_vehicle_m_s],
+        "from_accelerations_m_s": [_num(v) for v in trace.from_accelerations_m_s],
+    }
+
+
+def _trace(wind: Mapping[str, Any], f: _Fields) -> WindTrace | None:
+    if wind.get("trace") is None:
+        return None
+    doc, where = f.get(wind, "trace", "wind", dict), "wind.trace"
+    time_s = f.numbers(doc, "time_s", where, finite=True)
+    return WindTrace(
+        record=f.get(doc, "record", where, str),
+        time_s=time_s,
+        at_anemometer_m_s=f.numbers(doc, "at_anemometer_m_s", where, size=time_s.size),
+        at_vehicle_m_s=f.numbers(doc, "at_vehicle_m_s", where, size=time_s.size),
+        from_accelerations_m_s=f.numbers(doc, "from_accelerations_m_s", where, size=time_s.size),
+        output=f.get(doc, "output", where, str),
+        gain=f.number(doc, "gain", where, finite=True),
+        transport_delay_s=f.number(doc, "transport_delay_s", where, finite=True),
+        smoothing_hz=f.number(doc, "smoothing_hz", where, finite=True),
     )
 
 

@@ -28,6 +28,7 @@ __all__ = [
     "ParameterEstimate",
     "WindClockOffset",
     "WindFit",
+    "WindTrace",
     "Provenance",
     "IdentifiedModel",
 ]
@@ -170,6 +171,51 @@ class WindClockOffset:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class WindTrace:
+    """One wind record's along-nose wind at the anemometer, where the vehicle met it, and as the accelerometers felt it.
+
+    Parameters
+    ----------
+    record : str
+        The record's label.
+    time_s : ndarray, shape (n_samples,)
+        Log clock, s (about 10 Hz).
+    at_anemometer_m_s : ndarray, shape (n_samples,)
+        Along-nose wind the anemometer read at each instant (its clock
+        corrected), less the record's mean, m/s.
+    at_vehicle_m_s : ndarray, shape (n_samples,)
+        The same air where the vehicle met it, `transport_delay_s` later, m/s.
+    from_accelerations_m_s : ndarray, shape (n_samples,)
+        `output`'s residual of eq. 3.14 without the wind terms divided by
+        `gain`, low-passed at `smoothing_hz`, m/s: the wind the vehicle's
+        accelerations say it met.
+    output : str
+        The accelerometer output read (``ax``).
+    gain : float
+        The G_w gain of the along-nose wind on it, 1/s.
+    transport_delay_s : float
+        The record's anemometer-to-vehicle delay, s.
+    smoothing_hz : float
+        Low-pass of the wind and of the residual read as wind, Hz.
+    """
+
+    record: str
+    time_s: np.ndarray
+    at_anemometer_m_s: np.ndarray
+    at_vehicle_m_s: np.ndarray
+    from_accelerations_m_s: np.ndarray
+    output: str
+    gain: float
+    transport_delay_s: float
+    smoothing_hz: float
+
+    def __post_init__(self) -> None:
+        n = self.time_s.shape
+        if not self.at_anemometer_m_s.shape == self.at_vehicle_m_s.shape == self.from_accelerations_m_s.shape == n:
+            raise ValueError("time_s and the three winds must have one sample each")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class WindFit:
     """How well the wind terms explain the one-step-prediction residual of eq. 3.14.
 
@@ -186,6 +232,9 @@ class WindFit:
     clock_offset : WindClockOffset or None
         The anemometer clock offset scanned from the same residual, when the
         records carry the wind to move.
+    trace : WindTrace or None
+        One record's wind at the anemometer, at the vehicle and from the
+        accelerations (None when no G_w gain on ax was estimated).
     """
 
     outputs: tuple[str, ...]
@@ -193,6 +242,7 @@ class WindFit:
     rms_after: tuple[float, ...]
     samples: int
     clock_offset: WindClockOffset | None = None
+    trace: WindTrace | None = None
 
     def __post_init__(self) -> None:
         if not len(self.outputs) == len(self.rms_before) == len(self.rms_after):

@@ -57,8 +57,11 @@ from sysid.model.structure import ModelStructure
 __all__ = [
     "WindStepResult",
     "fit_wind",
+    "identified_outputs",
+    "prediction_residual",
     "residual_inflation",
     "speed_derivatives",
+    "speed_spread",
     "step_one_spread",
     "with_spread",
     "unfitted_wind",
@@ -92,6 +95,9 @@ class WindStepResult:
         Step 1 parameters estimated again with G_w (:func:`speed_derivatives`): they replace step 1's.
     speed_accuracy : Accuracy or None
         Their accuracy (the G_w gains solved beside them included).
+    speed_dropped : tuple of str
+        Those of them the wind step could not measure (both guidelines missed): at their drop values in
+        `speed_values`, each with its step in `reduction`.
     """
 
     values: Mapping[str, float]
@@ -101,6 +107,7 @@ class WindStepResult:
     reduction: tuple[ReductionStep, ...] = ()
     speed_values: Mapping[str, float] = field(default_factory=dict)
     speed_accuracy: Accuracy | None = None
+    speed_dropped: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -112,6 +119,37 @@ class _Data:
     times: list[np.ndarray]
     rows: list[int]
     scale: np.ndarray
+
+
+def prediction_residual(
+    structure: ModelStructure,
+    values: Mapping[str, float],
+    constants: Mapping[str, float],
+    record: Record,
+    output: str,
+) -> np.ndarray:
+    """One output's residual of eq. 3.14 without the wind terms, the record's mean taken out.
+
+    Parameters
+    ----------
+    structure : ModelStructure
+        A structure with wind inputs.
+    values : Mapping[str, float]
+        F and G_u values.
+    constants : Mapping[str, float]
+        Trim constants, SI.
+    record : Record
+        A record with the structure's states and inputs.
+    output : str
+        An output of the structure.
+
+    Returns
+    -------
+    ndarray, shape (n_samples,)
+        Residual, in the output's unit.
+    """
+    residual: np.ndarray = _prediction_data(structure, values, constants, [record], [output]).residual[0][:, 0]
+    return residual
 
 
 def _prediction_data(
@@ -414,7 +452,7 @@ def fit_wind(
     names = structure.wind_parameters
     if not names:
         raise FitError(f"model {structure.name} has no wind parameters to fit")
-    values, outputs, lost = _identified_outputs(structure, values, outputs)
+    values, outputs, lost = identified_outputs(structure, values, outputs)
     if not outputs:
         return unfitted_wind(structure, f"the outputs of the wind step belong to unidentified axes ({lost})")
     needed = {c.signal for c in structure.inputs} | set(outputs)
@@ -487,6 +525,35 @@ def _gains_problem(
     return problem, _Normal(problem, problem.start, gains), delays, gains
 
 
+#: Lags of the wind the airspeed's instruments are made of, s: the ground speed answers the gusts within seconds
+#: (0-3 s in 0.2 s and 0-5 s in 0.25 s gave the same on the tuning flights, within 0.4 %; fewer instruments
+#: bias an IV estimate less towards least squares).
+_INSTRUMENT_LAGS_S = np.arange(0.0, 2.0 + 1e-9, 0.5)
+
+
+def _lagged_wind(problem: _Problem) -> np.ndarray:
+    """Each wind channel at every lag of :data:`_INSTRUMENT_LAGS_S`, records stacked, shape (n_samples, n_lags n_wind)."""
+    channels = len(problem.columns)
+    return np.column_stack(
+        [np.concatenate(problem.shifted(k, float(lag))) for k in range(channels) for lag in _INSTRUMENT_LAGS_S]
+    )
+
+
+def _projected(columns: np.ndarray, basis: np.ndarray) -> np.ndarray:
+    """`columns` (n, m) projected onto the span of `basis` (n, k) by least squares, shape (n, m)."""
+    fitted: np.ndarray = basis @ np.linalg.lstsq(basis, columns, rcond=None)[0]
+    return fitted
+
+
+def _onto(regressors: np.ndarray, instruments: np.ndarray) -> np.ndarray:
+    """`regressors` (n, m) projected onto the span of `instruments` (n, m): the IV estimate's information design."""
+    if regressors.shape[1] == 0:
+        return regressors
+    q, _ = np.linalg.qr(instruments)
+    projected: np.ndarray = q @ (q.T @ regressors)
+    return projected
+
+
 def _with_wind_defaults(structure: ModelStructure, values: Mapping[str, float]) -> dict[str, float]:
     """`values` with each wind parameter it lacks at the structure's starting value."""
     return dict(values) | {n: values.get(n, structure.parameter(n).value) for n in structure.wind_parameters}
@@ -531,7 +598,7 @@ def wind_cost(
         ``changed`` one mapping of signal name to new values per record: the costs are weighted sums of
         squares per sample (dimensionless), the residual has shape (n_samples, n_outputs).
     """
-    values, outputs, _ = _identified_outputs(structure, values, outputs)
+    values, outputs, _ = identified_outputs(structure, values, outputs)
     if not outputs:
         return None
     current = _with_wind_defaults(structure, values)
@@ -565,6 +632,79 @@ def wind_cost(
     return cost
 
 
+class _Joint:
+    """The speed derivatives and the G_w gains solved together by instrumental variables, at given wind delays.
+
+    A regressor or instrument is one array per output, (n_samples, n_out),
+    and inner products weight each output by its scale squared: the speed
+    regressors, their instruments and the residual are fixed, so a new set
+    of delayed winds costs their products with the winds alone (as
+    :class:`_Normal`'s).
+    """
+
+    def __init__(
+        self, normal: _Normal, data: _Data, speeds: Sequence[np.ndarray], instruments: Sequence[np.ndarray]
+    ) -> None:
+        self.normal, self.scale, self.weight = normal, data.scale, data.scale**2
+        self.speeds, self.instruments = list(speeds), list(instruments)
+        self.n_speed, self.residual = len(self.speeds), normal.residual
+        fixed = [*self.speeds, *self.instruments, self.residual]
+        self.fixed = np.ascontiguousarray(np.hstack(fixed))  # (n, (2 n_speed + 1) n_out), for one BLAS product
+        self.n_fixed, self.n_out = len(fixed), self.residual.shape[1]
+        self.speed_speed = self._inner(self.speeds, self.speeds)
+        self.instrument_speed = self._inner(self.instruments, self.speeds)
+        self.speed_residual = self._inner(self.speeds, [self.residual])[:, 0]
+        self.instrument_residual = self._inner(self.instruments, [self.residual])[:, 0]
+        self.residual_residual = float(self._inner([self.residual], [self.residual])[0, 0])
+
+    def _inner(self, a: Sequence[np.ndarray], b: Sequence[np.ndarray]) -> np.ndarray:
+        return np.array([[float(np.einsum("nr,nr,r->", x, y, self.weight)) for y in b] for x in a]).reshape(
+            len(a), len(b)
+        )
+
+    def solve(self, wind: np.ndarray) -> tuple[float, np.ndarray]:
+        """Cost (weighted residual sum of squares) and solution ``[speed changes, gains]`` for the winds (n, n_wind)."""
+        e, d0, w, k = self.normal.e, self.normal.d0, self.weight, self.n_speed
+        gram = wind.T @ wind  # (n_wind, n_wind)
+        cross = (wind.T @ self.fixed).reshape(wind.shape[1], self.n_fixed, self.n_out).transpose(1, 0, 2)
+        on_speeds, on_instruments, on_residual = cross[:k], cross[k : 2 * k], cross[2 * k]
+        # <A, G_g> = sum_r w_r e_g[r, c] <A[:, r], wind[:, c]>; <A, T> = <A, res> - sum_r w_r d0[r, c] <A[:, r], wind[:, c]>
+        speed_gain = np.einsum("r,grc,fcr->fg", w, e, on_speeds)
+        instrument_gain = np.einsum("r,grc,fcr->fg", w, e, on_instruments)
+        gain_gain = np.einsum("r,grc,cd,hrd->gh", w, e, gram, e)
+        gain_residual = np.einsum("r,grc,cr->g", w, e, on_residual) - np.einsum("r,grc,cd,rd->g", w, e, gram, d0)
+        speed_target = self.speed_residual - np.einsum("r,rc,fcr->f", w, d0, on_speeds)
+        instrument_target = self.instrument_residual - np.einsum("r,rc,fcr->f", w, d0, on_instruments)
+        target_target = (
+            self.residual_residual
+            - 2 * float(np.einsum("r,rc,cr->", w, d0, on_residual))
+            + float(np.einsum("r,rc,cd,rd->", w, d0, gram, d0))
+        )
+        regressors_regressors = np.block([[self.speed_speed, speed_gain], [speed_gain.T, gain_gain]])
+        instruments_regressors = np.block([[self.instrument_speed, instrument_gain], [speed_gain.T, gain_gain]])
+        regressors_target = np.concatenate([speed_target, gain_residual])
+        instruments_target = np.concatenate([instrument_target, gain_residual])
+        solution = np.linalg.lstsq(instruments_regressors, instruments_target, rcond=None)[0]
+        cost = (
+            target_target - 2 * float(solution @ regressors_target) + float(solution @ regressors_regressors @ solution)
+        )
+        return cost, solution
+
+    def explicit(self, wind: np.ndarray, solution: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The weighted residual after (n, n_out) and the information design (n n_out, n_param) of `solution`.
+
+        The design is the regressors projected onto the instruments: its ``J^T J`` is the inverse of the IV
+        estimate's covariance for a unit residual variance.
+        """
+        e, d0, scale = self.normal.e, self.normal.d0, self.scale
+        gains = [(wind @ e[g].T) * scale for g in range(e.shape[0])]
+        regressors = np.column_stack([(c * scale).ravel() for c in self.speeds] + [g.ravel() for g in gains])
+        instruments = np.column_stack([(c * scale).ravel() for c in self.instruments] + [g.ravel() for g in gains])
+        target = ((self.residual - wind @ d0.T) * scale).ravel()
+        after = (target - regressors @ solution).reshape(self.residual.shape)
+        return after, _onto(regressors, instruments)
+
+
 def speed_derivatives(
     structure: ModelStructure,
     values: Mapping[str, float],
@@ -586,13 +726,25 @@ def speed_derivatives(
     it up: X_w_lon came out short by the same amount. The gusts excite the
     airspeed apart from the loop, so the residual measures both: each
     step 1 parameter the fitted outputs' rows read through u, v or w alone
-    (``X_u`` in ax, ``Z_w`` in az) is solved for with the G_w gains by linear
-    least squares, each output weighted by its residual level, at the wind
-    delays that leave the least residual (every 10 ms over each delay's
-    bounds, then every 2 ms about the best, coordinate-wise, twice: u carries the wind undelayed, so the
-    split between X_u and X_w_lon follows the delay); the Cramér–Rao
-    bounds are corrected for the residual's autocorrelation as the wind
-    step's.
+    (``X_u`` in ax, ``Z_w`` in az) is solved for with the G_w gains, each
+    output weighted by its residual level, at the wind delays that leave the
+    least residual (every 10 ms over each delay's bounds, then every 2 ms
+    about the best, coordinate-wise, twice: u carries the wind undelayed, so
+    the split between X_u and X_w_lon follows the delay).
+
+    The solution is by instrumental variables, not least squares. What tells
+    X_u from X_w_lon is the ground speed (u is the wind less it), a few
+    tenths of a m/s under position hold, and two things in it are not the
+    air: the velocity estimate's own error, and the ground speed's answer to
+    unmeasured forces that are also in the residual. Least squares read both
+    as airspeed and came out 3-7 % short on X_u and X_w_lon alike on the
+    generator's tuning flights (−1 to −2 % with either taken away). The
+    instruments of a speed regressor are its projection on the wind at lags
+    :data:`_INSTRUMENT_LAGS_S` (the ground speed's answer to the gusts), which
+    neither error reaches; the G_w regressors are their own instruments.
+    The Cramér–Rao bounds are those of the IV estimate (the regressors
+    projected onto the instruments), corrected for the residual's
+    autocorrelation as the wind step's.
 
     Parameters
     ----------
@@ -621,7 +773,7 @@ def speed_derivatives(
     """
     empty = accuracy(np.zeros((1, 0)), np.zeros(0), ())
     names = structure.wind_parameters
-    known, outputs, _ = _identified_outputs(structure, values, outputs)
+    known, outputs, _ = identified_outputs(structure, values, outputs)
     moving = [k for k, s in enumerate(structure.states) if s in _AIR_STATES]
     if not outputs or not moving or not all({structure.states[k] for k in moving} <= set(r.signals) for r in records):
         return {}, empty
@@ -652,19 +804,14 @@ def speed_derivatives(
     )
     speeds = [states @ dm.c[k][np.ix_(rows, moving)].T for k in chosen]  # (n, n_out) per parameter
 
-    residual = np.vstack(data.residual)
-    weighted_speeds = np.column_stack([(c * data.scale).ravel() for c in speeds]) if speeds else None
+    lagged = _lagged_wind(problem) if speeds else np.zeros((0, 0))
+    joint = _Joint(normal, data, speeds, [_projected(c, lagged) for c in speeds])
 
-    def solved(at: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
-        """Cost, solution, weighted residual after and design at the wind delays of `at` (normal equations)."""
+    def solved(at: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+        """Cost and solution at the wind delays of `at`, and the delayed winds (n_samples, n_wind)."""
         delays = problem.assembler.matrices(at).delays[problem.columns]
         wind = np.column_stack([np.concatenate(problem.shifted(k, tau)) for k, tau in enumerate(delays)])
-        gains_part = np.column_stack([((wind @ normal.e[g].T) * data.scale).ravel() for g in range(len(gains))])
-        design = gains_part if weighted_speeds is None else np.hstack([weighted_speeds, gains_part])
-        target = ((residual - wind @ normal.d0.T) * data.scale).ravel()
-        solution = np.linalg.lstsq(design.T @ design, design.T @ target, rcond=None)[0]
-        after = (target - design @ solution).reshape(residual.shape)
-        return float(np.sum(after**2)), solution, after, design
+        return (*joint.solve(wind), wind)
 
     # u carries the wind undelayed: the split between X_u and X_w_lon follows the wind delay, so it is scanned,
     # every 10 ms then every 2 ms about the best
@@ -684,7 +831,8 @@ def speed_derivatives(
                     cost = solved(trial)[0]
                     if cost < best:
                         at, best = trial, cost
-    _, solution, after, design = solved(at)
+    _, solution, wind = solved(at)
+    after, design = joint.explicit(wind, solution)
     labels = tuple(free[k] for k in chosen) + tuple(problem.free[g] for g in gains)
     estimates = np.concatenate([theta[chosen] + solution[: len(chosen)], solution[len(chosen) :]])
     inflation = residual_inflation(after) if with_accuracy else math.inf
@@ -771,7 +919,7 @@ def _read_by_residual(
 ) -> set[str]:
     """Step 1 parameters the residual of `outputs` reads: in their rows of C or D, in the rows of the states
     a record lacks (simulated: the actuator lags), or as an input delay."""
-    known, outputs, _ = _identified_outputs(structure, values, outputs)
+    known, outputs, _ = identified_outputs(structure, values, outputs)
     free = tuple(n for n in known if n not in structure.wind_parameters and n in structure.parameter_names)
     plain = Assembler(structure, free=free, fixed={}, constants=constants, include_wind=False)
     theta = np.array([known[n] for n in free])
@@ -788,6 +936,53 @@ def _read_by_residual(
         or np.any(dm.b[k][hidden] != 0)
         or np.any(dm.delays[k] != 0)
     }
+
+
+def speed_spread(
+    base: WindStepResult,
+    speed: Mapping[str, float],
+    speed_accuracy: Accuracy,
+    fitted: Callable[[Mapping[str, float]], WindStepResult],
+) -> dict[str, float]:
+    """One standard deviation of each wind parameter from the speed derivatives' own uncertainty.
+
+    The wind step fits G_w and the wind delays at the speed derivatives
+    :func:`speed_derivatives` found, and its bounds hold them fixed. But u
+    carries the wind undelayed, so X_u, X_w_lon and tau_w_lon share one
+    split: on the chapter 3 strong-wind flights tau_w_lon moved 0.55 ms per
+    0.001 of X_u (13.3 ms at the true X_u, 17.6 ms at X_u 3.6 % off, where
+    its bound held at X_u said ±0.8 ms). Each speed derivative is moved by its
+    bound, the wind step fitted again, and the changes are added in
+    quadrature.
+
+    Parameters
+    ----------
+    base : WindStepResult
+        The wind step at `speed`.
+    speed : Mapping[str, float]
+        The speed derivatives the wind step was fitted at.
+    speed_accuracy : Accuracy
+        Their accuracy (of the joint solution, step 1's uncertainty carried in).
+    fitted : callable
+        ``fitted(speed)``: the wind step at other speed derivatives.
+
+    Returns
+    -------
+    dict
+        Standard deviation of each wind parameter estimated in both fits, in its unit.
+    """
+    squares: dict[str, float] = {}
+    if not any(status == "estimated" for status in base.status.values()):
+        return squares  # nothing to move
+    for k, name in enumerate(speed_accuracy.names):
+        bound = float(speed_accuracy.cramer_rao[k])
+        if name not in speed or not math.isfinite(bound) or bound <= 0:
+            continue
+        again = fitted(dict(speed) | {name: speed[name] + bound})
+        for n, status in base.status.items():
+            if status == "estimated" and again.status.get(n) == "estimated":
+                squares[n] = squares.get(n, 0.0) + (again.values[n] - base.values[n]) ** 2
+    return {n: math.sqrt(v) for n, v in squares.items()}
 
 
 def with_spread(acc: Accuracy, spread: Mapping[str, float]) -> Accuracy:
@@ -808,11 +1003,26 @@ def with_spread(acc: Accuracy, spread: Mapping[str, float]) -> Accuracy:
     return replace(acc, cramer_rao=np.sqrt(acc.cramer_rao**2 + extra**2))
 
 
-def _identified_outputs(
+def identified_outputs(
     structure: ModelStructure, values: Mapping[str, float], outputs: Sequence[str]
 ) -> tuple[dict[str, float], list[str], str]:
-    """Values with each unidentified (NaN) parameter at its starting value, the outputs of identified axes only,
-    and the axes left out (for a message)."""
+    """The outputs of `outputs` that identified axes alone read, and values the matrices can be built from.
+
+    Parameters
+    ----------
+    structure : ModelStructure
+        The structure.
+    values : Mapping[str, float]
+        Identified values, NaN for the unidentified.
+    outputs : sequence of str
+        Outputs asked for.
+
+    Returns
+    -------
+    tuple
+        Values with each unidentified parameter at its starting value (it reads no output kept), the outputs
+        kept, and the axes left out (for a message; "" when none).
+    """
     unknown = {k for k, v in values.items() if not math.isfinite(v)}
     if not unknown:
         return dict(values), list(outputs), ""

@@ -61,6 +61,7 @@ __all__ = [
     "moved_wind",
     "offset_given",
     "scan_wind_offset",
+    "smoothed",
     "timed_wind",
     "untimed_wind",
 ]
@@ -154,7 +155,7 @@ def _movable(records: Sequence[Record], flights: Sequence[ConditionedFlight], *,
         if piece is not None and needed <= set(record.signals) and {"wind_n", "wind_e"} <= set(piece.signals):
             if id(piece) not in winds:  # a piece holds several records: its wind is smoothed once
                 wind = np.column_stack([piece["wind_n"], piece["wind_e"]])
-                winds[id(piece)] = _smoothed(wind, piece.rate_hz) if smooth else wind
+                winds[id(piece)] = smoothed(wind, piece.rate_hz) if smooth else wind
             out.append(_Moved.of(record, piece.time_s, winds[id(piece)]))
     return out
 
@@ -164,21 +165,33 @@ def _movable(records: Sequence[Record], flights: Sequence[ConditionedFlight], *,
 SMOOTHING_HZ = 2.0
 
 
-def _smoothed(wind_ne: np.ndarray, rate_hz: float) -> np.ndarray:
-    """Zero-phase 4th-order Butterworth low-pass of the wind at :data:`SMOOTHING_HZ`, shape (n, 2).
+def smoothed(wind_ne: np.ndarray, rate_hz: float) -> np.ndarray:
+    """Zero-phase 4th-order Butterworth low-pass of the wind at :data:`SMOOTHING_HZ`.
 
     The anemometer's noise reaches u v w and the wind regressor alike:
     regressed on, white noise shrinks every estimate on the wind by
     var(noise) / var(wind), 4-8 % for a ±0.3 m/s sensor in 0.6-0.9 m/s of
     turbulence. Zero phase: the record is filtered whole, after the flight.
+
+    Parameters
+    ----------
+    wind_ne : ndarray, shape (n_samples, n_columns)
+        Wind components, m/s, evenly sampled.
+    rate_hz : float
+        Their sample rate, Hz.
+
+    Returns
+    -------
+    ndarray, shape (n_samples, n_columns)
+        The same low-passed; as given when under 32 samples or sampled under 4 times the cut-off.
     """
     if wind_ne.shape[0] < 32 or rate_hz <= 4 * SMOOTHING_HZ:
         return wind_ne
     from scipy.signal import butter, sosfiltfilt  # scipy.signal takes 0.75 s to load: only here
 
     sos = butter(4, SMOOTHING_HZ, fs=rate_hz, output="sos")
-    smoothed: np.ndarray = sosfiltfilt(sos, wind_ne, axis=0)
-    return smoothed
+    low: np.ndarray = sosfiltfilt(sos, wind_ne, axis=0)
+    return low
 
 
 def moved_wind(

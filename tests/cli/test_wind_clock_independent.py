@@ -12,6 +12,7 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 from independent_sim.corpus import CaseFiles, Truth
@@ -91,13 +92,36 @@ def test_the_report_draws_the_cost_against_the_offset(outcomes: dict[str, _Outco
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", WINDY)
+def test_the_wind_the_vehicle_met_is_the_one_its_accelerations_felt(outcomes: dict[str, _Outcome], name: str) -> None:
+    """The report's trace: the anemometer's wind moved to the vehicle follows the ax residual read as wind (r 0.99
+    on the tuning cases; the reading unmoved 0.75-0.77), and the accelerations lag the anemometer by the transport
+    delay (the lag of their greatest cross-correlation, at the trace's 10 Hz)."""
+    trace = outcomes[name].model["wind"]["trace"]
+    felt = np.array(trace["from_accelerations_m_s"])
+    reading = np.array(trace["at_anemometer_m_s"])
+    at_vehicle = float(np.corrcoef(trace["at_vehicle_m_s"], felt)[0, 1])
+    assert at_vehicle >= 0.9 and at_vehicle > float(np.corrcoef(reading, felt)[0, 1]), at_vehicle
+    dt = float(np.median(np.diff(trace["time_s"])))
+    lags = np.arange(0, int(round(3.0 / dt)))  # the air reaches the vehicle after the anemometer: 0-3 s
+    cross = [float(np.corrcoef(reading[: reading.size - k], felt[k:])[0, 1]) for k in lags]
+    lag_s = float(lags[int(np.argmax(cross))] * dt)
+    assert abs(lag_s - outcomes[name].truth.wind["transport_delay_s"]) <= 0.15, (lag_s, trace["transport_delay_s"])
+    section = outcomes[name].report.split('id="wind-timing"', 1)[1].split("<h2", 1)[0]
+    assert "<svg" in section and f"r = {at_vehicle:.2f}" in section
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", WINDY)
 def test_the_wind_terms_come_within_15_percent(outcomes: dict[str, _Outcome], name: str) -> None:
-    """Measured: X_w_lon -3 to -12 %, Z_w_lon -1 to -11 % (X_u estimated again with them: -3 to -10 %)."""
+    """Measured: X_w_lon +1.1 to -5.4 %, Z_w_lon -1.3 to -11.0 % (X_u estimated again with them: -0.2 to -7.1 %)."""
     parameters, truth = outcomes[name].model["parameters"], outcomes[name].truth.parameters
     for term in ("X_w_lon", "Z_w_lon", "X_u"):
         assert parameters[term]["status"] == "estimated", (term, parameters[term])
         assert abs(parameters[term]["value"] / truth[term] - 1) <= 0.15, (term, parameters[term], truth[term])
     assert parameters["X_u"]["stage"] == "wind"
+    for term, p in parameters.items():  # Z_w came out "estimated" at CR 100-111 % on two of these before
+        unmeasured = p["status"] == "estimated" and p["cr_percent"] > 20 and p["insensitivity_percent"] > 10
+        assert not (p["stage"] == "wind" and unmeasured), (term, p)
 
 
 @pytest.mark.slow
@@ -112,24 +136,33 @@ def test_the_wind_term_cuts_the_doublets_ax_error(outcomes: dict[str, _Outcome],
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
-    reason="az cut 19.7 % and 14.7 % on the two ArduPilot cases (77 % and 28 % on PX4): issue 31 stays open on it",
+    reason="az cut 19.8 % and 16.1 % on the two ArduPilot cases (77 % and 28 % on PX4), with Z_w_lon within "
+    "1.9-3.0 % of the truth there: issue 31 stays open on it",
 )
 def test_the_wind_term_cuts_every_cases_az_error_by_20_percent(outcomes: dict[str, _Outcome]) -> None:
     cuts = {n: o.validation["wind_correction"]["az"]["reduction_percent"] for n, o in outcomes.items()}
     assert min(cuts.values()) >= 20.0, cuts
 
 
+def _inside_2_cr(outcome: _Outcome, term: str) -> bool:
+    parameter, truth = outcome.model["parameters"][term], outcome.truth.parameters[term]
+    return bool(abs(parameter["value"] / truth - 1) * 100 <= 2 * parameter["cr_percent"])
+
+
+@pytest.mark.slow
+def test_x_w_lons_truth_is_inside_2_cr(outcomes: dict[str, _Outcome]) -> None:
+    """Measured +1.1 / -5.4 / -4.7 / -0.1 % at CR 5.4 / 4.6 / 6.2 / 5.0 % (X_u's uncertainty carried in)."""
+    assert all(_inside_2_cr(outcome, "X_w_lon") for outcome in outcomes.values())
+
+
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
-    reason="the bounds are too tight: X_w_lon's truth is inside 2 CR on 1 of 4 cases, Z_w_lon's on 3 of 4 (the "
-    "estimates all fall short, by 1-12 %, at CR 1.7-3.4 % with step 1's uncertainty carried in): issue 31 stays open",
+    reason="Z_w_lon's truth is inside 2 CR on 3 of 4 cases: px4-slight -11.0 % at CR 3.4 %, from step 1's Z_thr "
+    "-8.3 % at CR 3.0 % (the thrust loop answers the gusts, so Z_thr's error moves Z_w_lon): issue 31 stays open",
 )
-def test_the_truth_is_inside_2_cr(outcomes: dict[str, _Outcome]) -> None:
-    for outcome in outcomes.values():
-        for term in ("X_w_lon", "Z_w_lon"):
-            parameter, truth = outcome.model["parameters"][term], outcome.truth.parameters[term]
-            assert abs(parameter["value"] / truth - 1) * 100 <= 2 * parameter["cr_percent"], (term, parameter, truth)
+def test_z_w_lons_truth_is_inside_2_cr(outcomes: dict[str, _Outcome]) -> None:
+    assert all(_inside_2_cr(outcome, "Z_w_lon") for outcome in outcomes.values())
 
 
 @pytest.mark.slow
@@ -159,3 +192,4 @@ def test_calm_air_claims_no_wind_term(independent_corpus, tmp_path: Path) -> Non
     for term in ("X_w_lon", "Z_w_lon"):
         assert doc["parameters"][term]["status"] == "unidentified", doc["parameters"][term]
     assert any("anemometer clock offset not measured" in note for note in doc["notes"]), doc["notes"]
+    assert doc["wind"] is None or doc["wind"].get("trace") is None  # no G_w, nothing read as wind

@@ -16,6 +16,7 @@ from sysid.fit import (
     FitOptions,
     IdentifiedModel,
     Provenance,
+    WindFit,
     fit_frequency_responses,
     fit_summary,
     from_control_layout,
@@ -28,6 +29,7 @@ from sysid.fit import (
     write_mat,
     write_model,
 )
+from sysid.fit.result import WindClockOffset, WindTrace
 from sysid.model import load_structure, structure_model
 from sysid.model.statespace import DelayedStateSpace
 
@@ -73,6 +75,42 @@ def test_json_round_trip_keeps_everything(model: IdentifiedModel, tmp_path) -> N
     doc = json.loads(path.read_text())
     assert doc["schema_version"] == 1 and doc["parameters"]["X_w_lon"]["status"] == "dropped"
     assert doc["parameters"]["N_r"]["cr_percent"] is None  # NaN is written as null
+
+
+def test_the_wind_steps_clock_scan_and_trace_round_trip(model: IdentifiedModel, tmp_path) -> None:
+    shift, t = np.linspace(-5.0, 5.0, 101), np.arange(0.0, 20.0, 0.1)
+    clock = WindClockOffset(
+        shift_s=shift,
+        cost=1.0 + (shift + 1.5) ** 2,
+        cost_without_wind=30.0,
+        best_shift_s=-1.5,
+        sigma_s=0.02,
+        used_clock_offset_s=0.0,
+        transport_delay_s=0.85,
+        measured=True,
+        reason="",
+        samples=1000,
+    )
+    trace = WindTrace(
+        record="a.bin lon sweep 10.00-30.00 s",
+        time_s=t,
+        at_anemometer_m_s=np.sin(t + 0.85),
+        at_vehicle_m_s=np.sin(t),
+        from_accelerations_m_s=np.sin(t) + 0.01 * np.cos(7 * t),
+        output="ax",
+        gain=-0.356,
+        transport_delay_s=0.85,
+        smoothing_hz=2.0,
+    )
+    wind = WindFit(outputs=("ax", "az"), rms_before=(0.3, 0.4), rms_after=(0.1, 0.2), samples=1000)
+    windy = dataclasses.replace(model, wind=dataclasses.replace(wind, clock_offset=clock, trace=trace))
+    back = read_model(write_model(tmp_path / "model.json", windy)).wind
+    assert back is not None and back.clock_offset is not None and back.trace is not None
+    assert back.clock_offset.clock_offset_s == clock.clock_offset_s == 1.5
+    assert np.array_equal(back.clock_offset.cost, clock.cost)
+    for name in ("time_s", "at_anemometer_m_s", "at_vehicle_m_s", "from_accelerations_m_s"):
+        assert np.array_equal(getattr(back.trace, name), getattr(trace, name)), name
+    assert (back.trace.record, back.trace.gain, back.trace.transport_delay_s) == (trace.record, -0.356, 0.85)
 
 
 def test_how_each_response_was_computed_is_kept(model: IdentifiedModel, tmp_path) -> None:
