@@ -203,7 +203,8 @@ def _print_summary(summary: dict[str, Any]) -> None:
             if alignment["residual_offset_s"] is not None:
                 say(
                     f"    residual clock offset {alignment['residual_offset_s']:+.3f} s against "
-                    f"{alignment['residual_against']} (correlation {alignment['residual_correlation']:.2f})"
+                    f"{alignment['residual_against']}, modelled as lagging the air by a first-order "
+                    f"{alignment['residual_lag_modelled_s']:g} s (correlation {alignment['residual_correlation']:.2f})"
                 )
         for record in entry.get("records", []):
             say(

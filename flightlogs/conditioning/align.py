@@ -10,8 +10,9 @@ Times are related by::
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any, Literal
@@ -23,6 +24,7 @@ from flightlogs.errors import DataError
 from flightlogs.flightlog import FlightLog
 
 __all__ = [
+    "ESTIMATOR_LAGS_S",
     "WindAlignment",
     "pair_winds",
     "overlap_s",
@@ -188,6 +190,23 @@ def wind_log_time(log: FlightLog, wind: Any, *, clock_offset_s: float, transport
     return log_time + transport_delay_s
 
 
+#: First-order lags tried for what the anemometer is correlated with, s: EKF wind states smooth over 1-5 s.
+ESTIMATOR_LAGS_S = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0)
+
+
+def _first_order_lag(signal: np.ndarray, time_constant_s: float, rate_hz: float) -> np.ndarray:
+    """`signal` (n, m) through a causal first-order lag of `time_constant_s`, started at its first value."""
+    if time_constant_s <= 0.0:
+        return signal
+    keep = math.exp(-1.0 / (time_constant_s * rate_hz))
+    out = np.empty_like(signal, dtype=np.float64)
+    out[0] = signal[0]
+    from scipy.signal import lfilter  # only when a lag is modelled: scipy.signal takes 0.75 s to load
+
+    out[1:] = lfilter([1.0 - keep], [1.0, -keep], signal[1:], axis=0, zi=keep * signal[:1])[0]
+    return out
+
+
 def estimate_residual_offset(
     time_s: np.ndarray,
     wind_ne: np.ndarray,
@@ -201,7 +220,13 @@ def estimate_residual_offset(
     Correlates with the autopilot's own wind estimate where the log has one,
     else with the attitude a position-holding multirotor takes to lean into
     the wind (pitch against the wind along the nose, roll against the wind
-    across it).
+    across it). Both lag the air: an EKF's wind is a smoothed state, the lean
+    follows the position loop; correlated as they are, that lag reads as
+    clock offset (2.5 s of estimator smoothing read 1.3 s of it on the
+    independent generator's flights). So the anemometer's wind is first
+    passed through a first-order lag of each time constant in
+    :data:`ESTIMATOR_LAGS_S`, and the one that correlates best says the lag;
+    the delay at it is the offset.
 
     Parameters
     ----------
@@ -220,27 +245,29 @@ def estimate_residual_offset(
     -------
     tuple
         The :class:`LagEstimate` (positive: the vehicle sees the wind later than
-        assumed, so the anemometer clock is ahead by that much) and the name of
-        what it was estimated against; ``(None, None)`` when no usable signal.
+        assumed, so the anemometer clock is ahead by that much; its
+        ``time_constant_s`` the lag modelled) and the name of what it was
+        estimated against; ``(None, None)`` when no usable signal.
     """
     max_lag_s = min(max_lag_s, 0.2 * (time_s[-1] - time_s[0]))
     if "est_wind_n" in table and "est_wind_e" in table:
-        pairs = [(wind_ne[:, 0], table["est_wind_n"]), (wind_ne[:, 1], table["est_wind_e"])]
+        wind, responses = wind_ne, [table["est_wind_n"], table["est_wind_e"]]
         against = "autopilot wind estimate"
     elif {"phi", "theta", "psi"} <= table.keys():
         from flightlogs.frames import wind_to_body_axes
 
-        body = wind_to_body_axes(wind_ne, table["psi"])
-        pairs = [(body[:, 0], table["theta"]), (body[:, 1], -table["phi"])]
+        wind, responses = wind_to_body_axes(wind_ne, table["psi"]), [table["theta"], -table["phi"]]
         against = "attitude (leaning into the wind)"
     else:
         return None, None
     best: LagEstimate | None = None
-    for wind_component, response in pairs:
-        try:
-            estimate = estimate_lag(wind_component, response, rate_hz, max_lag_s=max_lag_s, prewhiten=False)
-        except DataError:
-            continue
-        if best is None or abs(estimate.correlation) > abs(best.correlation):
-            best = estimate
+    for tau in ESTIMATOR_LAGS_S:
+        lagged = _first_order_lag(wind, tau, rate_hz)
+        for k, response in enumerate(responses):
+            try:
+                estimate = estimate_lag(lagged[:, k], response, rate_hz, max_lag_s=max_lag_s, prewhiten=False)
+            except DataError:
+                continue
+            if best is None or abs(estimate.correlation) > abs(best.correlation):
+                best = replace(estimate, time_constant_s=tau)
     return (best, against) if best is not None else (None, None)

@@ -33,10 +33,14 @@ class LagEstimate:
     correlation : float
         Normalised cross-correlation at the peak, -1..1 (its sign tells
         whether the two move together or against each other).
+    time_constant_s : float, optional
+        First-order lag the first stream was passed through before the
+        delay was measured (an estimator's smoothing, modelled), s; 0 when none.
     """
 
     lag_s: float
     correlation: float
+    time_constant_s: float = 0.0
 
 
 def estimate_lag(

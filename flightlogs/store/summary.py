@@ -109,6 +109,7 @@ def conditioned_summary(flight: Any) -> dict[str, Any]:
             "residual_offset_s": None if wind.residual is None else round(wind.residual.lag_s, 4),
             "residual_correlation": None if wind.residual is None else round(wind.residual.correlation, 4),
             "residual_against": wind.residual_against,
+            "residual_lag_modelled_s": None if wind.residual is None else round(wind.residual.time_constant_s, 4),
         }
     return {
         "rate_hz": round(flight.rate_hz, 6),
