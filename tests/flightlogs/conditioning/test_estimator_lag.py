@@ -45,3 +45,15 @@ def test_the_offset_is_measured_through_the_estimators_lag(offset_s: float, tau_
     assert found is not None and against == "autopilot wind estimate"
     assert abs(found.lag_s - offset_s) <= 0.1, found
     assert abs(found.time_constant_s - tau_s) <= 0.6, found
+
+
+def test_the_lag_is_scipys_first_order_filter() -> None:
+    """The bidiagonal solve that models the lag equals ``scipy.signal.lfilter`` started at rest on the first value."""
+    from scipy.signal import lfilter
+
+    from flightlogs.conditioning.align import _first_order_lag
+
+    signal = np.random.default_rng(3).standard_normal((800, 2)).cumsum(axis=0)
+    keep = math.exp(-1.0 / (2.5 * RATE_HZ))
+    expected = np.vstack([signal[:1], lfilter([1 - keep], [1, -keep], signal[1:], axis=0, zi=keep * signal[:1])[0]])
+    np.testing.assert_allclose(_first_order_lag(signal, 2.5, RATE_HZ), expected, rtol=1e-12, atol=1e-12)
