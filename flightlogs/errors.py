@@ -116,7 +116,8 @@ class CollectedWarnings:
         """Forget the warnings recorded so far: they came from work whose result is replaced.
 
         A conditioning pass that only measures a clock offset, redone with
-        the offset corrected, warns again about what still holds.
+        the offset corrected, warns again about what still holds; so does an
+        identification run again with the anemometer's clock offset it measured.
         """
         self._records.clear()
 

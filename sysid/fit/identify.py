@@ -254,7 +254,7 @@ def identify_flights(
     raised during the identification, which also goes on to the caller.
     """
     with collected_warnings() as caught:
-        model = _identified(flights, structure, options, files, progress)
+        model = _identified(flights, structure, options, files, progress, superseded=caught.discard)
     return dataclasses.replace(model, notes=model.notes + caught.messages)
 
 
@@ -266,8 +266,13 @@ def _identified(
     progress: Progress | None,
     *,
     timed: tuple[WindClockOffset, list[str]] | None = None,
+    superseded: Callable[[], None] | None = None,
 ) -> IdentifiedModel:
-    """The identification; `timed` is the clock offset scanned and applied to the flights by an earlier pass."""
+    """The identification; `timed` is the clock offset scanned and applied to the flights by an earlier pass.
+
+    When the offset measured moves the wind, the identification is run again on the moved flights and
+    `superseded` is called first: the first pass's warnings are said again by the second where they still hold.
+    """
     if isinstance(structure, str):
         structure = load_structure(structure)
     structure.check_constants(options.constants or {})
@@ -323,6 +328,8 @@ def _identified(
                 )
                 if clock is not None and clock.measured and _moves(clock, flights):  # step 1 again, u v w in time
                     moved = moved_flights(flights, clock.best_shift_s)
+                    if superseded is not None:
+                        superseded()
                     return _identified(moved, structure, options, files, progress, timed=(clock, said))
             else:
                 (clock, said), records = timed, moved_wind(records, flights, 0.0)  # smoothed as in the first pass
