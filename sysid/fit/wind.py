@@ -532,10 +532,14 @@ _INSTRUMENT_LAGS_S = np.arange(0.0, 2.0 + 1e-9, 0.5)
 
 
 def _lagged_wind(problem: _Problem) -> np.ndarray:
-    """Each wind channel at every lag of :data:`_INSTRUMENT_LAGS_S`, records stacked, shape (n_samples, n_lags n_wind)."""
-    channels = len(problem.columns)
+    """Each wind signal at every lag of :data:`_INSTRUMENT_LAGS_S`, records stacked, shape (n_samples, n_lags n_signal).
+
+    Channels that carry the same signal (the along-nose wind on u and on w) give it once.
+    """
+    signals = [problem.assembler.channels[j].signal for j in problem.columns]
+    first = [k for k, signal in enumerate(signals) if signals.index(signal) == k]
     return np.column_stack(
-        [np.concatenate(problem.shifted(k, float(lag))) for k in range(channels) for lag in _INSTRUMENT_LAGS_S]
+        [np.concatenate(problem.shifted(k, float(lag))) for k in first for lag in _INSTRUMENT_LAGS_S]
     )
 
 

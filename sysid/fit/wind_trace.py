@@ -72,15 +72,18 @@ def wind_trace(
     row = structure.outputs.index(output)
     columns = [j for j, c in enumerate(assembler.channels) if c.wind]
     gains = assembler.matrices(np.zeros(0)).d[row, columns]
-    if not columns or not np.all(np.isfinite(gains)) or not np.any(gains != 0):
-        return None
+    if not np.all(np.isfinite(gains)) or not np.any(gains != 0):
+        return None  # no wind channel, or no G_w gain estimated on `output`
     channel = int(np.argmax(np.abs(gains)))
     signal = assembler.channels[columns[channel]].signal
     record = max((r for r in records if signal in r.signals), key=lambda r: r.time_s[-1] - r.time_s[0], default=None)
-    delays = [f.wind.transport.delay_s for f in flights if f.wind is not None and record and f.source == record.source]
-    if record is None or not delays or not math.isfinite(delays[0]):
+    if record is None:
         return None
-    transport_delay_s = delays[0]
+    transport_delay_s = next(
+        (f.wind.transport.delay_s for f in flights if f.wind is not None and f.source == record.source), math.nan
+    )
+    if not math.isfinite(transport_delay_s):
+        return None
     residual = prediction_residual(structure, values, constants, record, output)
     t, at_vehicle = record.time_s, record[signal] - float(np.mean(record[signal]))
     felt = smoothed(residual[:, None] / float(gains[channel]), record.rate_hz)[:, 0]

@@ -176,7 +176,19 @@ def test_the_coarse_prior_models_the_estimators_lag(independent_corpus, name: st
     2.5 s exactly)."""
     files = independent_corpus.files(name)
     done = CliRunner().invoke(
-        cli, ["ingest", str(files.log), *_wind(files)[2:], "--estimate-wind-offset", "--json", "-", "-q"]
+        cli,
+        [
+            "ingest",
+            str(files.log),
+            "--wind",
+            str(files.anemometer_csv),
+            "--wind-distance",
+            "4.6",
+            "--estimate-wind-offset",
+            "--json",
+            "-",
+            "-q",
+        ],
     )
     assert done.exit_code == 0, done.output
     alignment = json.loads(done.stdout)["wind_alignment"]
