@@ -22,8 +22,8 @@ def _held_dtype(dtype: np.dtype) -> type[np.floating]:
     return np.float32 if exact_in_single else np.float64
 
 
-Autopilot = Literal["px4", "ardupilot"]
-LogFormat = Literal["ulog", "dataflash", "tlog"]
+Autopilot = Literal["px4", "ardupilot", "unknown"]
+LogFormat = Literal["ulog", "dataflash", "tlog", "table"]
 
 
 @dataclass(frozen=True, slots=True, init=False)
@@ -164,10 +164,11 @@ class FlightLog:
     ----------
     path : Path
         The file read.
-    log_format : {"ulog", "dataflash", "tlog"}
-        Format detected from the file content.
-    autopilot : {"px4", "ardupilot"}
-        Flight stack that wrote it.
+    log_format : {"ulog", "dataflash", "tlog", "table"}
+        Format detected from the file content (``table``: a CSV or Parquet
+        table read through a column map, :mod:`flightlogs.readers.table`).
+    autopilot : {"px4", "ardupilot", "unknown"}
+        Flight stack that wrote it (``unknown`` for a table).
     signals : Mapping[str, Signal]
         Canonical signals found, by name.
     vehicle : str

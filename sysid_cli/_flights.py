@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -10,7 +10,26 @@ import click
 
 from ._common import progress_bar
 
-__all__ = ["is_dataset", "check_sources", "dataset_flights", "conditioned_flights"]
+__all__ = ["is_dataset", "check_sources", "dataset_flights", "conditioned_flights", "map_option"]
+
+_MAP_HELP = (
+    "Column map of CSV / Parquet tables among the inputs: time=0,delta_lat=1,p=2:deg/s (canonical name = "
+    "column name or 0-based index, optional :unit converted to SI), or a .toml file of such entries."
+)
+
+
+def _parse_map(_ctx: click.Context, _param: click.Parameter, value: str | None) -> Any:
+    """The ``--map`` text as a :class:`~flightlogs.readers.table.TableMap` (click callback; a bad map exits 1)."""
+    if value is None:
+        return None
+    from flightlogs.readers.table import parse_table_map
+
+    return parse_table_map(value)
+
+
+def map_option(help: str = _MAP_HELP) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """``--map TEXT|FILE`` (into ``table_map``): how the columns of a table are read as signals."""
+    return click.option("--map", "table_map", metavar="MAP", callback=_parse_map, help=help)
 
 
 def is_dataset(path: Path) -> bool:
@@ -82,7 +101,13 @@ def dataset_flights(datasets: Sequence[Path]) -> list[Any]:
 
 
 def conditioned_flights(
-    sources: Sequence[Path], wind_paths: Sequence[Path], conditioning: Any, *, log_only: Mapping[str, Any], quiet: bool
+    sources: Sequence[Path],
+    wind_paths: Sequence[Path],
+    conditioning: Any,
+    *,
+    log_only: Mapping[str, Any],
+    quiet: bool,
+    table_map: Any = None,
 ) -> list[Any]:
     """The conditioned flights of `sources`: read from datasets, or logs ingested here with a progress bar.
 
@@ -98,6 +123,8 @@ def conditioned_flights(
         Options the command was given that only go with logs (see :func:`check_sources`).
     quiet : bool
         No progress bar.
+    table_map : flightlogs.readers.table.TableMap, optional
+        How tables among the logs are read (``--map``).
 
     Returns
     -------
@@ -116,6 +143,10 @@ def conditioned_flights(
 
     with progress_bar("reading", unit="bytes", quiet=quiet) as bar:
         campaign = ingest_campaign(
-            list(sources), list(wind_paths), options=conditioning, progress=lambda _name, done, total: bar(done, total)
+            list(sources),
+            list(wind_paths),
+            options=conditioning,
+            progress=lambda _name, done, total: bar(done, total),
+            table_map=table_map,
         )
     return list(campaign.require_flights())

@@ -10,6 +10,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
+from ._flights import map_option
 from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["batch", "expand_logs"]
@@ -24,14 +25,17 @@ Examples:
 
 #: Files a folder given on the command line contributes (case-insensitive suffixes).
 _LOG_SUFFIXES = (".ulg", ".bin", ".tlog")
+_TABLE_SUFFIXES = (".csv", ".txt", ".parquet")
 
 
-def expand_logs(paths: tuple[Path, ...]) -> list[Path]:
-    """The logs named, folders searched recursively for ``.ulg``, ``.bin`` and ``.tlog`` files (sorted)."""
+def expand_logs(paths: tuple[Path, ...], *, tables: bool = False) -> list[Path]:
+    """The logs named, folders searched recursively for ``.ulg``, ``.bin`` and ``.tlog`` files (sorted);
+    with `tables` (a ``--map`` given) also ``.csv``, ``.txt`` and ``.parquet``."""
+    suffixes = _LOG_SUFFIXES + (_TABLE_SUFFIXES if tables else ())
     found: list[Path] = []
     for path in paths:
         if path.is_dir():
-            found += sorted(p for p in path.rglob("*") if p.is_file() and p.suffix.lower() in _LOG_SUFFIXES)
+            found += sorted(p for p in path.rglob("*") if p.is_file() and p.suffix.lower() in suffixes)
         else:
             found.append(path)
     return list(dict.fromkeys(found))
@@ -44,6 +48,7 @@ def expand_logs(paths: tuple[Path, ...]) -> list[Path]:
 @wind_distance_option()
 @wind_offset_option("Anemometer clock minus UTC, s.")
 @click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset of each log by cross-correlation.")
+@map_option()
 @click.option(
     "--mapping",
     type=click.Path(exists=True, dir_okay=False, path_type=Path),
@@ -87,6 +92,7 @@ def batch(
     wind_distance: float | None,
     wind_offset: float | None,
     estimate_wind_offset: bool,
+    table_map: Any,
     mapping: Path | None,
     group_by: str,
     against: Path | None,
@@ -118,7 +124,7 @@ def batch(
     if scheduler is not None and workers is not None:
         raise click.UsageError("--workers sizes the local cluster; a --scheduler has its own workers")
     keys = tuple(k.strip() for k in group_by.split(",") if k.strip())
-    found = expand_logs(logs)
+    found = expand_logs(logs, tables=table_map is not None)
     if not found:
         raise click.UsageError(f"no log (.ulg, .bin, .tlog) in {', '.join(map(str, logs))}")
     log_mapping = read_log_mapping(mapping) if mapping is not None else None
@@ -133,6 +139,7 @@ def batch(
         ),
         wind_paths=tuple(str(Path(w).resolve()) for w in winds),
         wind_sha256=tuple(file_sha256(w) for w in winds),
+        table_map=table_map,
     )
     drift = DriftOptions()
     start = time.perf_counter()

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
-from ._flights import conditioned_flights
+from ._flights import conditioned_flights, map_option
 from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["discrepancy"]
@@ -36,6 +37,7 @@ Examples:
 @wind_option("Anemometer CSV, or a folder of them (repeatable), for the real flights: adds the wind term.")
 @wind_distance_option()
 @wind_offset_option()
+@map_option()
 @click.option(
     "--rotor-radius",
     "rotor_radius",
@@ -58,6 +60,7 @@ def discrepancy(
     wind_paths: tuple[Path, ...],
     wind_distance: float | None,
     wind_offset: float | None,
+    table_map: Any,
     rotor_radius: float | None,
     out: Path | None,
     report: Path | None,
@@ -102,11 +105,13 @@ def discrepancy(
     maneuvers = None if report is not None else ()
     windy = ConditioningOptions(wind_offset_s=wind_offset, wind_distance_m=wind_distance, segments=maneuvers)
     log_only = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset}
-    flown = conditioned_flights(list(real_logs), list(wind_paths), windy, log_only=log_only, quiet=quiet)
+    flown = conditioned_flights(
+        list(real_logs), list(wind_paths), windy, log_only=log_only, quiet=quiet, table_map=table_map
+    )
     real_series = [flight_series(f.source.name, f.records) for f in flown]
     if model is None:
         simulated = conditioned_flights(
-            list(sim_logs), [], ConditioningOptions(segments=maneuvers), log_only={}, quiet=quiet
+            list(sim_logs), [], ConditioningOptions(segments=maneuvers), log_only={}, quiet=quiet, table_map=table_map
         )
         sim_series = [flight_series(f.source.name, f.records) for f in simulated]
     else:

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
-from ._flights import check_sources, dataset_flights
+from ._flights import check_sources, dataset_flights, map_option
 from ._wind_options import (
     anemometer_at_option,
     segments_from,
@@ -85,6 +85,7 @@ class _GuidelineOption(click.Option):
 @wind_offset_option("Anemometer clock minus UTC, s.")
 @click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset by cross-correlation.")
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
+@map_option()
 @click.option(
     "--kind",
     default="sweep",
@@ -167,6 +168,7 @@ def fit(
     wind_offset: float | None,
     estimate_wind_offset: bool,
     segments_file: Path | None,
+    table_map: Any,
     kind: str,
     initial: dict[str, float],
     constants: dict[str, float],
@@ -227,6 +229,7 @@ def fit(
             "--wind-offset": wind_offset,
             "--estimate-wind-offset": estimate_wind_offset,
             "--segments": segments_file,
+            "--map": table_map,
         },
     )
     with staged_progress("identifying", quiet=quiet) as progress:
@@ -249,6 +252,7 @@ def fit(
                 conditioning=conditioning,
                 options=options,
                 progress=progress,
+                table_map=table_map,
             )
     if out is not None:
         write_model(out, model)

@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option
-from ._flights import conditioned_flights
+from ._flights import conditioned_flights, map_option
 from ._wind_options import segments_from, segments_option, wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["freqresp"]
@@ -65,6 +65,7 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
 @wind_distance_option("Anemometer-to-vehicle distance, m (with --wind; see `sysid ingest` for the other choices).")
 @wind_offset_option("Anemometer clock minus UTC, s (with --wind).")
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection (with logs).")
+@map_option()
 @click.option(
     "--pairs",
     callback=_pairs,
@@ -156,6 +157,7 @@ def freqresp(
     wind_distance: float | None,
     wind_offset: float | None,
     segments_file: Path | None,
+    table_map: Any,
     pairs: tuple[tuple[str, str], ...] | None,
     axis: str | None,
     kind: str,
@@ -209,8 +211,10 @@ def freqresp(
             "--wind-distance": wind_distance,
             "--wind-offset": wind_offset,
             "--segments": segments_file,
+            "--map": table_map,
         },
         quiet=quiet,
+        table_map=table_map,
     )
     computed = flight_responses(
         flights, pairs, axis=axis, kind=kind, options=options, use_excitation=reference != "none"

@@ -9,6 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
+from ._flights import map_option
 from ._warnings import mark_reported
 from ._wind_options import (
     anemometer_at_option,
@@ -103,6 +104,7 @@ _MAX_RATE_HZ = 10_000.0
     help="Rate of the common time base, up to 10 kHz (default: the fastest core signal's).",
 )
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
+@map_option()
 @click.option("-o", "--out", type=OutputPath(), help="Write signals, records and segments to this HDF5 dataset.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
@@ -119,11 +121,12 @@ def ingest(
     estimate_transport_delay: bool,
     rate_hz: float | None,
     segments_file: Path | None,
+    table_map: Any,
     out: Path | None,
     json_path: str | None,
     quiet: bool,
 ) -> None:
-    """Read LOGS (PX4 .ulg, ArduPilot .bin or MAVLink .tlog, detected from content), report every
+    """Read LOGS (PX4 .ulg, ArduPilot .bin or MAVLink .tlog, detected from content; CSV or Parquet tables with --map), report every
     canonical signal with its rate, unit and source, align the anemometer wind, and find the maneuvers."""
     from flightlogs.conditioning.condition import ConditioningOptions
     from flightlogs.store.campaign import ingest_campaign
@@ -148,6 +151,7 @@ def ingest(
             columns=columns,
             options=options,
             progress=lambda _name, done, total: bar(done, total),
+            table_map=table_map,
         )
     if out is not None:
         from flightlogs.store.dataset import write_dataset  # h5py: loaded only to write

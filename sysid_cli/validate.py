@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option
-from ._flights import conditioned_flights, is_dataset
+from ._flights import conditioned_flights, is_dataset, map_option
 from ._wind_options import (
     segments_from,
     segments_option,
@@ -38,6 +38,7 @@ Examples:
 @transport_delay_option()
 @wind_offset_option()
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis, kind) overriding detection.")
+@map_option()
 @click.option(
     "--before",
     "before_s",
@@ -77,6 +78,7 @@ def validate(
     transport_delay: float | None,
     wind_offset: float | None,
     segments_file: Path | None,
+    table_map: Any,
     before_s: float,
     after_s: float,
     initial_state: str,
@@ -112,8 +114,9 @@ def validate(
         "--wind-offset": wind_offset,
         "--transport-delay": transport_delay,
         "--segments": segments_file,
+        "--map": table_map,
     }
-    flights = conditioned_flights(logs, wind_paths, conditioning, log_only=log_only, quiet=quiet)
+    flights = conditioned_flights(logs, wind_paths, conditioning, log_only=log_only, quiet=quiet, table_map=table_map)
     if segments_file is not None and segments is not None:
         _check_segments(segments_file, segments, flights)
     verification, notes = _verify(

@@ -3,7 +3,7 @@
 The public names of :mod:`~flightlogs.readers.anemometer`, :mod:`~flightlogs.readers.ardupilot`,
 :mod:`~flightlogs.readers.dataflash`, :mod:`~flightlogs.readers.detect`,
 :mod:`~flightlogs.readers.dispatch`, :mod:`~flightlogs.readers.px4_topics`,
-:mod:`~flightlogs.readers.rig`, :mod:`~flightlogs.readers.tlog` and :mod:`~flightlogs.readers.ulog`
+:mod:`~flightlogs.readers.rig`, :mod:`~flightlogs.readers.table`, :mod:`~flightlogs.readers.tlog` and :mod:`~flightlogs.readers.ulog`
 are re-exported here: write ``from flightlogs.readers import name``. Modules with a leading
 underscore are private. Each name loads its module on first use: ``import flightlogs.readers.ulog``
 loads neither pymavlink nor the other readers.
@@ -42,6 +42,7 @@ if TYPE_CHECKING:
         rotor_count,
     )
     from flightlogs.readers.rig import HEIGHT_UNITS, THRUST_UNITS, RigData, read_rig_csv
+    from flightlogs.readers.table import TableColumn, TableMap, is_table, parse_table_map, read_table
     from flightlogs.readers.tlog import read_tlog
     from flightlogs.readers.ulog import read_ulog
 
@@ -80,6 +81,11 @@ __all__ = [
     "read_rig_csv",
     "HEIGHT_UNITS",
     "THRUST_UNITS",
+    "TableColumn",
+    "TableMap",
+    "parse_table_map",
+    "read_table",
+    "is_table",
     "read_tlog",
     "read_ulog",
 ]
@@ -112,6 +118,7 @@ _HOMES = {
         "px4_topics",
     ),
     **dict.fromkeys(("HEIGHT_UNITS", "THRUST_UNITS", "RigData", "read_rig_csv"), "rig"),
+    **dict.fromkeys(("TableColumn", "TableMap", "is_table", "parse_table_map", "read_table"), "table"),
     **dict.fromkeys(("read_tlog",), "tlog"),
     **dict.fromkeys(("read_ulog",), "ulog"),
 }

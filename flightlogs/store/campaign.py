@@ -14,6 +14,7 @@ from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
 from flightlogs.flightlog import FlightLog
 from flightlogs.readers.anemometer import WindMeasurement, read_anemometer_csv
 from flightlogs.readers.dispatch import read_log
+from flightlogs.readers.table import TableMap
 
 __all__ = ["Campaign", "ingest_campaign", "expand_wind_paths"]
 
@@ -99,13 +100,14 @@ def ingest_campaign(
     columns: Mapping[str, str] | None = None,
     options: ConditioningOptions = ConditioningOptions(),
     progress: Callable[[str, int, int], None] | None = None,
+    table_map: TableMap | None = None,
 ) -> Campaign:
     """Read logs and anemometer files, pair them by UTC and condition each flight.
 
     Parameters
     ----------
     log_paths : sequence of Path
-        Flight logs (any supported format).
+        Flight logs (any supported format), or CSV / Parquet tables read through `table_map`.
     wind_paths : sequence of Path, optional
         Anemometer CSV files or folders of them.
     columns : Mapping[str, str], optional
@@ -115,6 +117,8 @@ def ingest_campaign(
     progress : callable, optional
         ``progress(file_name, done, total)`` while reading: bytes read of all
         the logs so far and in all, so one bar runs once from 0 to the end.
+    table_map : TableMap, optional
+        Which column of a table is which signal (:func:`~flightlogs.readers.table.parse_table_map`).
 
     Returns
     -------
@@ -141,7 +145,7 @@ def ingest_campaign(
             if progress is not None:
                 progress(name, before + min(done, size), sum(sizes))
 
-        logs.append(read_log(path, progress=report))
+        logs.append(read_log(path, progress=report, table_map=table_map))
     winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
     paired = pair_winds(logs, winds, clock_offset_s=options.wind_offset_s)
     conditioned: list[ConditionedFlight | None] = []

@@ -28,6 +28,7 @@ _BLOCK_S = 0.5
 _TRANSITION_S = 2.0  # the climb or descent to a new step may take this long without splitting the step
 _PLAUSIBLE = (0.8, 2.0)  # F/F0 outside this band: on the ground, motors idle, or not hovering
 _NOISE_FLOOR_M = 1e-6
+_ROTOR_SPEEDS = ("rpm", "rad/s")  # motor signals that are rotor speeds (a motion-capture rig's rpm), not commands
 
 
 def flight_thrust_ratio(log: FlightLog, config: GroundEffectDataConfig) -> ThrustRatioData:
@@ -171,7 +172,7 @@ def _noise(y: np.ndarray) -> float:
 
 
 def _eq_2_6(log: FlightLog, config: GroundEffectDataConfig) -> tuple[np.ndarray, np.ndarray, str]:
-    """Time base and F0 = sum k_f PWM_i (eq. 2.6), N, on the first motor's time base."""
+    """Time base and F0 = sum k_f PWM_i (eq. 2.6; k_f omega_i^2 for rotor speeds), N, on the first motor's time base."""
     motors: list[Signal] = sorted(
         (s for n, s in log.signals.items() if n.startswith("motor_")), key=lambda s: int(s.name.split("_")[1])
     )
@@ -182,10 +183,14 @@ def _eq_2_6(log: FlightLog, config: GroundEffectDataConfig) -> tuple[np.ndarray,
         raise DataError(f"{log.path.name}: motor signals in mixed units {sorted(units)}")
     unit = units.pop()
     time_s = motors[0].time_s
+    squared = unit in _ROTOR_SPEEDS  # thrust grows with the square of a rotor's speed, with a command's value
     total = np.zeros_like(time_s)
     for motor in motors:
-        total += np.interp(time_s, motor.time_s, motor.values)
-    if unit == "normalised":
+        commanded = np.interp(time_s, motor.time_s, motor.values)
+        total += commanded**2 if squared else commanded
+    if squared:
+        counts, note = total, f", rotor speeds in {unit}: k_f taken per ({unit})^2"
+    elif unit == "normalised":
         counts, note = total * config.pwm_full_scale, f", motors 0..1 scaled to {config.pwm_full_scale:g} counts"
     else:
         counts, note = total, f", motors in {unit} taken as counts"

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import DataError
+from flightlogs.readers.table import TableMap
 from flightlogs.store.campaign import ingest_campaign
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify.engine import VerificationOptions, verify
@@ -30,6 +31,7 @@ def verify_logs(
     after_s: float = 1.0,
     progress: Callable[[str, int, int], None] | None = None,
     unidentified: Mapping[str, str] | None = None,
+    table_map: TableMap | None = None,
 ) -> Verification:
     """Verify `model` (and `wind_model`) on every doublet of the logs.
 
@@ -56,6 +58,8 @@ def verify_logs(
         ``progress(file_name, done, total)`` while reading, bytes.
     unidentified : Mapping[str, str], optional
         Mixer inputs of the model's unidentified axes, with the reason (see :func:`verify_flights`).
+    table_map : TableMap, optional
+        Which column of a CSV or Parquet table is which signal (tables among `log_paths`).
 
     Returns
     -------
@@ -72,7 +76,9 @@ def verify_logs(
             "the model has wind terms but no anemometer file was given (--wind); "
             "without wind only the model without G_w can be verified"
         )
-    campaign = ingest_campaign(list(log_paths), list(wind_paths), options=conditioning, progress=progress)
+    campaign = ingest_campaign(
+        list(log_paths), list(wind_paths), options=conditioning, progress=progress, table_map=table_map
+    )
     return verify_flights(
         model,
         campaign.require_flights(),
