@@ -186,6 +186,10 @@ class FlightLog:
     system_id_runs : tuple of SystemIdRun
         ArduPilot System ID maneuvers logged (SIDS messages), in time order;
         empty when the log holds none (and for other autopilots).
+    vehicle_type : str
+        ``"multirotor"``, the kind of vehicle the log says it is otherwise
+        (``"fixed wing (MAV_TYPE 1)"``, ``"rover (ArduRover)"``), or ``""``
+        when it does not say (a table, a generic MAV_TYPE 0).
     """
 
     path: Path
@@ -198,6 +202,7 @@ class FlightLog:
     utc_offset_s: float | None = None
     warnings: tuple[str, ...] = ()
     system_id_runs: tuple[SystemIdRun, ...] = ()
+    vehicle_type: str = ""
 
     def __post_init__(self) -> None:
         for name, signal in self.signals.items():

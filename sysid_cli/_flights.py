@@ -10,7 +10,7 @@ import click
 
 from ._common import progress_bar
 
-__all__ = ["is_dataset", "check_sources", "dataset_flights", "conditioned_flights", "map_option"]
+__all__ = ["is_dataset", "check_sources", "dataset_flights", "conditioned_flights", "reading_options", "reading_from"]
 
 _MAP_HELP = (
     "Column map of CSV / Parquet tables among the inputs: time=0,delta_lat=1,p=2:deg/s (canonical name = "
@@ -27,9 +27,34 @@ def _parse_map(_ctx: click.Context, _param: click.Parameter, value: str | None) 
     return parse_table_map(value)
 
 
-def map_option(help: str = _MAP_HELP) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """``--map TEXT|FILE`` (into ``table_map``): how the columns of a table are read as signals."""
-    return click.option("--map", "table_map", metavar="MAP", callback=_parse_map, help=help)
+def reading_options(map_help: str = _MAP_HELP) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """``--map TEXT|FILE`` (into ``table_map``: how a table's columns are read as signals) and
+    ``--vehicle multirotor`` (into ``vehicle``: read a log of another vehicle type as a multirotor)."""
+
+    def decorate(command: Callable[..., Any]) -> Callable[..., Any]:
+        vehicle = click.option(
+            "--vehicle",
+            type=click.Choice(["multirotor"]),
+            help="Read a log whose vehicle type says otherwise (fixed wing, rover...) as a multirotor.",
+        )
+        return click.option("--map", "table_map", metavar="MAP", callback=_parse_map, help=map_help)(vehicle(command))
+
+    return decorate
+
+
+def reading_from(table_map: Any, vehicle: str | None) -> Any:
+    """The :class:`~flightlogs.readers.dispatch.ReadOptions` of ``--map`` and ``--vehicle``.
+
+    Parameters
+    ----------
+    table_map : flightlogs.readers.table.TableMap or None
+        The parsed ``--map``.
+    vehicle : str or None
+        ``--vehicle`` (``"multirotor"`` or None).
+    """
+    from flightlogs.readers.dispatch import ReadOptions
+
+    return ReadOptions(table_map=table_map, force_multirotor=vehicle == "multirotor")
 
 
 def is_dataset(path: Path) -> bool:
@@ -107,7 +132,7 @@ def conditioned_flights(
     *,
     log_only: Mapping[str, Any],
     quiet: bool,
-    table_map: Any = None,
+    reading: Any = None,
 ) -> list[Any]:
     """The conditioned flights of `sources`: read from datasets, or logs ingested here with a progress bar.
 
@@ -123,8 +148,8 @@ def conditioned_flights(
         Options the command was given that only go with logs (see :func:`check_sources`).
     quiet : bool
         No progress bar.
-    table_map : flightlogs.readers.table.TableMap, optional
-        How tables among the logs are read (``--map``).
+    reading : flightlogs.readers.dispatch.ReadOptions, optional
+        How tables among the logs are read and another vehicle refused (``--map``, ``--vehicle``).
 
     Returns
     -------
@@ -147,6 +172,6 @@ def conditioned_flights(
             list(wind_paths),
             options=conditioning,
             progress=lambda _name, done, total: bar(done, total),
-            table_map=table_map,
+            **({} if reading is None else {"reading": reading}),
         )
     return list(campaign.require_flights())

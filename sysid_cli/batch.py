@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
-from ._flights import map_option
+from ._flights import reading_from, reading_options
 from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["batch", "expand_logs"]
@@ -48,7 +48,7 @@ def expand_logs(paths: tuple[Path, ...], *, tables: bool = False) -> list[Path]:
 @wind_distance_option()
 @wind_offset_option("Anemometer clock minus UTC, s.")
 @click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset of each log by cross-correlation.")
-@map_option()
+@reading_options()
 @click.option(
     "--mapping",
     type=click.Path(exists=True, dir_okay=False, path_type=Path),
@@ -93,6 +93,7 @@ def batch(
     wind_offset: float | None,
     estimate_wind_offset: bool,
     table_map: Any,
+    vehicle: str | None,
     mapping: Path | None,
     group_by: str,
     against: Path | None,
@@ -139,7 +140,7 @@ def batch(
         ),
         wind_paths=tuple(str(Path(w).resolve()) for w in winds),
         wind_sha256=tuple(file_sha256(w) for w in winds),
-        table_map=table_map,
+        reading=reading_from(table_map, vehicle),
     )
     drift = DriftOptions()
     start = time.perf_counter()

@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
-from ._flights import conditioned_flights, map_option
+from ._flights import conditioned_flights, reading_from, reading_options
 from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["discrepancy"]
@@ -37,7 +37,7 @@ Examples:
 @wind_option("Anemometer CSV, or a folder of them (repeatable), for the real flights: adds the wind term.")
 @wind_distance_option()
 @wind_offset_option()
-@map_option()
+@reading_options()
 @click.option(
     "--rotor-radius",
     "rotor_radius",
@@ -61,6 +61,7 @@ def discrepancy(
     wind_distance: float | None,
     wind_offset: float | None,
     table_map: Any,
+    vehicle: str | None,
     rotor_radius: float | None,
     out: Path | None,
     report: Path | None,
@@ -106,12 +107,22 @@ def discrepancy(
     windy = ConditioningOptions(wind_offset_s=wind_offset, wind_distance_m=wind_distance, segments=maneuvers)
     log_only = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset}
     flown = conditioned_flights(
-        list(real_logs), list(wind_paths), windy, log_only=log_only, quiet=quiet, table_map=table_map
+        list(real_logs),
+        list(wind_paths),
+        windy,
+        log_only=log_only,
+        quiet=quiet,
+        reading=reading_from(table_map, vehicle),
     )
     real_series = [flight_series(f.source.name, f.records) for f in flown]
     if model is None:
         simulated = conditioned_flights(
-            list(sim_logs), [], ConditioningOptions(segments=maneuvers), log_only={}, quiet=quiet, table_map=table_map
+            list(sim_logs),
+            [],
+            ConditioningOptions(segments=maneuvers),
+            log_only={},
+            quiet=quiet,
+            reading=reading_from(table_map, vehicle),
         )
         sim_series = [flight_series(f.source.name, f.records) for f in simulated]
     else:

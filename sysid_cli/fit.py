@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
-from ._flights import check_sources, dataset_flights, map_option
+from ._flights import check_sources, dataset_flights, reading_from, reading_options
 from ._wind_options import (
     anemometer_at_option,
     segments_from,
@@ -85,7 +85,7 @@ class _GuidelineOption(click.Option):
 @wind_offset_option("Anemometer clock minus UTC, s.")
 @click.option("--estimate-wind-offset", is_flag=True, help="Refine the clock offset by cross-correlation.")
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
-@map_option()
+@reading_options()
 @click.option(
     "--kind",
     default="sweep",
@@ -169,6 +169,7 @@ def fit(
     estimate_wind_offset: bool,
     segments_file: Path | None,
     table_map: Any,
+    vehicle: str | None,
     kind: str,
     initial: dict[str, float],
     constants: dict[str, float],
@@ -230,6 +231,7 @@ def fit(
             "--estimate-wind-offset": estimate_wind_offset,
             "--segments": segments_file,
             "--map": table_map,
+            "--vehicle": vehicle,
         },
     )
     with staged_progress("identifying", quiet=quiet) as progress:
@@ -252,7 +254,7 @@ def fit(
                 conditioning=conditioning,
                 options=options,
                 progress=progress,
-                table_map=table_map,
+                reading=reading_from(table_map, vehicle),
             )
     if out is not None:
         write_model(out, model)

@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option
-from ._flights import conditioned_flights, map_option
+from ._flights import conditioned_flights, reading_from, reading_options
 from ._wind_options import segments_from, segments_option, wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["freqresp"]
@@ -65,7 +65,7 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
 @wind_distance_option("Anemometer-to-vehicle distance, m (with --wind; see `sysid ingest` for the other choices).")
 @wind_offset_option("Anemometer clock minus UTC, s (with --wind).")
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection (with logs).")
-@map_option()
+@reading_options()
 @click.option(
     "--pairs",
     callback=_pairs,
@@ -158,6 +158,7 @@ def freqresp(
     wind_offset: float | None,
     segments_file: Path | None,
     table_map: Any,
+    vehicle: str | None,
     pairs: tuple[tuple[str, str], ...] | None,
     axis: str | None,
     kind: str,
@@ -212,9 +213,10 @@ def freqresp(
             "--wind-offset": wind_offset,
             "--segments": segments_file,
             "--map": table_map,
+            "--vehicle": vehicle,
         },
         quiet=quiet,
-        table_map=table_map,
+        reading=reading_from(table_map, vehicle),
     )
     computed = flight_responses(
         flights, pairs, axis=axis, kind=kind, options=options, use_excitation=reference != "none"

@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
-from ._flights import map_option
+from ._flights import reading_from, reading_options
 from .ingest import parse_columns
 
 __all__ = ["ground_effect"]
@@ -64,7 +64,7 @@ def _models(_ctx: click.Context, _param: click.Parameter, value: str | None) -> 
 def _data_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Options turning a rig CSV or a flight log into F/F0 against Z/R (shared by fit and spacing)."""
     options = [
-        map_option(
+        reading_options(
             "Flight table (motion capture, CSV or Parquet): its column map, e.g. time=t:ms,height_agl=z:mm,"
             "motor_1=rpm1:rpm,... (rotor speeds in rpm or rad/s give F0 = k_f sum omega^2), or a .toml file."
         ),
@@ -208,7 +208,9 @@ def fit(data: Path, out: Path | None, report: Path | None, json_path: str | None
 
     data_config, fit_config = _configs(kw)
     with progress_bar("reading", unit="bytes", quiet=quiet) as bar:
-        points = load_thrust_ratio(data, data_config, progress=bar, table_map=kw["table_map"])
+        points = load_thrust_ratio(
+            data, data_config, progress=bar, reading=reading_from(kw["table_map"], kw["vehicle"])
+        )
     result = fit_ground_effect(points, fit_config)
     if out is not None:
         write_ground_effect_model(result, out)
@@ -262,7 +264,9 @@ def spacing(
     _check_spacings(spacing_mm, data)
     data_config, fit_config = _configs(kw)
     with progress_bar("fitting", quiet=quiet) as bar:
-        datasets = [load_thrust_ratio(path, data_config, table_map=kw["table_map"]) for path in data]
+        datasets = [
+            load_thrust_ratio(path, data_config, reading=reading_from(kw["table_map"], kw["vehicle"])) for path in data
+        ]
         study = spacing_study(datasets, [s * 1e-3 for s in spacing_mm], rotors=rotors, config=fit_config, progress=bar)
     if report is not None:
         from reports.groundeffect_report import write_spacing_report

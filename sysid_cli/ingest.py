@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
-from ._flights import map_option
+from ._flights import reading_from, reading_options
 from ._warnings import mark_reported
 from ._wind_options import (
     anemometer_at_option,
@@ -104,7 +104,7 @@ _MAX_RATE_HZ = 10_000.0
     help="Rate of the common time base, up to 10 kHz (default: the fastest core signal's).",
 )
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis[, kind]) overriding detection.")
-@map_option()
+@reading_options()
 @click.option("-o", "--out", type=OutputPath(), help="Write signals, records and segments to this HDF5 dataset.")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no table.")
@@ -122,6 +122,7 @@ def ingest(
     rate_hz: float | None,
     segments_file: Path | None,
     table_map: Any,
+    vehicle: str | None,
     out: Path | None,
     json_path: str | None,
     quiet: bool,
@@ -151,7 +152,7 @@ def ingest(
             columns=columns,
             options=options,
             progress=lambda _name, done, total: bar(done, total),
-            table_map=table_map,
+            reading=reading_from(table_map, vehicle),
         )
     if out is not None:
         from flightlogs.store.dataset import write_dataset  # h5py: loaded only to write

@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option
-from ._flights import conditioned_flights, is_dataset, map_option
+from ._flights import conditioned_flights, is_dataset, reading_from, reading_options
 from ._wind_options import (
     segments_from,
     segments_option,
@@ -38,7 +38,7 @@ Examples:
 @transport_delay_option()
 @wind_offset_option()
 @segments_option("TOML or CSV of maneuvers (start_s, end_s, axis, kind) overriding detection.")
-@map_option()
+@reading_options()
 @click.option(
     "--before",
     "before_s",
@@ -79,6 +79,7 @@ def validate(
     wind_offset: float | None,
     segments_file: Path | None,
     table_map: Any,
+    vehicle: str | None,
     before_s: float,
     after_s: float,
     initial_state: str,
@@ -115,8 +116,11 @@ def validate(
         "--transport-delay": transport_delay,
         "--segments": segments_file,
         "--map": table_map,
+        "--vehicle": vehicle,
     }
-    flights = conditioned_flights(logs, wind_paths, conditioning, log_only=log_only, quiet=quiet, table_map=table_map)
+    flights = conditioned_flights(
+        logs, wind_paths, conditioning, log_only=log_only, quiet=quiet, reading=reading_from(table_map, vehicle)
+    )
     if segments_file is not None and segments is not None:
         _check_segments(segments_file, segments, flights)
     verification, notes = _verify(

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
         read_messages,
     )
     from flightlogs.readers.detect import detect_format
-    from flightlogs.readers.dispatch import ProgressCallback, read_log
+    from flightlogs.readers.dispatch import ProgressCallback, ReadOptions, read_log
     from flightlogs.readers.px4_topics import (
         AUTOSTART_ROTORS,
         CA_AIRFRAME_NAMES,
@@ -39,6 +39,8 @@ if TYPE_CHECKING:
         SignalGroup,
         TopicSource,
         describe_vehicle,
+        mav_type_vehicle,
+        px4_vehicle_type,
         rotor_count,
     )
     from flightlogs.readers.rig import HEIGHT_UNITS, THRUST_UNITS, RigData, read_rig_csv
@@ -63,6 +65,7 @@ __all__ = [
     "message_dtype",
     "detect_format",
     "read_log",
+    "ReadOptions",
     "ProgressCallback",
     "Conversion",
     "TopicSource",
@@ -77,6 +80,8 @@ __all__ = [
     "CA_AIRFRAME_NAMES",
     "rotor_count",
     "describe_vehicle",
+    "mav_type_vehicle",
+    "px4_vehicle_type",
     "RigData",
     "read_rig_csv",
     "HEIGHT_UNITS",
@@ -98,7 +103,7 @@ _HOMES = {
         "dataflash",
     ),
     **dict.fromkeys(("detect_format",), "detect"),
-    **dict.fromkeys(("ProgressCallback", "read_log"), "dispatch"),
+    **dict.fromkeys(("ProgressCallback", "ReadOptions", "read_log"), "dispatch"),
     **dict.fromkeys(
         (
             "AUTOSTART_ROTORS",
@@ -113,6 +118,8 @@ _HOMES = {
             "SignalGroup",
             "TopicSource",
             "describe_vehicle",
+            "mav_type_vehicle",
+            "px4_vehicle_type",
             "rotor_count",
         ),
         "px4_topics",

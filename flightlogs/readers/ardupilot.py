@@ -145,6 +145,13 @@ _SYSID_AXES = {
     12: "mixer yaw",
     13: "mixer thrust",
 }
+_FIRMWARE_KINDS = {
+    "Copter": "multirotor",
+    "Plane": "fixed wing",
+    "Rover": "rover",
+    "Sub": "submarine",
+    "Blimp": "blimp",
+}
 _FIRMWARE = re.compile(r"^(APM:\w+|Ardu\w+|ArduPilot\w*)\s+V\d")
 #: The board and its 96-bit unique id, as ArduPilot logs them at boot (``"fmuv5 00290019 32375118 32363435"``).
 _BOARD_ID = re.compile(r"^\S+( [0-9A-F]{8}){3}$")
@@ -262,6 +269,7 @@ def _flightlog(messages: DataFlashMessages) -> FlightLog:
         autopilot="ardupilot",
         signals=signals,
         vehicle=_vehicle(messages, parameters, n_motors),
+        vehicle_type=_vehicle_type(messages, parameters),
         board_id=next((t for t in _texts(messages) if _BOARD_ID.match(t)), ""),
         parameters=parameters,
         utc_offset_s=_utc_offset(messages),
@@ -506,6 +514,17 @@ def _texts(messages: DataFlashMessages) -> list[str]:
 def _frame_text(messages: DataFlashMessages) -> str:
     """``"QUAD"`` from a ``"Frame: QUAD"`` MSG, or ``""``."""
     return next((t.split(":", 1)[1].strip() for t in _texts(messages) if t.startswith("Frame:")), "")
+
+
+def _vehicle_type(messages: DataFlashMessages, parameters: dict[str, float]) -> str:
+    """``multirotor`` for ArduCopter (a helicopter frame aside), the firmware's kind otherwise, ``""`` if unlogged."""
+    firmware = next((t for t in _texts(messages) if _FIRMWARE.match(t)), "")
+    kind = next((k for k in _FIRMWARE_KINDS if k in firmware), None)
+    if kind is None:
+        return ""
+    if kind != "Copter":
+        return f"{_FIRMWARE_KINDS[kind]} ({firmware.split()[0]})"
+    return "helicopter (FRAME_CLASS 6)" if parameters.get("FRAME_CLASS") == 6 else "multirotor"
 
 
 def _vehicle(messages: DataFlashMessages, parameters: dict[str, float], n_motors: int | None) -> str:

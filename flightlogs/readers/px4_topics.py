@@ -53,6 +53,8 @@ __all__ = [
     "AUTOSTART_ROTORS",
     "CA_AIRFRAME_NAMES",
     "rotor_count",
+    "mav_type_vehicle",
+    "px4_vehicle_type",
     "describe_vehicle",
 ]
 
@@ -396,6 +398,46 @@ CA_AIRFRAME_NAMES: dict[int, str] = {
     10: "helicopter (tail servo)",
     11: "helicopter (coaxial)",
 }
+
+
+def mav_type_vehicle(mav_type: int | None) -> str:
+    """``"multirotor"`` for a multirotor ``MAV_TYPE``, ``""`` for none or generic (0), else what it is.
+
+    Parameters
+    ----------
+    mav_type : int or None
+        MAVLink ``MAV_TYPE`` (PX4's parameter, a HEARTBEAT's ``type``).
+
+    Examples
+    --------
+    >>> mav_type_vehicle(13), mav_type_vehicle(0), mav_type_vehicle(1), mav_type_vehicle(10)
+    ('multirotor', '', 'fixed wing (MAV_TYPE 1)', 'MAV_TYPE 10')
+    """
+    if mav_type is None or mav_type == 0:
+        return ""
+    if mav_type in MAV_TYPE_ROTORS:
+        return "multirotor"
+    return f"{MAV_TYPE_NAMES[mav_type]} (MAV_TYPE {mav_type})" if mav_type in MAV_TYPE_NAMES else f"MAV_TYPE {mav_type}"
+
+
+def px4_vehicle_type(parameters: Mapping[str, float]) -> str:
+    """What a PX4 log's ``CA_AIRFRAME`` and ``MAV_TYPE`` say the vehicle is (see :func:`mav_type_vehicle`).
+
+    Parameters
+    ----------
+    parameters : Mapping[str, float]
+        The log's parameters.
+
+    Examples
+    --------
+    >>> px4_vehicle_type({"MAV_TYPE": 2.0, "CA_AIRFRAME": 0.0}), px4_vehicle_type({"CA_AIRFRAME": 1.0})
+    ('multirotor', 'fixed-wing (CA_AIRFRAME 1)')
+    """
+    airframe = _int_param(parameters, "CA_AIRFRAME")
+    if airframe is not None and airframe != 0:
+        return f"{CA_AIRFRAME_NAMES.get(airframe, 'airframe')} (CA_AIRFRAME {airframe})"
+    found = mav_type_vehicle(_int_param(parameters, "MAV_TYPE"))
+    return found or ("multirotor" if airframe == 0 else "")
 
 
 def rotor_count(parameters: Mapping[str, float], *, allocator_only: bool = False) -> int:

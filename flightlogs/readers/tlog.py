@@ -53,6 +53,7 @@ from flightlogs.flightlog import FlightLog, Signal
 from flightlogs.readers._references import tlog_references
 from flightlogs.readers._series import make_signal
 from flightlogs.readers._tlog_scan import FIELDS, Key, Scan, message_table, scan_tlog
+from flightlogs.readers.px4_topics import mav_type_vehicle
 
 __all__ = ["read_tlog"]
 
@@ -197,6 +198,7 @@ def read_tlog(path: str | PathLike[str], *, progress: Callable[[int, int], None]
             autopilot=autopilot,  # type: ignore[arg-type]
             signals=signals,
             vehicle=_vehicle_string(rows, mav_type),
+            vehicle_type=mav_type_vehicle(mav_type),
             parameters=parameters,
             utc_offset_s=_utc_offset(tables, clock),
             warnings=caught.messages,

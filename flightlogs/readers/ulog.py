@@ -37,6 +37,7 @@ from flightlogs.readers.px4_topics import (
     SignalGroup,
     TopicSource,
     describe_vehicle,
+    px4_vehicle_type,
     rotor_count,
 )
 
@@ -156,6 +157,7 @@ def read_ulog(path: str | os.PathLike[str], *, progress: Callable[[int, int], No
             autopilot="px4",
             signals=signals,
             vehicle=describe_vehicle(ulog.msg_info_dict, parameters),
+            vehicle_type=px4_vehicle_type(parameters),
             board_id=str(ulog.msg_info_dict.get("sys_uuid", "")),
             parameters=parameters,
             utc_offset_s=utc_offset_s,

@@ -13,8 +13,7 @@ from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOpt
 from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
 from flightlogs.flightlog import FlightLog
 from flightlogs.readers.anemometer import WindMeasurement, read_anemometer_csv
-from flightlogs.readers.dispatch import read_log
-from flightlogs.readers.table import TableMap
+from flightlogs.readers.dispatch import ReadOptions, read_log
 
 __all__ = ["Campaign", "ingest_campaign", "expand_wind_paths"]
 
@@ -100,14 +99,14 @@ def ingest_campaign(
     columns: Mapping[str, str] | None = None,
     options: ConditioningOptions = ConditioningOptions(),
     progress: Callable[[str, int, int], None] | None = None,
-    table_map: TableMap | None = None,
+    reading: ReadOptions = ReadOptions(),
 ) -> Campaign:
     """Read logs and anemometer files, pair them by UTC and condition each flight.
 
     Parameters
     ----------
     log_paths : sequence of Path
-        Flight logs (any supported format), or CSV / Parquet tables read through `table_map`.
+        Flight logs (any supported format), or CSV / Parquet tables read through ``reading.table_map``.
     wind_paths : sequence of Path, optional
         Anemometer CSV files or folders of them.
     columns : Mapping[str, str], optional
@@ -117,8 +116,8 @@ def ingest_campaign(
     progress : callable, optional
         ``progress(file_name, done, total)`` while reading: bytes read of all
         the logs so far and in all, so one bar runs once from 0 to the end.
-    table_map : TableMap, optional
-        Which column of a table is which signal (:func:`~flightlogs.readers.table.parse_table_map`).
+    reading : ReadOptions, optional
+        How tables are read, and whether a log of another vehicle is refused (:func:`read_log`).
 
     Returns
     -------
@@ -145,7 +144,7 @@ def ingest_campaign(
             if progress is not None:
                 progress(name, before + min(done, size), sum(sizes))
 
-        logs.append(read_log(path, progress=report, table_map=table_map))
+        logs.append(read_log(path, progress=report, reading=reading))
     winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
     paired = pair_winds(logs, winds, clock_offset_s=options.wind_offset_s)
     conditioned: list[ConditionedFlight | None] = []

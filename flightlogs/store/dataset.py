@@ -4,7 +4,7 @@ Layout (schema version 2; version 1 held variable-length strings, still read)::
 
     /                               attrs: schema, schema_version, software, created_utc
     /logs/<key>/                    attrs: path, sha256, log_format, autopilot, vehicle,
-                                           board_id (absent in files written before it: ""),
+                                           board_id, vehicle_type (absent in files written before them: ""),
                                            utc_offset_s (NaN when unknown), warnings (JSON)
     /logs/<key>/parameters          compound dataset (name, value)
     /logs/<key>/system_id_runs      compound dataset, one row per ArduPilot SIDS run (fields of SystemIdRun)
@@ -200,6 +200,7 @@ def _write_log(group: h5py.Group, log: FlightLog) -> None:
         ("autopilot", log.autopilot),
         ("vehicle", log.vehicle),
         ("board_id", log.board_id),
+        ("vehicle_type", log.vehicle_type),
         ("warnings", json.dumps(list(log.warnings))),
     ):
         put_text(group.attrs, name, value)
@@ -265,6 +266,7 @@ def _read_log(group: h5py.Group) -> FlightLog:
         utc_offset_s=None if np.isnan(offset) else offset,
         warnings=tuple(json.loads(group.attrs["warnings"])),
         system_id_runs=runs,
+        vehicle_type=text(group.attrs["vehicle_type"]) if "vehicle_type" in group.attrs else "",
     )
 
 

@@ -21,7 +21,7 @@ def log_summary(log: FlightLog) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``path``, ``log_format``, ``autopilot``, ``vehicle``, ``duration_s``,
+        ``path``, ``log_format``, ``autopilot``, ``vehicle``, ``vehicle_type``, ``duration_s``,
         ``utc_start`` (ISO-8601 or None), ``signals.NAME.{samples, rate_hz,
         unit, source}``, ``missing`` (names) and ``warnings`` (sentences).
     """
@@ -31,6 +31,7 @@ def log_summary(log: FlightLog) -> dict[str, Any]:
         "log_format": log.log_format,
         "autopilot": log.autopilot,
         "vehicle": log.vehicle,
+        "vehicle_type": log.vehicle_type,
         "duration_s": round(log.duration_s, 6),
         "utc_start": utc_start.isoformat() if utc_start else None,
         "signals": {

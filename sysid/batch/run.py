@@ -79,7 +79,7 @@ def run_batch(
     reference = None if against is None else str(Path(against).resolve())
     surveys = _gathered(
         client,
-        [client.submit(survey_log, p, cache, settings.table_map, pure=False) for p in paths],
+        [client.submit(survey_log, p, cache, settings.reading, pure=False) for p in paths],
         lambda k, err: LogSurvey(path=paths[k], sha256="", error=f"{paths[k]}: {err}"),
         "reading",
         progress,

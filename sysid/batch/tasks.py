@@ -21,7 +21,7 @@ from typing import Any
 
 from flightlogs.conditioning.condition import ConditioningOptions
 from flightlogs.errors import DataError, SysidError, SysidWarning
-from flightlogs.readers.table import TableMap
+from flightlogs.readers.dispatch import ReadOptions
 from sysid.batch.cache import cache_key, load_fit, load_survey, save_fit, save_survey
 from sysid.batch.groups import Group
 from sysid.batch.results import GroupFit, LogComparison, LogSurvey
@@ -53,8 +53,8 @@ class BatchSettings:
         Their hashes.
     initial_state : str
         How the verification starts each doublet (``estimated``: with VERIFY's bias and shift).
-    table_map : TableMap or None
-        Which column of a CSV or Parquet table is which signal (tables among the logs).
+    reading : ReadOptions
+        The column map of tables among the logs, and whether a log of another vehicle is refused.
     """
 
     structure: str
@@ -64,7 +64,7 @@ class BatchSettings:
     wind_paths: tuple[str, ...] = ()
     wind_sha256: tuple[str, ...] = ()
     initial_state: str = "estimated"
-    table_map: TableMap | None = None
+    reading: ReadOptions = field(default_factory=ReadOptions)
 
     def key_parts(self) -> tuple[str, ...]:
         """Text of everything that changes a fit, for :func:`~sysid.batch.cache.cache_key`."""
@@ -74,11 +74,11 @@ class BatchSettings:
             repr(self.identify),
             *self.wind_sha256,
             self.initial_state,
-            repr(self.table_map),
+            repr(self.reading),
         )
 
 
-def survey_log(path: str, cache: str, table_map: TableMap | None = None) -> LogSurvey:
+def survey_log(path: str, cache: str, reading: ReadOptions = ReadOptions()) -> LogSurvey:
     """Hash and read one log: its vehicle's id and its start in UTC, or why it cannot be read.
 
     Parameters
@@ -87,8 +87,8 @@ def survey_log(path: str, cache: str, table_map: TableMap | None = None) -> LogS
         The log, absolute.
     cache : str
         The cache folder.
-    table_map : TableMap, optional
-        How a table is read (:class:`BatchSettings`).
+    reading : ReadOptions, optional
+        How a table is read and another vehicle refused (:class:`BatchSettings`).
 
     Returns
     -------
@@ -107,7 +107,7 @@ def survey_log(path: str, cache: str, table_map: TableMap | None = None) -> LogS
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SysidWarning)  # the fit reads the log again and keeps its warnings
-            log = read_log(path, table_map=table_map)
+            log = read_log(path, reading=reading)
     except SysidError as err:
         survey = LogSurvey(path=path, sha256=sha256, error=str(err))
     else:
@@ -174,7 +174,7 @@ def _fit(group: Group, settings: BatchSettings, folder: Path, base: GroupFit, re
             paths,
             [Path(p) for p in settings.wind_paths],
             options=settings.conditioning,
-            table_map=settings.table_map,
+            reading=settings.reading,
         )
         flights = campaign.require_flights()
         model = identify_flights(flights, settings.structure, options=settings.identify, files=paths)

@@ -24,7 +24,7 @@ from scipy import linalg
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import FitError, FitWarning, collected_warnings
-from flightlogs.readers.table import TableMap
+from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.record import Record
 from flightlogs.store.dataset import file_sha256
 from flightlogs.writers.jsonio import jsonable
@@ -455,7 +455,7 @@ def identify_logs(
     conditioning: ConditioningOptions = ConditioningOptions(),
     options: IdentifyOptions = IdentifyOptions(),
     progress: Progress | None = None,
-    table_map: TableMap | None = None,
+    reading: ReadOptions = ReadOptions(),
 ) -> IdentifiedModel:
     """Read, condition and identify: ``sysid fit LOGS... --wind CSV``.
 
@@ -473,8 +473,8 @@ def identify_logs(
         Identification choices.
     progress : callable, optional
         ``progress(stage, done, total)``.
-    table_map : TableMap, optional
-        Which column of a CSV or Parquet table is which signal (tables among `log_paths`).
+    reading : ReadOptions, optional
+        How tables among `log_paths` are read, and whether a log of another vehicle is refused.
 
     Returns
     -------
@@ -489,15 +489,15 @@ def identify_logs(
     """
     from flightlogs.store.campaign import expand_wind_paths, ingest_campaign
 
-    def reading(name: str, done: int, total: int) -> None:
+    def read(name: str, done: int, total: int) -> None:
         _report(progress, f"reading {name}", done, total)
 
     campaign = ingest_campaign(
         [Path(p) for p in log_paths],
         [Path(p) for p in wind_paths],
         options=conditioning,
-        progress=reading,
-        table_map=table_map,
+        progress=read,
+        reading=reading,
     )
     flights = list(campaign.require_flights())
     winds = expand_wind_paths([Path(p) for p in wind_paths])

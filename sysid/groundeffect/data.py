@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from flightlogs.errors import DataError
-from flightlogs.readers.table import TableMap
+from flightlogs.readers.dispatch import ReadOptions
 from sysid.groundeffect.flight import flight_thrust_ratio
 from sysid.groundeffect.records import GroundEffectDataConfig, HoverStep, HoverSteps, ThrustRatioData
 
@@ -106,7 +106,7 @@ def load_thrust_ratio(
     config: GroundEffectDataConfig,
     *,
     progress: Callable[[int, int], None] | None = None,
-    table_map: TableMap | None = None,
+    reading: ReadOptions = ReadOptions(),
 ) -> ThrustRatioData:
     """F/F0 against Z/R from a rig CSV or a flight log, told apart by content.
 
@@ -114,7 +114,7 @@ def load_thrust_ratio(
     telemetry log is a flight log (:func:`sysid.groundeffect.flight.flight_thrust_ratio`);
     any other text file is a rig CSV (:func:`flightlogs.readers.rig.read_rig_csv`), unless
     it is named ``.ulg``, ``.bin`` or ``.tlog``: then the log reader's error stands. With a
-    `table_map`, a CSV or Parquet table is a flight (motion capture: height, motor commands or
+    column map (``reading.table_map``), a CSV or Parquet table is a flight (motion capture: height, motor commands or
     speeds) read through it.
 
     Parameters
@@ -125,8 +125,9 @@ def load_thrust_ratio(
         Rotor radius, F0 or k_f and mass, columns.
     progress : callable, optional
         ``progress(done, total)`` in bytes while a flight log is read.
-    table_map : TableMap, optional
-        Which column of a flight table is which signal (``height_agl``, ``motor_1..n``).
+    reading : ReadOptions, optional
+        The column map of a flight table (``height_agl``, ``motor_1..n``), and whether a log of
+        another vehicle is refused.
 
     Returns
     -------
@@ -144,13 +145,13 @@ def load_thrust_ratio(
     try:
         detect_format(path)
     except LogFormatError:
-        if table_map is None and _is_text(path) and path.suffix.lower() not in _LOG_SUFFIXES:
+        if reading.table_map is None and _is_text(path) and path.suffix.lower() not in _LOG_SUFFIXES:
             return _rig(path, config)
-        if table_map is None:
+        if reading.table_map is None:
             raise
     from flightlogs.readers.dispatch import read_log
 
-    return flight_thrust_ratio(read_log(path, progress=progress, table_map=table_map), config)
+    return flight_thrust_ratio(read_log(path, progress=progress, reading=reading), config)
 
 
 def _is_text(path: Path) -> bool:

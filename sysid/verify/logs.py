@@ -8,7 +8,7 @@ from pathlib import Path
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import DataError
-from flightlogs.readers.table import TableMap
+from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.store.campaign import ingest_campaign
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify.engine import VerificationOptions, verify
@@ -31,7 +31,7 @@ def verify_logs(
     after_s: float = 1.0,
     progress: Callable[[str, int, int], None] | None = None,
     unidentified: Mapping[str, str] | None = None,
-    table_map: TableMap | None = None,
+    reading: ReadOptions = ReadOptions(),
 ) -> Verification:
     """Verify `model` (and `wind_model`) on every doublet of the logs.
 
@@ -58,8 +58,8 @@ def verify_logs(
         ``progress(file_name, done, total)`` while reading, bytes.
     unidentified : Mapping[str, str], optional
         Mixer inputs of the model's unidentified axes, with the reason (see :func:`verify_flights`).
-    table_map : TableMap, optional
-        Which column of a CSV or Parquet table is which signal (tables among `log_paths`).
+    reading : ReadOptions, optional
+        How tables among `log_paths` are read, and whether a log of another vehicle is refused.
 
     Returns
     -------
@@ -77,7 +77,7 @@ def verify_logs(
             "without wind only the model without G_w can be verified"
         )
     campaign = ingest_campaign(
-        list(log_paths), list(wind_paths), options=conditioning, progress=progress, table_map=table_map
+        list(log_paths), list(wind_paths), options=conditioning, progress=progress, reading=reading
     )
     return verify_flights(
         model,
