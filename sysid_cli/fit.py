@@ -9,7 +9,8 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
-from ._flights import check_sources, dataset_flights, reading_from, reading_options
+from ._flights import check_sources, conditioned_flights, dataset_flights, reading_from, reading_options
+from ._transfer import fit_transfer, parse_band
 from ._wind_options import (
     anemometer_at_option,
     segments_from,
@@ -31,6 +32,8 @@ Examples:
   sysid fit sweeps/*.bin --wind anemometer/ --wind-distance 4.6 --model hover-wind -o model.json --json -
   sysid fit dataset.h5 --model my-structure.toml --starts 5 --set T_a=0.05 -o model.json --mat model.mat
   sysid fit flight.ulg --segments maneuvers.toml --partial -o model.json    # the axes flown only
+  sysid fit roll.csv --map time=t:ms,delta_lat=1,p=2:deg/s --delay --report tf.html \
+      --tf "p/delta_lat = b2*s^2/(s^4 + a3*s^3 + a2*s^2 + a1*s + a0)"
 """
 
 
@@ -153,6 +156,16 @@ class _GuidelineOption(click.Option):
     help="Write a model of the axes that can be identified, the others marked unidentified "
     "(default: an axis without a usable maneuver is an error).",
 )
+@click.option(
+    "--tf",
+    "tf_texts",
+    multiple=True,
+    metavar="EXPR",
+    help="Fit a transfer function instead of the structure (repeatable), e.g. "
+    '"p/delta_lat = b2*s^2/(s^4 + a3*s^3 + a2*s^2 + a1*s + a0)".',
+)
+@click.option("--delay", is_flag=True, help="With --tf: fit a transport delay exp(-tau s) too.")
+@click.option("--band", callback=parse_band, metavar="LO,HI", help="With --tf: fit only within LO-HI rad/s.")
 @click.option("-o", "--out", type=OutputPath(), help="Write the identified model (versioned JSON).")
 @click.option("--mat", type=OutputPath(), help="Also write the model for MATLAB (.mat).")
 @click.option("--report", type=OutputPath(), help="Write the HTML fit report.")
@@ -180,6 +193,9 @@ def fit(
     max_correlation: float | None,
     min_coherence: float,
     partial: bool,
+    tf_texts: tuple[str, ...],
+    delay: bool,
+    band: tuple[float, float] | None,
     out: Path | None,
     mat: Path | None,
     report: Path | None,
@@ -204,6 +220,46 @@ def fit(
     )
     from sysid.model import load_structure
 
+    log_only = {
+        "--wind": wind_paths,
+        "--wind-distance": wind_distance,
+        "--anemometer-at": anemometer_at,
+        "--transport-delay": transport_delay,
+        "--wind-offset": wind_offset,
+        "--estimate-wind-offset": estimate_wind_offset,
+        "--segments": segments_file,
+        "--map": table_map,
+        "--vehicle": vehicle,
+    }
+    conditioning = ConditioningOptions(
+        wind_distance_m=wind_distance,
+        anemometer_position_rad=anemometer_at,
+        transport_delay_s=transport_delay,
+        wind_offset_s=wind_offset,
+        estimate_wind_offset=estimate_wind_offset,
+        segments=segments_from(segments_file),
+    )
+    reading = reading_from(table_map, vehicle)
+    if tf_texts:
+        if mat is not None:
+            raise click.UsageError("--mat writes a state-space model; --tf fits transfer functions")
+        flights = conditioned_flights(logs, wind_paths, conditioning, log_only=log_only, quiet=quiet, reading=reading)
+        fit_transfer(
+            flights,
+            tf_texts,
+            delay=delay,
+            band=band,
+            kind=kind,
+            min_coherence=min_coherence,
+            sources=list(logs),
+            out=out,
+            report=report,
+            json_path=json_path,
+            quiet=quiet,
+        )
+        return
+    if delay or band is not None:
+        raise click.UsageError("--delay and --band go with --tf")
     structure = load_structure(model_name)
     structure.values(initial)  # a --set that names no parameter is an error before any work
     options = IdentifyOptions(
@@ -220,33 +276,12 @@ def fit(
         initial=initial or None,
         partial=partial,
     )
-    dataset = check_sources(
-        logs,
-        {
-            "--wind": wind_paths,
-            "--wind-distance": wind_distance,
-            "--anemometer-at": anemometer_at,
-            "--transport-delay": transport_delay,
-            "--wind-offset": wind_offset,
-            "--estimate-wind-offset": estimate_wind_offset,
-            "--segments": segments_file,
-            "--map": table_map,
-            "--vehicle": vehicle,
-        },
-    )
+    dataset = check_sources(logs, log_only)
     with staged_progress("identifying", quiet=quiet) as progress:
         if dataset:
             flights = dataset_flights(logs)
             model = identify_flights(flights, structure, options=options, files=list(logs), progress=progress)
         else:
-            conditioning = ConditioningOptions(
-                wind_distance_m=wind_distance,
-                anemometer_position_rad=anemometer_at,
-                transport_delay_s=transport_delay,
-                wind_offset_s=wind_offset,
-                estimate_wind_offset=estimate_wind_offset,
-                segments=segments_from(segments_file),
-            )
             model = identify_logs(
                 list(logs),
                 structure,
@@ -254,7 +289,7 @@ def fit(
                 conditioning=conditioning,
                 options=options,
                 progress=progress,
-                reading=reading_from(table_map, vehicle),
+                reading=reading,
             )
     if out is not None:
         write_model(out, model)

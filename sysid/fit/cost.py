@@ -27,7 +27,7 @@ from flightlogs.errors import FitError
 from sysid.freqresp import FrequencyResponse
 from sysid.model.assemble import Assembler, SystemMatrices
 
-__all__ = ["CostWeights", "CostSummary", "FitPoints", "fit_points", "ResponseModel"]
+__all__ = ["CostWeights", "CostSummary", "FitPoints", "fit_points", "LogResponseCost", "ResponseModel"]
 
 _DB = 20.0 / np.log(10.0)  # dB per neper
 _DEG = 180.0 / np.pi
@@ -188,7 +188,94 @@ def _times_real(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     return cast(np.ndarray, (left.real @ right) + 1j * (left.imag @ right))
 
 
-class ResponseModel:
+class LogResponseCost:
+    """Eq. 3.9 on a set of fit points for any model that gives ``ln T`` and its derivatives.
+
+    Subclasses provide :meth:`log_response`; the weighted residuals (dB and
+    deg), their Jacobian and the cost follow from it here, the same for a
+    state-space structure (:class:`ResponseModel`) and a transfer function
+    (:mod:`sysid.fit.transfer`).
+
+    Parameters
+    ----------
+    points : FitPoints
+        The measured data.
+    weights : CostWeights, optional
+        The weights W_g, W_p.
+    """
+
+    def __init__(self, points: FitPoints, *, weights: CostWeights = CostWeights()) -> None:
+        self.points, self.weights = points, weights
+        root = np.sqrt(points.weight)
+        self._scale = np.concatenate([root * np.sqrt(weights.magnitude) * _DB, root * np.sqrt(weights.phase) * _DEG])
+
+    def log_response(
+        self, theta: np.ndarray, *, with_derivatives: bool = False
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """``ln T`` of the model at each point, and optionally ``d ln T / d theta`` (see subclasses).
+
+        Parameters
+        ----------
+        theta : ndarray, shape (n_free,)
+            Free-parameter values.
+        with_derivatives : bool, optional
+            Also return the derivatives, shape (n_points_total, n_free).
+        """
+        raise NotImplementedError
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        """Weighted residual vector; its sum of squares is J.
+
+        Parameters
+        ----------
+        theta : ndarray, shape (n_free,)
+            Free-parameter values.
+
+        Returns
+        -------
+        ndarray, shape (2 n_points_total,)
+            Magnitude residuals (dB, weighted) then phase residuals (deg, weighted).
+        """
+        log_t, _ = self.log_response(theta)
+        return self._residuals(log_t)
+
+    def jacobian(self, theta: np.ndarray) -> np.ndarray:
+        """Jacobian of :meth:`residuals`, shape (2 n_points_total, n_free).
+
+        Parameters
+        ----------
+        theta : ndarray, shape (n_free,)
+            Free-parameter values.
+        """
+        if np.size(theta) == 0:  # structure reduction has removed every parameter
+            return np.zeros((2 * self.points.omega.size, 0))
+        _, d_log_t = self.log_response(theta, with_derivatives=True)
+        assert d_log_t is not None
+        jac = np.concatenate([d_log_t.real, d_log_t.imag]) * self._scale[:, None]
+        return np.where(np.isfinite(jac), jac, 0.0)
+
+    def _residuals(self, log_t: np.ndarray) -> np.ndarray:
+        error = log_t - self.points.log_measured
+        phase = np.angle(np.exp(1j * error.imag))  # wrapped to (-pi, pi]
+        r = np.concatenate([error.real, phase]) * self._scale
+        return np.where(np.isfinite(r), r, 1e3)
+
+    def cost(self, theta: np.ndarray) -> CostSummary:
+        """J_ave and the cost of each pair at `theta`.
+
+        Parameters
+        ----------
+        theta : ndarray, shape (n_free,)
+            Free-parameter values.
+        """
+        r = self.residuals(theta)
+        n = self.points.omega.size
+        per_point = r[:n] ** 2 + r[n:] ** 2
+        per_pair = np.bincount(self.points.response, weights=per_point, minlength=len(self.points.pairs))
+        return CostSummary(average=float(per_pair.mean()), responses=dict(zip(self.points.pairs, per_pair.tolist())))
+
+
+class ResponseModel(LogResponseCost):
     """Residuals of eq. 3.9 and their Jacobian for a structure on a set of fit points.
 
     Parameters
@@ -207,7 +294,8 @@ class ResponseModel:
     """
 
     def __init__(self, assembler: Assembler, points: FitPoints, *, weights: CostWeights = CostWeights()) -> None:
-        self.assembler, self.points, self.weights = assembler, points, weights
+        super().__init__(points, weights=weights)
+        self.assembler = assembler
         outputs = assembler.structure.outputs
         signals = [c.signal for c in assembler.channels]
         for pair, i, o in zip(points.pairs, points.inputs, points.outputs):
@@ -221,8 +309,6 @@ class ResponseModel:
             [[float(signals[c] == points.inputs[r]) for c in range(len(signals))] for r in points.response]
         )
         self._s = 1j * points.omega
-        root = np.sqrt(points.weight)
-        self._scale = np.concatenate([root * np.sqrt(weights.magnitude) * _DB, root * np.sqrt(weights.phase) * _DEG])
 
     def log_response(
         self, theta: np.ndarray, *, with_derivatives: bool = False
@@ -279,54 +365,3 @@ class ResponseModel:
         dg -= self._s[:, None, None] * dm.delays[None, :, :] * g[:, None, :]
         with np.errstate(divide="ignore", invalid="ignore"):
             return cast(np.ndarray, (dg @ delay[:, :, None])[:, :, 0] / t[:, None])
-
-    def residuals(self, theta: np.ndarray) -> np.ndarray:
-        """Weighted residual vector; its sum of squares is J.
-
-        Parameters
-        ----------
-        theta : ndarray, shape (n_free,)
-            Free-parameter values.
-
-        Returns
-        -------
-        ndarray, shape (2 n_points_total,)
-            Magnitude residuals (dB, weighted) then phase residuals (deg, weighted).
-        """
-        log_t, _ = self.log_response(theta)
-        return self._residuals(log_t)
-
-    def jacobian(self, theta: np.ndarray) -> np.ndarray:
-        """Jacobian of :meth:`residuals`, shape (2 n_points_total, n_free).
-
-        Parameters
-        ----------
-        theta : ndarray, shape (n_free,)
-            Free-parameter values.
-        """
-        if np.size(theta) == 0:  # structure reduction has removed every parameter
-            return np.zeros((2 * self.points.omega.size, 0))
-        _, d_log_t = self.log_response(theta, with_derivatives=True)
-        assert d_log_t is not None
-        jac = np.concatenate([d_log_t.real, d_log_t.imag]) * self._scale[:, None]
-        return np.where(np.isfinite(jac), jac, 0.0)
-
-    def _residuals(self, log_t: np.ndarray) -> np.ndarray:
-        error = log_t - self.points.log_measured
-        phase = np.angle(np.exp(1j * error.imag))  # wrapped to (-pi, pi]
-        r = np.concatenate([error.real, phase]) * self._scale
-        return np.where(np.isfinite(r), r, 1e3)
-
-    def cost(self, theta: np.ndarray) -> CostSummary:
-        """J_ave and the cost of each pair at `theta`.
-
-        Parameters
-        ----------
-        theta : ndarray, shape (n_free,)
-            Free-parameter values.
-        """
-        r = self.residuals(theta)
-        n = self.points.omega.size
-        per_point = r[:n] ** 2 + r[n:] ** 2
-        per_pair = np.bincount(self.points.response, weights=per_point, minlength=len(self.points.pairs))
-        return CostSummary(average=float(per_pair.mean()), responses=dict(zip(self.points.pairs, per_pair.tolist())))

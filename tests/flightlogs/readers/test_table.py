@@ -17,7 +17,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from flightlogs.errors import DataError, LogFormatError
-from flightlogs.readers import TableColumn, is_table, parse_table_map, read_log, read_table
+from flightlogs.readers import ReadOptions, TableColumn, is_table, parse_table_map, read_log, read_table
 
 T = np.round(np.arange(0.0, 4.0, 0.02), 6)  # 50 Hz, s
 P_DEG_S = 30.0 * np.sin(2.0 * np.pi * 0.7 * T)
@@ -47,7 +47,7 @@ def test_every_layout_reads_to_the_same_si_signals(
     tmp_path: Path, delimiter: str, header: str | None, time_scale: float, text: str
 ) -> None:
     path = _write(tmp_path / "sweep.csv", None if header is None else header, _rows(delimiter, time_scale))
-    log = read_log(path, table_map=parse_table_map(text))
+    log = read_log(path, reading=ReadOptions(table_map=parse_table_map(text)))
     assert (log.log_format, log.autopilot, sorted(log.signals)) == ("table", "unknown", ["delta_lat", "p"])
     np.testing.assert_allclose(log["p"].time_s, T, atol=1e-9)
     np.testing.assert_allclose(log["p"].values, np.radians(P_DEG_S), rtol=1e-8, atol=1e-12)
@@ -84,7 +84,9 @@ def test_parquet_with_a_timestamp_column_and_percent_throttle(tmp_path: Path) ->
     stamps = pa.array((1_714_557_600_000_000 + (T * 1e6).astype(np.int64)), pa.timestamp("us"))
     path = tmp_path / "flight.parquet"
     pq.write_table(pa.table({"stamp": stamps, "thr_pct": 50.0 + 10.0 * DELTA, "phi_deg": P_DEG_S}), path)
-    log = read_log(path, table_map=parse_table_map("time=stamp,delta_thr=thr_pct:%,phi=phi_deg:deg"))
+    log = read_log(
+        path, reading=ReadOptions(table_map=parse_table_map("time=stamp,delta_thr=thr_pct:%,phi=phi_deg:deg"))
+    )
     assert log.warnings == () and log.utc_offset_s == pytest.approx(1_714_557_600.0)
     np.testing.assert_allclose(log["phi"].values, np.radians(P_DEG_S), rtol=1e-12)
     np.testing.assert_allclose(log["delta_thr"].values, 0.5 + 0.1 * DELTA, rtol=1e-12)
