@@ -13,13 +13,50 @@ import numpy as np
 
 from flightlogs.signals import LOGGED_SIGNALS, is_canonical
 
-__all__ = ["Signal", "SystemIdRun", "FlightLog", "Autopilot", "LogFormat"]
+__all__ = ["Signal", "SystemIdRun", "FlightLog", "Autopilot", "LogFormat", "logged_rate_hz"]
 
 
 def _held_dtype(dtype: np.dtype) -> type[np.floating]:
     """float32 for float32 and for integers of up to 16 bits (exact in it), float64 for anything else."""
     exact_in_single = dtype == np.float32 or (dtype.kind in "iub" and dtype.itemsize <= 2)
     return np.float32 if exact_in_single else np.float64
+
+
+def logged_rate_hz(time_s: np.ndarray) -> float:
+    """The rate a series was logged at, Hz: its mean interval within the pieces its gaps separate.
+
+    An interval over five times the median is a gap (a logging pause, the
+    space between two record pieces; as :class:`~flightlogs.conditioning.condition.ConditioningOptions`'
+    ``max_gap_samples``) and is left out, so a 628 s pause does not read a 25
+    Hz IMU as 2.6 Hz; the others are averaged, so a logger's jitter (20-24
+    ms intervals of a 50 Hz topic) reads as the rate it keeps, not as its
+    median interval.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (n_samples,)
+        Sample times, s, non-decreasing.
+
+    Returns
+    -------
+    float
+        0 for fewer than two distinct times.
+
+    Examples
+    --------
+    >>> t = np.r_[np.arange(0.0, 10.0, 0.04), 638.0 + np.arange(0.0, 10.0, 0.04)]
+    >>> round(logged_rate_hz(t), 6), round(float((t.size - 1) / (t[-1] - t[0])), 2)
+    (25.0, 0.77)
+    """
+    steps = np.diff(np.asarray(time_s, dtype=np.float64))
+    positive = steps[steps > 0]
+    if not positive.size:
+        return 0.0
+    within = steps[steps <= _GAP_INTERVALS * float(np.median(positive))]
+    return within.size / float(np.sum(within))
+
+
+_GAP_INTERVALS = 5.0  # an interval this many times the median is a gap, not a sample interval
 
 
 Autopilot = Literal["px4", "ardupilot", "unknown"]
@@ -107,9 +144,8 @@ class Signal:
 
     @property
     def rate_hz(self) -> float:
-        """Mean sample rate, Hz (0 for fewer than two samples)."""
-        span = self.duration_s
-        return (self.samples - 1) / span if span > 0 else 0.0
+        """Sample rate, Hz, from the median interval (:func:`logged_rate_hz`; 0 for fewer than two samples)."""
+        return logged_rate_hz(self.time_s)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

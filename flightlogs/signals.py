@@ -28,6 +28,7 @@ __all__ = [
     "LOGGED_SIGNALS",
     "ESTIMATOR_SIGNALS",
     "REFERENCE_SIGNALS",
+    "STATE_SIGNALS",
     "COMMAND_AXES",
     "is_canonical",
     "describe",
@@ -94,6 +95,8 @@ _SPECS = (
     SignalSpec("stick_lon", "pilot's pitch stick, back (nose up) positive (-1..1)", "1"),
     SignalSpec("stick_yaw", "pilot's yaw stick, right positive (-1..1)", "1"),
     SignalSpec("stick_thr", "pilot's throttle stick, up positive (0..1, or -1..1 as logged)", "1"),
+    SignalSpec("armed", "motors armed (1) or not (0), as the autopilot says", "1"),
+    SignalSpec("landed", "on the ground (1) or airborne (0), by the autopilot's land detector", "1"),
 )
 
 #: Every canonical signal with a fixed name, by name.
@@ -142,6 +145,11 @@ REFERENCE_SIGNALS: tuple[str, ...] = (
     "stick_yaw",
     "stick_thr",
 )
+
+#: Optional flight states a reader adds when the autopilot logs them: whether it is armed and whether its land
+#: detector says it is on the ground. They tell hover from a bench or the time before take-off; like the
+#: position they are not dynamic signals and stay out of conditioned records.
+STATE_SIGNALS: tuple[str, ...] = ("armed", "landed")
 
 #: The control axis each command moves: the mixer inputs and the references.
 COMMAND_AXES: Mapping[str, str] = MappingProxyType(

@@ -93,8 +93,8 @@ class _GuidelineOption(click.Option):
     "--kind",
     default="sweep",
     show_default=True,
-    type=click.Choice(["sweep", "multisine", "3211", "doublet"]),
-    help="Maneuvers to fit.",
+    type=click.Choice(["sweep", "multisine", "3211", "doublet", "broadband"]),
+    help="Maneuvers to fit (broadband: a pilot's input without a frequency trend, only when asked for).",
 )
 @click.option(
     "--set",
@@ -360,6 +360,7 @@ def _print_fit(summary: dict[str, Any], guidelines: Guidelines) -> None:
     print_modes(summary["eigenvalues"], say)
     for note in summary["notes"]:
         say(f"  note: {note}")
+    say(f"verdict: {summary['verdict']['sentence']}")
     for key in ("output", "mat", "report"):
         if summary.get(key):
             say(f"wrote {summary[key]}")

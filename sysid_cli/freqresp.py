@@ -82,8 +82,8 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
     "--kind",
     default="sweep",
     show_default=True,
-    type=click.Choice(["sweep", "multisine", "3211", "doublet"]),
-    help="Maneuvers to use.",
+    type=click.Choice(["sweep", "multisine", "3211", "doublet", "broadband"]),
+    help="Maneuvers to use (broadband: a pilot's input without a frequency trend).",
 )
 @click.option(
     "--omega-min",

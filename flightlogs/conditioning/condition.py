@@ -39,6 +39,7 @@ from flightlogs.maneuvers.excitation_recovery import ExcitationRecovery
 from flightlogs.maneuvers.segments import Segment, SegmentDetector, segments_from_sid
 from flightlogs.masks import true_runs
 from flightlogs.record import Record
+from flightlogs.signals import STATE_SIGNALS
 
 __all__ = ["ConditioningOptions", "ConditionedFlight", "condition_flight", "CORE_SIGNALS"]
 
@@ -215,7 +216,7 @@ def _one_pass(log: FlightLog, wind: Any | None, options: ConditioningOptions) ->
     core = {name: _unwrapped(log.signals[name]) for name in CORE_SIGNALS if name in log.signals}
     if not core:
         raise DataError(f"{log.path}: none of the core signals ({', '.join(CORE_SIGNALS)}) is in the log")
-    others = {n: _unwrapped(s) for n, s in log.signals.items() if n not in core and n not in _POSITION}
+    others = {n: _unwrapped(s) for n, s in log.signals.items() if n not in core and n not in _POSITION + STATE_SIGNALS}
     alignment, wind_signals = (None, {}) if wind is None else _wind_signals(log, wind, options)
     cut_by = core | wind_signals
     time_base = uniform_time_base(cut_by, rate_hz=options.rate_hz)
@@ -250,7 +251,7 @@ def _one_pass(log: FlightLog, wind: Any | None, options: ConditioningOptions) ->
             warnings.warn(DataQualityWarning(message), stacklevel=2)
     _derived(values, units, wind_given=bool(wind_signals))
     give_back_freed_memory()  # the resampler's working arrays: segmentation's are larger
-    segments = _segments(log, time_base, values, options)
+    segments = _segments(log, time_base, values, options, spans.spans)
     holds = {name: 1.5 / signal.rate_hz for name, signal in others.items() if signal.rate_hz > 0}
     records = tuple(
         _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}", holds)
@@ -519,8 +520,13 @@ def _derived(values: dict[str, np.ndarray], units: dict[str, str], *, wind_given
 
 
 def _segments(
-    log: FlightLog, time_base: np.ndarray, values: dict[str, np.ndarray], options: ConditioningOptions
+    log: FlightLog,
+    time_base: np.ndarray,
+    values: dict[str, np.ndarray],
+    options: ConditioningOptions,
+    pieces: Sequence[tuple[float, float]],
 ) -> tuple[Segment, ...]:
+    """The maneuvers given, logged (SIDS) or detected, and the hovers: airborne stretches inside one record piece."""
     if options.segments is not None:
         return tuple(sorted(options.segments, key=lambda s: s.start_s))
     logged = segments_from_sid(log.system_id_runs) if log.system_id_runs else ()
@@ -528,16 +534,19 @@ def _segments(
     shown = {axis: [name for name in names if name in values] for axis, names in _SHOWN_BY.items()}
     if not inputs and not any(shown.values()):
         return tuple(logged)
-    pieces = _between(time_base, logged)
+    between = _between(time_base, logged)
     quiet = np.zeros(time_base.size, dtype=bool)
-    for start, stop in pieces:
+    for start, stop in between:
         quiet[start:stop] = True
     # the sweeps are found in the logged traces, once; the steps in the excitation, refitted below
     detectors = [
         (start, stop, SegmentDetector(time_base[start:stop], responses=_finite_traces(values, shown, start, stop)))
-        for start, stop in pieces
+        for start, stop in between
     ]
-    flying, vd = _flight_state(time_base, values)
+    flying, vd, flight_shown = _flight_state(log, time_base, values)
+    within = np.zeros(time_base.size, dtype=bool)
+    for first, last in pieces:
+        within |= (time_base >= first) & (time_base <= last)
 
     def flown(found: Sequence[Segment]) -> list[Segment]:
         return [
@@ -561,7 +570,8 @@ def _segments(
             for segment in detector.detect({a: x[start:stop] for a, x in excitation.items()})
         ]
     kept = flown(detected)
-    hovers = [piece for s in detected if s.kind == "hover" for piece in _airborne(s, time_base, flying)]
+    hovers = [piece for s in detected if s.kind == "hover" for piece in _airborne(s, time_base, flying & within)]
+    hovers = hovers if flight_shown else []  # no thrust and no land detector: nothing shows the vehicle off the ground
     return tuple(sorted([*logged, *kept, *hovers], key=lambda s: s.start_s))
 
 
@@ -576,17 +586,29 @@ def _airborne(hover: Segment, time_base: np.ndarray, flying: np.ndarray) -> list
 
 
 _THRUST_ON = 0.3  # flying: thrust above this fraction of its 95th percentile
+_HOVER_THRUST = ("MPC_THR_HOVER", "MOT_THST_HOVER")  # the hover thrust, normalised, where the autopilot keeps it
+_HOVER_FRACTION = 0.5  # flying: thrust above this fraction of the hover thrust, where it is known
 _MIN_HOVER_S = 3.0  # shortest hover kept once ground time is taken out, s (as detect_segments')
 _SETTLE_S = 2.0  # flying: this long after take-off and before landing are neither; the hover before a maneuver
 _LEVEL_M_S = 0.5  # level hover: |mean vertical speed| over the _SETTLE_S before a maneuver below this
 
 
-def _flight_state(time_base: np.ndarray, values: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Where the vehicle flies (thrust on, away from take-off and landing), and its vertical speed, m/s.
+def _flight_state(
+    log: FlightLog, time_base: np.ndarray, values: dict[str, np.ndarray]
+) -> tuple[np.ndarray, np.ndarray, bool]:
+    """Where the vehicle flies (armed, not landed, thrust on, away from take-off and landing), its vertical
+    speed, m/s, and whether the log shows flight at all (a thrust or a land detector).
 
     Thrust is the mixer's, else the motors' mean; without either, or
-    without a vertical speed, every sample passes that test. A log that
-    starts or ends in flight has no take-off or landing at its edges.
+    without a vertical speed, every sample passes that test (a maneuver is
+    then judged by its own traces), but nothing shows the vehicle off the
+    ground, so no hover is claimed. With a hover thrust among the parameters
+    (``MPC_THR_HOVER``, ``MOT_THST_HOVER``) thrust is on from half of it.
+    ``armed`` and ``landed`` (:data:`~flightlogs.signals.STATE_SIGNALS`),
+    where the log has them, are held from each sample to the next: a bench
+    board that is never armed, or a vehicle its land detector puts on the
+    ground, does not fly whatever its thrust. A log that starts or ends in
+    flight has no take-off or landing at its edges.
     """
     dt = float(np.median(np.diff(time_base))) if time_base.size > 1 else 1.0
     width = max(1, int(round(_SETTLE_S / dt)))
@@ -595,13 +617,29 @@ def _flight_state(time_base: np.ndarray, values: dict[str, np.ndarray]) -> tuple
     motors = [v for name, v in values.items() if name.startswith("motor_")]
     if thrust is None and motors:
         thrust = np.mean(motors, axis=0)
+    shown = "landed" in log.signals or (thrust is not None and bool(np.isfinite(thrust).any()))
     if thrust is not None and np.isfinite(thrust).any():
         level_on = _THRUST_ON * float(np.nanpercentile(thrust, 95))
+        hover = next((log.parameters[p] for p in _HOVER_THRUST if p in log.parameters), None)
+        if hover is not None and thrust is values.get("delta_thr") and 0 < hover < 1:
+            level_on = max(level_on, _HOVER_FRACTION * hover)
         on = np.nan_to_num(thrust, nan=-np.inf) > level_on if level_on > 0 else np.zeros(time_base.size, dtype=bool)
         flying = erode(on, width) if on.any() else on
+    for name, flies_when in (("armed", 1.0), ("landed", 0.0)):
+        if name in log.signals:
+            state = _held(log.signals[name], time_base)
+            flying &= erode(np.isnan(state) | (state == flies_when), width)
     vd = values.get("vd")
     climb = vd if vd is not None and np.isfinite(vd).all() else np.zeros(time_base.size)
-    return flying, climb
+    return flying, climb, shown
+
+
+def _held(signal: Signal, time_base: np.ndarray) -> np.ndarray:
+    """A state signal on `time_base`, each sample held until the next; NaN before its first."""
+    index = np.searchsorted(signal.time_s, time_base, side="right") - 1
+    held = signal.values[np.maximum(index, 0)].astype(np.float64)
+    held[index < 0] = np.nan
+    return held
 
 
 def _flown(segment: Segment, time_base: np.ndarray, flying: np.ndarray, vd: np.ndarray) -> bool:

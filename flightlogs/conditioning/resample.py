@@ -36,7 +36,7 @@ from flightlogs.conditioning._resampling import (
     snap,
 )
 from flightlogs.errors import DataError
-from flightlogs.flightlog import Signal
+from flightlogs.flightlog import Signal, logged_rate_hz
 
 __all__ = [
     "Method",
@@ -187,8 +187,9 @@ def uniform_time_base(
     signals : Mapping[str, Signal] or iterable of Signal or (time_s, values)
         Signals to cover; only their times are used.
     rate_hz : float, optional
-        Sample rate, Hz. Default: the fastest mean rate among `signals`,
-        rounded to the nearest 1 Hz (kept as is below 1 Hz).
+        Sample rate, Hz. Default: the fastest logged rate among `signals`
+        (one over the median interval: :func:`~flightlogs.flightlog.logged_rate_hz`,
+        which a gap does not move), rounded to the nearest 1 Hz (kept as is below 1 Hz).
     start_s, end_s : float, optional
         Span to cover, s. Default: the intersection of the signals' spans
         (latest first sample to earliest last sample).
@@ -218,7 +219,7 @@ def uniform_time_base(
     if not series:
         raise DataError("no signal to build a time base from")
     if rate_hz is None:
-        rates = [(len(t) - 1) / (t[-1] - t[0]) for _, t, _ in series if len(t) > 1 and t[-1] > t[0]]
+        rates = [logged_rate_hz(t) for _, t, _ in series if len(t) > 1 and t[-1] > t[0]]
         if not rates:
             raise DataError("cannot infer a sample rate: every signal has fewer than 2 samples")
         fastest = max(rates)

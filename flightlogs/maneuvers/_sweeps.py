@@ -52,6 +52,7 @@ _YIELD = 3.0  # a frame where another axis scores this many times higher is that
 _THRESHOLD, _TREND_S, _BURST_MERGE_S, _MIN_ACTIVE_S = 4.0, 10.0, 2.0, 0.3  # time-domain edges, as detect_segments
 _HELD = 1e-9  # a trace whose quiet noise is below this fraction of its peak is held (a setpoint), not measured
 _EDGE_WINDOW_S = 15.0  # edges are searched this far outside the ridge, s
+_INTEGRAL_OF = {"phi": "p", "theta": "q", "vd": "az"}  # a trace, and the trace it integrates
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -62,8 +63,9 @@ class FoundSweep:
     ----------
     axis : str
         The axis that owns it.
-    kind : {"sweep", "multisine"}
-        One sweep, or a periodic (Schroeder-phased) multisine sweeping its band once a period.
+    kind : {"sweep", "multisine", "broadband"}
+        One sweep, a periodic (Schroeder-phased) multisine sweeping its band once a period, or a
+        pilot's broadband input without a frequency trend (not a sweep: no trend to call one).
     first, last : int
         Its first and last sample (inclusive).
     f_min_hz, f_max_hz : float
@@ -77,7 +79,7 @@ class FoundSweep:
     """
 
     axis: str
-    kind: Literal["sweep", "multisine"]
+    kind: Literal["sweep", "multisine", "broadband"]
     first: int
     last: int
     f_min_hz: float
@@ -326,7 +328,7 @@ def _found(
     counts = np.bincount(ridge.trace[frames], minlength=len(ridge.names))
     return FoundSweep(
         axis=axis,
-        kind="sweep" if kind == "piloted" else kind,
+        kind="broadband" if kind == "piloted" else kind,
         first=first,
         last=last,
         f_min_hz=float(ridge.freq_hz[frames].min()),
@@ -338,18 +340,23 @@ def _found(
 
 
 def _time_edges(activity: _Activities, i0: int, i1: int, dt: float) -> tuple[int, int]:
-    """Earliest start and latest end, over the traces, of the activity overlapping samples [i0, i1]."""
+    """Earliest start and latest end, over the traces, of the activity overlapping samples [i0, i1].
+
+    A trace that integrates another one carrying the activity (the attitude its rate, the vertical speed
+    its acceleration) rings on after the sweep's last, slowest half-waves; it does not set the end.
+    """
     window = (max(0, i0 - int(_EDGE_WINDOW_S / dt)), min(activity.n - 1, i1 + int(_EDGE_WINDOW_S / dt)))
-    starts, ends = [], []
+    starts, ends = [], {}
     for name, act in activity.used.items():
         bursts = [burst for burst in activity.bursts[name] if burst.last >= i0 and burst.first <= i1]
         if bursts:
             lo, hi = _edges(act, min(b.first for b in bursts), max(b.last for b in bursts), dt, window, _THRESHOLD)
             starts.append(lo)
-            ends.append(hi)
+            ends[name] = hi
     if not starts:
         return i0, i1
-    return min(starts), max(ends)
+    settling = [hi for name, hi in ends.items() if _INTEGRAL_OF.get(name) not in ends]
+    return min(starts), max(settling or ends.values())
 
 
 def _owned(found: list[FoundSweep]) -> list[FoundSweep]:

@@ -41,7 +41,7 @@ __all__ = [
 ]
 
 Axis = Literal["lat", "lon", "yaw", "thr"]
-Kind = Literal["sweep", "doublet", "3211", "multisine", "hover"]
+Kind = Literal["sweep", "doublet", "3211", "multisine", "broadband", "hover"]
 SegmentSource = Literal["sids", "detected", "user"]
 
 #: Mixer axes in canonical order (delta_lat, delta_lon, delta_yaw, delta_thr).
@@ -104,8 +104,10 @@ class Segment:
     ----------
     axis : {"lat", "lon", "yaw", "thr"} or None
         Mixer axis excited; None exactly when `kind` is ``"hover"``.
-    kind : {"sweep", "doublet", "3211", "multisine", "hover"}
-        What was flown.
+    kind : {"sweep", "doublet", "3211", "multisine", "broadband", "hover"}
+        What was flown. ``broadband`` is a pilot's frequency-rich input without
+        a frequency trend: not a sweep (a sweep's frequency rises or falls), used
+        for identification only when asked for.
     start_s, end_s : float
         Bounds on the log clock, s; a fade-in is inside.
     source : {"sids", "detected", "user"}
@@ -306,7 +308,7 @@ class SegmentDetector:
                     detail=(
                         f"{s.direction} ridge in {', '.join(s.evidence)}"
                         if s.direction != "none"
-                        else f"piloted, broadband without a trend, in {', '.join(s.evidence)}"
+                        else f"piloted, without a frequency trend, in {', '.join(s.evidence)}"
                     ),
                 )
                 for s in sweeps

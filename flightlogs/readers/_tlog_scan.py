@@ -21,7 +21,8 @@ _PROGRESS_EVERY = 2000  # messages between progress callbacks
 
 #: Fields kept per message type; everything else in the stream is decoded and dropped.
 FIELDS: dict[str, tuple[str, ...]] = {
-    "HEARTBEAT": ("type", "autopilot"),
+    "HEARTBEAT": ("type", "autopilot", "base_mode"),
+    "EXTENDED_SYS_STATE": ("landed_state",),
     "ATTITUDE": ("time_boot_ms", "roll", "pitch", "yaw", "rollspeed", "pitchspeed", "yawspeed"),
     "HIGHRES_IMU": ("time_usec", "xacc", "yacc", "zacc"),
     "SCALED_IMU": ("time_boot_ms", "xacc", "yacc", "zacc"),

@@ -40,7 +40,7 @@ import calendar
 import dataclasses
 import re
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import cast
 
@@ -75,6 +75,8 @@ _TYPES = (
     "PARM",
     "MSG",
     "RCIN",
+    "EV",
+    "ARM",
 )
 _MOTOR_CHANNELS = tuple(f"{prefix}{k}" for prefix in ("C", "Ch") for k in range(1, 13))  # up to DODECAHEXA's 12
 #: The columns the mapping reads, decoded in one pass over the file (a column not listed is decoded when read).
@@ -85,6 +87,8 @@ _COLUMNS: dict[str, tuple[str, ...]] = {
     "CTUN": ("ThO", "ThrOut", "Alt"),
     "RCOU": _MOTOR_CHANNELS,
     "RCIN": tuple(f"C{k}" for k in range(1, 17)),
+    "EV": ("Id",),
+    "ARM": ("ArmState",),
     "BAT": ("Volt",),
     "CURR": ("Volt",),
     "RFND": ("Dist", "Dist1"),
@@ -263,6 +267,7 @@ def _flightlog(messages: DataFlashMessages) -> FlightLog:
     runs = system_id_runs(messages)
     _map_excitation(messages, runs, add)
     dataflash_references(messages, parameters, add, wrap_yaw=_wrap_deg)
+    signals |= _flight_states(messages, signals)
     return FlightLog(
         path=messages.path,
         log_format="dataflash",
@@ -367,6 +372,45 @@ def _map_motors(messages: DataFlashMessages, parameters: dict[str, float], add: 
     for k, column in enumerate(channels[:count], start=1):
         add(f"motor_{k}", rcou, column, "us", f"RCOU.{column} (PWM)")
     return count or None
+
+
+#: EV ids (AP_Logger LogEvent) that set a flight state: the state and the value it takes.
+_EVENTS = {10: ("armed", 1.0), 11: ("armed", 0.0), 18: ("landed", 1.0), 28: ("landed", 0.0)}
+
+
+def _flight_states(messages: DataFlashMessages, signals: Mapping[str, Signal]) -> dict[str, Signal]:
+    """``armed`` and ``landed`` from the ARM messages or the EV events, held from each event to the next.
+
+    Each state starts, at the log's first sample, as the opposite of its first
+    event (a log opens disarmed, on the ground). EV messages without a time
+    (Copter 3.3) cannot be placed and give nothing.
+    """
+    start = min((float(s.time_s[0]) for s in signals.values() if s.samples), default=None)
+    found: dict[str, list[tuple[float, float]]] = {"armed": [], "landed": []}
+    sources: dict[str, str] = {}
+    arm = messages.get("ARM")
+    if arm is not None and arm.time_s is not None and "ArmState" in arm:
+        found["armed"] += zip(arm.time_s.tolist(), (arm["ArmState"] != 0).astype(float).tolist())
+        sources["armed"] = "ARM.ArmState"
+    ev = messages.get("EV")
+    if ev is not None and ev.time_s is not None and "Id" in ev:
+        for time_s, event in zip(ev.time_s.tolist(), ev["Id"].astype(int).tolist()):
+            if event in _EVENTS and not (event in (10, 11) and "armed" in sources):
+                name, value = _EVENTS[event]
+                found[name].append((time_s, value))
+        sources.setdefault("armed", "EV.Id (10 armed, 11 disarmed)")
+        sources["landed"] = "EV.Id (18 land complete, 28 not landed)"
+    states = {}
+    for name, events in found.items():
+        if not events or start is None:
+            continue
+        events.sort()
+        times = np.array([min(start, events[0][0] - 1e-3), *(t for t, _ in events)])
+        values = np.array([1.0 - events[0][1], *(v for _, v in events)])
+        signal = make_signal(name, times, values, "1", f"{sources[name]}, held to the next event")
+        if signal is not None:
+            states[name] = signal
+    return states
 
 
 def _map_battery_height(messages: DataFlashMessages, add: _Add) -> None:

@@ -65,8 +65,9 @@ __all__ = [
 #: ``quaternion_to_euler``: four fields ``w, x, y, z`` give ``phi, theta, psi``;
 #: ``rangefinder``: ``distance_sensor`` fields ``current_distance``,
 #: ``min_distance``, ``max_distance`` (in that order) give the distance where
-#: it is within range, the signal quality is not 0 and the sensor faces down.
-Conversion = Literal["copy", "negate", "degrees", "degrees_e7", "quaternion_to_euler", "rangefinder"]
+#: it is within range, the signal quality is not 0 and the sensor faces down;
+#: ``arming_state``: ``vehicle_status.arming_state`` gives 1 where it is 2 (armed), else 0.
+Conversion = Literal["copy", "negate", "degrees", "degrees_e7", "quaternion_to_euler", "rangefinder", "arming_state"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -254,6 +255,15 @@ PX4_GROUPS: tuple[SignalGroup, ...] = (
             TopicSource(topic="actuator_controls_0", fields=("control[3]",)),
         ),
     ),
+    SignalGroup(
+        ("armed",),
+        "1",
+        (
+            TopicSource(topic="actuator_armed", fields=("armed",)),
+            TopicSource(topic="vehicle_status", fields=("arming_state",), conversion="arming_state"),
+        ),
+    ),
+    SignalGroup(("landed",), "1", (TopicSource(topic="vehicle_land_detected", fields=("landed",)),)),
     SignalGroup(
         ("battery_v",),
         "V",

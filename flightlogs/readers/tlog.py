@@ -184,6 +184,7 @@ def read_tlog(path: str | PathLike[str], *, progress: Callable[[int, int], None]
             builder(tables, clock, signals)
         _motors(tables, clock, mav_type, autopilot, parameters, signals)
         _battery(tables, clock, signals)
+        _states(tables, clock, signals)
         _position(tables, clock, signals)
         tlog_references(
             tables,
@@ -448,6 +449,30 @@ def _battery(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:
         "V",
         "SYS_STATUS.voltage_battery (mV / 1000; time from the receive clock)",
     )
+
+
+_ARMED_FLAG = 128  # MAV_MODE_FLAG_SAFETY_ARMED of HEARTBEAT.base_mode
+_ON_GROUND = 1  # MAV_LANDED_STATE_ON_GROUND; 0 is undefined, 2-4 in air, taking off, landing
+
+
+def _states(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:
+    """``armed`` from the vehicle's HEARTBEAT and ``landed`` from EXTENDED_SYS_STATE, on the receive clock."""
+    for name, message, field, state in (
+        ("armed", "HEARTBEAT", "base_mode", "128: armed"),
+        ("landed", "EXTENDED_SYS_STATE", "landed_state", "1: on the ground"),
+    ):
+        table = tables[message]
+        boot_s = clock.boot_time_s(table["rx"]) if table["rx"].size else None
+        if boot_s is None:
+            continue
+        raw = table[field].astype(np.int64)
+        if name == "armed":
+            values, known = ((raw & _ARMED_FLAG) != 0).astype(np.float64), np.ones(raw.size, dtype=bool)
+        else:
+            values, known = (raw == _ON_GROUND).astype(np.float64), raw != 0
+        if known.any():
+            time_s = clock.log_time_s(boot_s, table["rx"])[known]
+            _add(signals, name, time_s, values[known], "1", f"{message}.{field} ({state}; time from the receive clock)")
 
 
 def _position(tables: _Tables, clock: _BootClock, signals: _Signals) -> None:

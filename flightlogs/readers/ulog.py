@@ -54,6 +54,7 @@ _EVERY_TOPIC_UP_TO = _WHOLE_FILE_LIMIT
 _STALL_READS = 400_000  # reads with nothing new: pyulog loops (walking garbage re-reads < 2 * 65535)
 _MIN_UTC_US = 946_684_800_000_000  # 2000-01-01: GPS time before this is a receiver default
 _DOWNWARD = 25  # distance_sensor.orientation ROTATION_DOWNWARD_FACING
+_ARMED = 2  # vehicle_status.arming_state ARMING_STATE_ARMED
 _PYULOG_ERRORS = (
     ULogException,
     struct.error,
@@ -520,6 +521,8 @@ def _convert(source: TopicSource, data: Mapping[str, np.ndarray]) -> tuple[list[
         usable = np.isfinite(norm) & (norm > 0.5)  # an all-zero quaternion is "not set"
         quaternion[~usable] = np.nan
         columns = list(quaternion_to_euler(quaternion).T)
+    elif source.conversion == "arming_state":
+        columns = [(columns[0] == _ARMED).astype(np.float64)]
     elif source.conversion == "rangefinder":
         distance, low, high = columns
         usable = (distance >= low) & (distance <= high)
@@ -538,7 +541,9 @@ def _source_text(source: TopicSource, label: str, k: int) -> str:
         return f"{label}.{first.split('[')[0]}[{first[-2]}..{last[-2]}] (quaternion→Euler)"
     field = source.fields[0] if source.conversion == "rangefinder" else source.fields[k]
     sign = "-" if source.conversion == "negate" else ""
-    unit = {"degrees": " (deg→rad)", "degrees_e7": " (1e-7 deg→rad)"}.get(source.conversion, "")
+    unit = {"degrees": " (deg→rad)", "degrees_e7": " (1e-7 deg→rad)", "arming_state": " (2: armed)"}.get(
+        source.conversion, ""
+    )
     return f"{sign}{label}.{field}{unit}"
 
 

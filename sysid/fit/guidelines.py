@@ -271,8 +271,18 @@ class _Axis(Protocol):
     def reason(self) -> str: ...
 
 
+class _Found(Protocol):
+    """What the verdict reads of a model's provenance (:class:`~sysid.fit.result.Provenance`)."""
+
+    @property
+    def maneuvers(self) -> Sequence[str]: ...
+
+
 class _Judged(Protocol):
     """What the verdict reads of a model (:class:`~sysid.fit.result.IdentifiedModel`)."""
+
+    @property
+    def provenance(self) -> _Found: ...
 
     @property
     def cost(self) -> CostSummary: ...
@@ -443,6 +453,30 @@ def _coverage_checks(model: _Judged) -> list[Check]:
     return checks
 
 
+def _maneuver_check(maneuvers: Sequence[str]) -> Check | None:
+    """Whether the responses come from designed maneuvers: a pilot's broadband input found by detection in a
+    flight is a look at the data, never a model on its own; given by the user, it is at best acceptable."""
+    if not maneuvers:
+        return None  # a model file written before the maneuvers were recorded
+    found = [m.split() for m in maneuvers]
+    broadband = [axis for kind, axis, _source in found if kind == "broadband"]
+    detected = [axis for kind, axis, source in found if kind == "broadband" and source == "detected"]
+    grade: Grade = "poor" if detected else "acceptable" if broadband else "good"
+    return Check(
+        guideline="maneuvers designed for identification",
+        value=", ".join(maneuvers),
+        limit="sweeps, multisines, doublets or 3211s",
+        grade=grade,
+        problem=f"the responses of {', '.join(detected)} come from a pilot's broadband input found in the flight "
+        "(no frequency trend, no designed maneuver): a look at the data, not a model on its own"
+        if detected
+        else f"the responses of {', '.join(broadband)} come from a pilot's broadband input (no frequency trend), "
+        "not a designed maneuver"
+        if broadband
+        else "",
+    )
+
+
 def _verification_check(summary: Sequence[_Scored], g: Guidelines) -> Check | None:
     if not summary:
         return None
@@ -474,7 +508,10 @@ def model_verdict(
     (acceptable); the off-axis outputs are shown for information only. A
     limit met exactly is met. A model is never good when an axis of its
     structure is unidentified (the sentence names the missing axes first) or
-    when fewer than half the structure's free parameters were estimated.
+    when fewer than half the structure's free parameters were estimated; never
+    better than poor when its responses come from a pilot's broadband input
+    found in the flight (no designed maneuver), never better than acceptable
+    when that input was given.
 
     Parameters
     ----------
@@ -494,13 +531,15 @@ def model_verdict(
     --------
     >>> from types import SimpleNamespace
     >>> x_u = SimpleNamespace(name="X_u", status="estimated", cr_percent=25.0, insensitivity_percent=2.0)
-    >>> model = SimpleNamespace(cost=CostSummary(average=50.0, responses={"q/delta_lon": 60.0}),
-    ...                         parameters=(x_u,), guidelines=DEFAULT_GUIDELINES, axis_status=())
+    >>> model = SimpleNamespace(cost=CostSummary(average=50.0, responses={"q/delta_lon": 60.0}), parameters=(x_u,),
+    ...                         guidelines=DEFAULT_GUIDELINES, axis_status=(),
+    ...                         provenance=SimpleNamespace(maneuvers=("sweep lon detected",)))
     >>> model_verdict(model).grade, model_verdict(model, guidelines=Guidelines(max_cr_percent=30.0)).grade
     ('acceptable', 'good')
     """
     g = model.guidelines if guidelines is None else guidelines
-    coverage = _coverage_checks(model)
+    maneuvers = _maneuver_check(model.provenance.maneuvers)
+    coverage = _coverage_checks(model) + ([maneuvers] if maneuvers is not None else [])
     checks = _cost_checks(model.cost, g) + [_parameter_check(model.parameters, g)] + coverage
     verified = _verification_check(verification.summary, g) if verification is not None else None
     if verified is not None:

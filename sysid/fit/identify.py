@@ -347,7 +347,9 @@ def _identified(
         else:
             notes.append(f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give --wind)")
     _report(progress, "done", len(_AXES) + 2, len(_AXES) + 2)
-    return model_from_fit(fit, wind, trim=trim, provenance=_provenance(files, options), notes=notes)
+    flown = sorted({f"{s.kind} {s.axis} {s.source}" for f in flights for s in f.segments if s.kind == options.kind})
+    provenance = dataclasses.replace(_provenance(files, options), maneuvers=tuple(flown))
+    return model_from_fit(fit, wind, trim=trim, provenance=provenance, notes=notes)
 
 
 def _wind_step(

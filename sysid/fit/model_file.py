@@ -115,6 +115,7 @@ def model_to_dict(model: IdentifiedModel) -> dict[str, Any]:
             "options": dict(model.provenance.options),
             "versions": dict(model.provenance.versions),
             "created_utc": model.provenance.created_utc,
+            "maneuvers": list(model.provenance.maneuvers),
         },
         "linear_model": {
             "states": list(linear.states),
@@ -425,6 +426,7 @@ def model_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> Identi
                 options=f.get(prov, "options", "provenance", dict, {}),
                 versions=f.get(prov, "versions", "provenance", dict, {}),
                 created_utc=f.get(prov, "created_utc", "provenance", str, ""),
+                maneuvers=tuple(f.get(prov, "maneuvers", "provenance", list, [])),
             ),
             wind=_wind(doc, f),
             input_units=dict(f.get(doc, "input_units", "the file", dict, {})),

@@ -267,6 +267,10 @@ class Provenance:
         Versions of flight-sysid, numpy, scipy.
     created_utc : str
         ISO 8601 time of the identification.
+    maneuvers : tuple of str
+        How each fitted maneuver was found, one ``"kind axis source"`` per
+        distinct triple (``"sweep lat sids"``, ``"broadband lon detected"``):
+        the verdict weighs it (:func:`~sysid.fit.guidelines.model_verdict`).
     """
 
     files: tuple[str, ...] = ()
@@ -274,6 +278,7 @@ class Provenance:
     options: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     versions: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     created_utc: str = ""
+    maneuvers: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -7,6 +7,7 @@ from typing import Any
 
 from sysid._json import finite_or_none as _num
 from sysid.fit._json import axis_entry, parameter_entry
+from sysid.fit.guidelines import model_verdict
 from sysid.fit.result import IdentifiedModel
 from sysid.model.modes import Mode, modes
 
@@ -63,9 +64,13 @@ def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
         control input's ``axis``, ``input``, ``status`` "identified" or
         "unidentified", ``reason``, ``remedy``); ``reduction`` (the log, a
         ``kept`` step with the costs that rose); ``wind`` (residual RMS
-        before/after, or None); ``notes``. Eigenvalues are those of the
-        identified axes.
+        before/after, or None); ``notes``; ``maneuvers`` (how the fitted
+        maneuvers were found, ``"kind axis source"``); ``verdict`` (``grade``
+        and ``sentence`` by the guidelines of the fit, not yet verified on
+        doublets: :func:`~sysid.fit.guidelines.model_verdict`). Eigenvalues
+        are those of the identified axes.
     """
+    verdict = model_verdict(model)
     return {
         "model": model.structure_name,
         "parameters": {p.name: parameter_entry(p) for p in model.parameters},
@@ -97,4 +102,6 @@ def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
         "trim": dict(model.trim),
         "input_units": dict(model.input_units),
         "notes": list(model.notes),
+        "maneuvers": list(model.provenance.maneuvers),
+        "verdict": {"grade": verdict.grade, "sentence": verdict.sentence},
     }

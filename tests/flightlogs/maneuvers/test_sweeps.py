@@ -88,7 +88,7 @@ def test_a_pilot_shaking_two_sticks_at_once_is_found_on_both_axes() -> None:
     found = detect_segments(T, {}, responses=responses, min_hover_s=1e9)
     assert sorted(s.axis for s in found) == ["lat", "lon"]
     for segment in found:
-        assert segment.kind == "sweep" and segment.detail.startswith("piloted, broadband without a trend")
+        assert segment.kind == "broadband" and segment.detail.startswith("piloted, without a frequency trend")
         assert 28.5 <= segment.start_s <= 31.0 and 79.0 <= segment.end_s <= 81.5
 
 

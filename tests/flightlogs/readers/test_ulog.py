@@ -42,16 +42,21 @@ POSITION = {"latitude", "longitude"}
 # references (optional, never missing): vehicle_rates_setpoint, vehicle_attitude_setpoint, manual_control_setpoint
 REFERENCES = {"p_ref", "q_ref", "r_ref", "phi_ref", "theta_ref", "psi_ref"}
 STICKS = {"stick_lat", "stick_lon", "stick_yaw", "stick_thr"}
+# flight states (optional, never missing): actuator_armed or vehicle_status, vehicle_land_detected (data README)
+ARMED = {"armed"}
+STATES = {"armed", "landed"}
 
 # file -> (signals present, exactly; sources of some of them), from the data README
 REAL_ULOGS = {
     "kd0aij-impulse-response/log1.ulg": (
-        RATES_ACCEL | REFERENCES,
-        {"p": "sensor_gyro[0].x", "az": "sensor_accel[0].z"},
+        RATES_ACCEL | REFERENCES | ARMED,
+        {"p": "sensor_gyro[0].x", "az": "sensor_accel[0].z", "armed": "vehicle_status[0].arming_state (2: armed)"},
     ),
     QUAD: (
-        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | REFERENCES | STICKS | {"vd", "height_agl", "battery_v"},
+        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | REFERENCES | STICKS | STATES | {"vd", "height_agl", "battery_v"},
         {
+            "landed": "vehicle_land_detected[0].landed",
+            "armed": "actuator_armed[0].armed",
             "p": "vehicle_angular_velocity[0].xyz[0]",
             "phi": "vehicle_attitude[0].q[0..3] (quaternion→Euler)",
             "ax": "vehicle_acceleration[0].xyz[0]",
@@ -62,7 +67,7 @@ REAL_ULOGS = {
         },
     ),
     GPS_LOG: (
-        set(LOGGED_SIGNALS) | MOTORS_4 | POSITION | REFERENCES | STICKS,
+        set(LOGGED_SIGNALS) | MOTORS_4 | POSITION | REFERENCES | STICKS | STATES,
         {
             "vn": "vehicle_local_position[0].vx",
             "delta_lat": "vehicle_torque_setpoint[0].xyz[0]",
@@ -72,11 +77,11 @@ REAL_ULOGS = {
         },
     ),
     "px4-ulog-rs/corrupt_actuator_armed_wrong_size.ulg": (
-        RATES_ACCEL | ATTITUDE | {"vd", "height_agl", "battery_v"},
+        RATES_ACCEL | ATTITUDE | ARMED | {"vd", "height_agl", "battery_v"},
         {"r": "vehicle_angular_velocity[0].xyz[2]", "battery_v": "battery_status[0].voltage_v"},
     ),
     OLD: (
-        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | REFERENCES | {"vd", "height_agl"},
+        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | REFERENCES | ARMED | {"vd", "height_agl"},
         {
             "p": "vehicle_attitude[0].rollspeed",
             "ax": "sensor_combined[0].accelerometer_m_s2[0]",
@@ -86,7 +91,13 @@ REAL_ULOGS = {
         },
     ),
     "pyulog/sample_appended_multiple.ulg": (
-        RATES_ACCEL | ATTITUDE | DELTAS | MOTORS_4 | REFERENCES | {"vd", "height_agl", "est_wind_n", "est_wind_e"},
+        RATES_ACCEL
+        | ATTITUDE
+        | DELTAS
+        | MOTORS_4
+        | REFERENCES
+        | ARMED
+        | {"vd", "height_agl", "est_wind_n", "est_wind_e"},
         {
             "q": "vehicle_attitude[0].pitchspeed",
             "est_wind_n": "wind_estimate[0].windspeed_north",

@@ -256,3 +256,31 @@ def test_the_reduction_margin_on_the_average() -> None:
     )
     rise = DEFAULT_GUIDELINES.reduction_cost_rise(before, CostSummary(average=210.0, responses={"a": 110, "b": 310}))
     assert rise == "J_ave rose from 200 to 210 (allowed: up to 204)"
+
+
+@pytest.mark.parametrize(
+    ("maneuvers", "grade", "problem"),
+    [
+        (("sweep lat detected", "sweep lon sids"), "good", ""),
+        (
+            ("broadband lat user",),
+            "acceptable",
+            "the responses of lat come from a pilot's broadband input (no frequency",
+        ),
+        (
+            ("broadband lat detected", "broadband lon detected"),
+            "poor",
+            "the responses of lat, lon come from a pilot's broadband input found in the flight",
+        ),
+    ],
+)
+def test_a_broadband_input_found_in_a_flight_never_makes_a_model_on_its_own(
+    maneuvers: tuple[str, ...], grade: str, problem: str
+) -> None:
+    """The fit itself meets every guideline: only how its maneuvers were found grades it down."""
+    model = _model()
+    model = dataclasses.replace(model, provenance=dataclasses.replace(model.provenance, maneuvers=maneuvers))
+    verdict = model_verdict(model)
+    assert verdict.grade == grade
+    check = next(c for c in verdict.checks if c.guideline == "maneuvers designed for identification")
+    assert check.problem.startswith(problem) and (not problem or problem in verdict.sentence)

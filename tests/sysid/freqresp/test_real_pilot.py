@@ -37,7 +37,7 @@ DB = 3.0  # a rate loop with integral action tracks within this of 0 dB there
 @pytest.fixture(scope="module", name="responses")
 def responses_fixture(real_data: Path):  # type: ignore[no-untyped-def]
     flight = condition_flight(read_log(real_data / KD0AIJ))
-    found = flight_responses([flight], [("p", "p_ref"), ("q", "q_ref")], options=ResponseOptions())
+    found = flight_responses([flight], [("p", "p_ref"), ("q", "q_ref")], kind="broadband", options=ResponseOptions())
     return {r.pair: r for r in found.responses}
 
 
