@@ -16,6 +16,7 @@ import math
 import re
 import warnings
 from collections.abc import Callable, Mapping
+from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
 from typing import TypeVar
@@ -25,6 +26,7 @@ import pandas as pd
 
 from flightlogs.conditioning.condition import ConditioningOptions, condition_flight
 from flightlogs.errors import SysidWarning
+from flightlogs.flightlog import FlightLog
 from flightlogs.readers import read_log
 from flightlogs.record import Record
 from simulator.vehicle.identified import CALM_HOVER
@@ -380,3 +382,41 @@ def synthetic_series(n: int = 3000, seed: int = 0, *, drag: float = 0.0, lowest_
     return FlightSeries(
         name=f"synthetic-{seed}", time_s=np.arange(n) / 50.0, piece=np.zeros(n, int), signals=signals, rate_hz=50.0
     )
+
+
+#: The column map of :func:`roll_table`'s tables.
+ROLL_TABLE_MAP = "time=time_ms:ms,delta_lat=mixer_roll,p=roll_rate_dps:deg/s"
+
+
+def simulated_roll_log(folder: Path) -> Path:
+    """Our simulator's 34 s roll sweep (calm hover, seed 2) as a PX4 log; the sweep is 28-62 s on the log clock."""
+    from simulator.autopilot.excitation import Maneuver
+    from simulator.flights.linear import simulate_hover
+    from simulator.output.px4 import write_px4_log
+
+    flight = simulate_hover(
+        50.0,
+        (Maneuver(axis="lat", kind="sweep", start_s=8.0, amplitude=8.0, duration_s=34.0),),
+        parameters=CALM_HOVER,
+        seed=2,
+    )
+    return write_px4_log(flight, folder / "roll.ulg", utc_start=datetime(2024, 5, 1, 10, tzinfo=UTC))
+
+
+def roll_table(log: FlightLog, folder: Path) -> tuple[Path, Path]:
+    """A log's roll mixer input and roll rate on the rate's time base, as a flight-test export would hold them:
+    ``roll.csv`` (time in ms, rate in deg/s) and ``roll.parquet``, read with :data:`ROLL_TABLE_MAP`."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    t = log["p"].time_s
+    delta = np.interp(t, log["delta_lat"].time_s, log["delta_lat"].values)
+    p_deg_s = np.degrees(log["p"].values)
+    csv = folder / "roll.csv"
+    csv.write_text(
+        "time_ms,mixer_roll,roll_rate_dps\n"
+        + "".join(f"{a * 1e3:.4f},{b:.9g},{c:.9g}\n" for a, b, c in zip(t, delta, p_deg_s))
+    )
+    parquet = folder / "roll.parquet"
+    pq.write_table(pa.table({"time_ms": t * 1e3, "mixer_roll": delta, "roll_rate_dps": p_deg_s}), parquet)
+    return csv, parquet

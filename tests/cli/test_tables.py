@@ -10,41 +10,18 @@ motion-capture-style table with rotor speeds in rpm.
 from __future__ import annotations
 
 import json
-from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
-import pyarrow as pa
-import pyarrow.parquet as pq
 import pytest
 from click.testing import CliRunner
 from independent_sim.fixtures import independent_corpus_fixture  # noqa: F401 (registers the fixture)
 
-from flightlogs.flightlog import FlightLog
 from flightlogs.readers import read_log
-from simulator.autopilot.excitation import Maneuver
-from simulator.flights.linear import simulate_hover
-from simulator.output.px4 import write_px4_log
-from simulator.vehicle.identified import CALM_HOVER
 from sysid.freqresp import read_responses
 from sysid_cli.main import cli
 
-ROLL_MAP = "time=time_ms:ms,delta_lat=mixer_roll,p=roll_rate_dps:deg/s"
-
-
-def _roll_table(log: FlightLog, folder: Path) -> tuple[Path, Path]:
-    """The log's roll mixer input and roll rate on the rate's time base: a CSV (ms, deg/s) and a Parquet file."""
-    t = log["p"].time_s
-    delta = np.interp(t, log["delta_lat"].time_s, log["delta_lat"].values)
-    p_deg_s = np.degrees(log["p"].values)
-    csv = folder / "roll.csv"
-    csv.write_text(
-        "time_ms,mixer_roll,roll_rate_dps\n"
-        + "".join(f"{a * 1e3:.4f},{b:.9g},{c:.9g}\n" for a, b, c in zip(t, delta, p_deg_s))
-    )
-    parquet = folder / "roll.parquet"
-    pq.write_table(pa.table({"time_ms": t * 1e3, "mixer_roll": delta, "roll_rate_dps": p_deg_s}), parquet)
-    return csv, parquet
+from builders import ROLL_TABLE_MAP, roll_table, simulated_roll_log
 
 
 def _response(source: Path, segments: Path, out: Path, *extra: str) -> np.ndarray:
@@ -60,19 +37,13 @@ def _response(source: Path, segments: Path, out: Path, *extra: str) -> np.ndarra
 
 @pytest.mark.slow
 def test_a_simulated_roll_sweep_as_csv_and_parquet_gives_the_logs_response(tmp_path: Path) -> None:
-    flight = simulate_hover(
-        50.0,
-        (Maneuver(axis="lat", kind="sweep", start_s=8.0, amplitude=8.0, duration_s=34.0),),
-        parameters=CALM_HOVER,
-        seed=2,
-    )
-    log = write_px4_log(flight, tmp_path / "roll.ulg", utc_start=datetime(2024, 5, 1, 10, tzinfo=UTC))
+    log = simulated_roll_log(tmp_path)
     segments = tmp_path / "segments.csv"
     segments.write_text("start_s,end_s,axis,kind\n28.0,62.0,lat,sweep\n")
-    csv, parquet = _roll_table(read_log(log), tmp_path)
+    csv, parquet = roll_table(read_log(log), tmp_path)
     logged = _response(log, segments, tmp_path / "log.h5")
     for table in (csv, parquet):
-        from_table = _response(table, segments, tmp_path / f"{table.suffix[1:]}.h5", "--map", ROLL_MAP)
+        from_table = _response(table, segments, tmp_path / f"{table.suffix[1:]}.h5", "--map", ROLL_TABLE_MAP)
         np.testing.assert_allclose(from_table, logged, rtol=1e-4)
 
 
@@ -82,10 +53,10 @@ def test_the_independent_generators_roll_sweep_as_csv_gives_the_logs_response(
     tmp_path: Path,
 ) -> None:
     files = independent_corpus.files("tune-px4-lon-lat-sweeps")
-    csv, _ = _roll_table(read_log(files.log), tmp_path)
+    csv, _ = roll_table(read_log(files.log), tmp_path)
     logged = _response(files.log, files.segments_csv, tmp_path / "log.h5")
     np.testing.assert_allclose(
-        _response(csv, files.segments_csv, tmp_path / "csv.h5", "--map", ROLL_MAP), logged, rtol=1e-4
+        _response(csv, files.segments_csv, tmp_path / "csv.h5", "--map", ROLL_TABLE_MAP), logged, rtol=1e-4
     )
 
 

@@ -12,7 +12,6 @@ inside their 2 CR, while the rest meet the floors.
 from __future__ import annotations
 
 import json
-from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -21,30 +20,30 @@ from click.testing import CliRunner
 from independent_sim.roll_table import ROLL_TRUTH, write_roll_table
 
 from flightlogs.readers import read_log
-from simulator.autopilot.excitation import Maneuver
-from simulator.flights.linear import simulate_hover
-from simulator.output.px4 import write_px4_log
 from simulator.vehicle.identified import CALM_HOVER
 from sysid_cli.main import cli
 
-MAP = "time=time_ms:ms,delta_lat=mixer_roll,p=roll_rate_dps:deg/s"
+from builders import ROLL_TABLE_MAP, roll_table, simulated_roll_log
+
 FOURTH_ORDER = "p/delta_lat = b2*s^2/(s^4 + a3*s^3 + a2*s^2 + a1*s + a0)"
 
 
 def _fit(source: Path, *extra: str) -> dict:
-    result = CliRunner().invoke(cli, ["fit", str(source), "--map", MAP, "--delay", *extra, "--json", "-", "-q"])
+    result = CliRunner().invoke(
+        cli, ["fit", str(source), "--map", ROLL_TABLE_MAP, "--delay", *extra, "--json", "-", "-q"]
+    )
     assert result.exit_code == 0, result.output
     return json.loads(result.stdout)
 
 
-@pytest.fixture(scope="module", name="roll_table")
-def roll_table_fixture(tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
+@pytest.fixture(scope="module", name="known_roll")
+def known_roll_fixture(tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
     return write_roll_table(tmp_path_factory.mktemp("roll-table"))
 
 
 @pytest.mark.parametrize("fmt", ["csv", "parquet"])
-def test_the_generators_known_roll_response_is_recovered(roll_table, fmt: str, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
-    source = roll_table.csv if fmt == "csv" else roll_table.parquet
+def test_the_generators_known_roll_response_is_recovered(known_roll, fmt: str, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    source = known_roll.csv if fmt == "csv" else known_roll.parquet
     report = tmp_path / "tf.html"
     (tf,) = _fit(source, "--tf", FOURTH_ORDER, "--report", str(report))["tf"]
     assert tf["pair"] == "p/delta_lat" and tf["J"] <= 50.0 and tf["notes"] == []
@@ -60,27 +59,14 @@ def test_the_generators_known_roll_response_is_recovered(roll_table, fmt: str, t
     assert "<svg" in page and "Transfer-function fits" in page and "b2*s^2/(s^4" in page
 
 
-def test_a_band_narrows_the_fit(roll_table) -> None:  # type: ignore[no-untyped-def]
-    (tf,) = _fit(roll_table.csv, "--tf", FOURTH_ORDER, "--band", "2,20")["tf"]
+def test_a_band_narrows_the_fit(known_roll) -> None:  # type: ignore[no-untyped-def]
+    (tf,) = _fit(known_roll.csv, "--tf", FOURTH_ORDER, "--band", "2,20")["tf"]
     assert tf["band_rad_s"][0] >= 2.0 and tf["band_rad_s"][1] <= 20.0
 
 
 @pytest.mark.slow
 def test_our_simulators_roll_sweep_says_which_coefficients_it_cannot_give(tmp_path: Path) -> None:
-    flight = simulate_hover(
-        50.0,
-        (Maneuver(axis="lat", kind="sweep", start_s=8.0, amplitude=8.0, duration_s=34.0),),
-        parameters=CALM_HOVER,
-        seed=2,
-    )
-    log = read_log(write_px4_log(flight, tmp_path / "roll.ulg", utc_start=datetime(2024, 5, 1, 10, tzinfo=UTC)))
-    t = log["p"].time_s
-    delta = np.interp(t, log["delta_lat"].time_s, log["delta_lat"].values)
-    table = tmp_path / "roll.csv"
-    table.write_text(
-        "time_ms,mixer_roll,roll_rate_dps\n"
-        + "".join(f"{a * 1e3:.3f},{b:.7g},{c:.7g}\n" for a, b, c in zip(t, delta, np.degrees(log["p"].values)))
-    )
+    table, _ = roll_table(read_log(simulated_roll_log(tmp_path)), tmp_path)
     segments = tmp_path / "segments.csv"
     segments.write_text("start_s,end_s,axis,kind\n28.0,62.0,lat,sweep\n")
     # the bare airframe: p/delta = (L_lat s + L_v Y_lat - L_lat Y_v) s / ((s + 1/T_a)(s^3 - Y_v s^2 - g L_v)) / T_a
@@ -108,6 +94,6 @@ def test_our_simulators_roll_sweep_says_which_coefficients_it_cannot_give(tmp_pa
     assert not tf["stable"] and any("unstable fit" in note for note in tf["notes"])
 
 
-def test_delay_and_band_go_with_tf(roll_table) -> None:  # type: ignore[no-untyped-def]
-    result = CliRunner().invoke(cli, ["fit", str(roll_table.csv), "--map", MAP, "--delay"])
+def test_delay_and_band_go_with_tf(known_roll) -> None:  # type: ignore[no-untyped-def]
+    result = CliRunner().invoke(cli, ["fit", str(known_roll.csv), "--map", ROLL_TABLE_MAP, "--delay"])
     assert result.exit_code == 2 and "--delay and --band go with --tf" in result.output
