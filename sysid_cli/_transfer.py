@@ -35,6 +35,8 @@ def fit_transfer(
     band: tuple[float, float] | None,
     kind: str,
     min_coherence: float,
+    max_cr: float,
+    max_insensitivity: float,
     sources: Sequence[Path],
     out: Path | None,
     report: Path | None,
@@ -57,6 +59,8 @@ def fit_transfer(
         Maneuvers used.
     min_coherence : float
         Gating threshold.
+    max_cr, max_insensitivity : float
+        The guidelines the fits are judged by, % (``--max-cr``, ``--max-insensitivity``).
     sources : sequence of Path
         The files read.
     out, report : Path or None
@@ -67,6 +71,7 @@ def fit_transfer(
         No table.
     """
     from flightlogs.writers.jsonio import write_json
+    from sysid.fit.guidelines import Guidelines
     from sysid.fit.transfer import TransferOptions, fit_transfer_functions
     from sysid.model.transfer import parse_transfer_function
 
@@ -74,7 +79,11 @@ def fit_transfer(
     fits = fit_transfer_functions(
         flights,
         structures,
-        options=TransferOptions(delay=delay, band_rad_s=band),
+        options=TransferOptions(
+            delay=delay,
+            band_rad_s=band,
+            guidelines=Guidelines(max_cr_percent=max_cr, max_insensitivity_percent=max_insensitivity),
+        ),
         kind=kind,
         min_coherence=min_coherence,
     )

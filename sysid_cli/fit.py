@@ -251,6 +251,8 @@ def fit(
             band=band,
             kind=kind,
             min_coherence=min_coherence,
+            max_cr=max_cr,
+            max_insensitivity=max_insensitivity,
             sources=list(logs),
             out=out,
             report=report,

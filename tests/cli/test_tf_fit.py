@@ -97,3 +97,10 @@ def test_our_simulators_roll_sweep_says_which_coefficients_it_cannot_give(tmp_pa
 def test_delay_and_band_go_with_tf(known_roll) -> None:  # type: ignore[no-untyped-def]
     result = CliRunner().invoke(cli, ["fit", str(known_roll.csv), "--map", ROLL_TABLE_MAP, "--delay"])
     assert result.exit_code == 2 and "--delay and --band go with --tf" in result.output
+
+
+def test_the_guidelines_given_judge_the_coefficients(known_roll) -> None:  # type: ignore[no-untyped-def]
+    """--max-cr 5: every coefficient of the known roll response (CR 8.8-12.2 %) is said to miss it."""
+    (tf,) = _fit(known_roll.csv, "--tf", FOURTH_ORDER, "--max-cr", "5")["tf"]
+    flagged = {note.split(": ")[1].split(" ")[0] for note in tf["notes"] if "not identified to the guidelines" in note}
+    assert flagged == set(tf["parameters"]) and all("against 5," in note for note in tf["notes"])
