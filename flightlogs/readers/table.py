@@ -18,6 +18,7 @@ different rates reads as it was logged.
 
 from __future__ import annotations
 
+import csv
 import io
 import re
 import tomllib
@@ -349,7 +350,12 @@ def _delimiter(line: str) -> str | None:
 
 
 def _split(line: str, delimiter: str) -> list[str]:
-    return line.split() if delimiter == " " else [cell.strip() for cell in line.split(delimiter)]
+    """A row's fields; a quoted field may hold the delimiter (``"roll rate, deg/s"``)."""
+    if delimiter == " ":
+        return line.split()
+    if '"' not in line:
+        return [cell.strip() for cell in line.split(delimiter)]
+    return [cell.strip() for cell in next(csv.reader([line], delimiter=delimiter, skipinitialspace=True))]
 
 
 def _is_number(cell: str) -> bool:
@@ -379,7 +385,7 @@ def _index(path: Path, labels: list[str], has_header: bool, name: str, column: s
 def _check_widths(path: Path, data: list[tuple[int, str]], delimiter: str, width: int) -> None:
     """LogFormatError naming the first row whose number of fields is not the first row's."""
     for line, text in data:
-        fields = len(text.split()) if delimiter == " " else text.count(delimiter) + 1
+        fields = len(_split(text, delimiter)) if delimiter == " " or '"' in text else text.count(delimiter) + 1
         if fields != width:
             raise LogFormatError(f"{path}, line {line}: {fields} fields where the first row has {width}")
 

@@ -173,3 +173,18 @@ def test_units_convert_exactly() -> None:
 
     assert si_factor("deg", "rad") == math.pi / 180.0 and si_factor("g", "m/s^2") == 9.80665
     assert si_factor("km/h", "m/s") == pytest.approx(1 / 3.6) and si_factor("ft", "m") == 0.3048
+
+
+def test_a_quoted_header_may_hold_the_delimiter(tmp_path: Path) -> None:
+    rows = [f'{t:.2f},"{d:.6f}",{p:.4f}' for t, d, p in zip(T, DELTA, P_DEG_S)]
+    path = _write(tmp_path / "quoted.csv", '"time, s","mixer, roll","roll rate, deg/s"', rows)
+    log = read_table(path, parse_table_map(str(_toml(tmp_path))))
+    np.testing.assert_allclose(log["p"].values, np.radians(P_DEG_S), rtol=1e-4)
+    np.testing.assert_allclose(log["delta_lat"].values, DELTA, atol=1e-6)
+
+
+def _toml(folder: Path) -> Path:
+    """A map naming columns whose names hold commas: only a TOML map can."""
+    path = folder / "quoted.toml"
+    path.write_text('time = "time, s:s"\ndelta_lat = "mixer, roll"\np = "roll rate, deg/s:deg/s"\n')
+    return path
