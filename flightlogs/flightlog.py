@@ -11,7 +11,7 @@ from typing import Literal
 
 import numpy as np
 
-from flightlogs.signals import LOGGED_SIGNALS, is_canonical
+from flightlogs.signals import LOGGED_SIGNALS, STATE_SIGNALS, is_canonical
 
 __all__ = ["Signal", "SystemIdRun", "FlightLog", "Autopilot", "LogFormat", "logged_rate_hz"]
 
@@ -267,9 +267,15 @@ class FlightLog:
 
     @property
     def time_range_s(self) -> tuple[float, float]:
-        """Earliest and latest sample time over all signals, s (log clock)."""
-        starts = [s.time_s[0] for s in self.signals.values() if s.samples]
-        ends = [s.time_s[-1] for s in self.signals.values() if s.samples]
+        """Earliest and latest sample time over all signals, s (log clock).
+
+        The flight states (``armed``, ``landed``: :data:`~flightlogs.signals.STATE_SIGNALS`) are left out: an
+        autopilot logs them from boot and at each change, so they would stretch the span to the ground time
+        before the first measurement (and with it the wind the transport delay is averaged over).
+        """
+        timed = [s for name, s in self.signals.items() if s.samples and name not in STATE_SIGNALS]
+        starts = [s.time_s[0] for s in timed]
+        ends = [s.time_s[-1] for s in timed]
         if not starts:
             return (0.0, 0.0)
         return (float(min(starts)), float(max(ends)))

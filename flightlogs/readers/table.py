@@ -22,13 +22,14 @@ import csv
 import io
 import re
 import tomllib
+import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from flightlogs.errors import DataError, LogFormatError
+from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
 from flightlogs.flightlog import FlightLog, Signal
 from flightlogs.readers._units import AS_LOGGED, SI_SIZES, canonical_unit, si_factor
 from flightlogs.signals import describe, is_canonical
@@ -219,9 +220,14 @@ def read_table(
     LogFormatError
         If the file is not a table.
     DataError
-        If a mapped column is missing or not numbers, time is missing or
-        goes back, or a unit does not fit (each names the column, and the
+        If a mapped column is missing, empty or not numbers, time is missing
+        or goes back, or a unit does not fit (each names the column, and the
         line or row).
+
+    Warns
+    -----
+    DataQualityWarning
+        When the time column's unit was found from its interval, not given.
     """
     path = Path(path)
     try:
@@ -235,6 +241,8 @@ def read_table(
     for name, column in columns.items():
         unit, factor = _conversion(name, column.unit)
         has_value = np.isfinite(column.values)
+        if not has_value.any():
+            raise DataError(f"{path}: {_named(column.label)} ({name}) has no value in any row")
         shown = _named(column.label) + (f" ({column.unit} → {unit})" if column.unit != unit else "")
         signals[name] = Signal(
             name=name,
@@ -243,6 +251,8 @@ def read_table(
             unit=unit,
             source=f"{path.name} {shown}",
         )
+    if note:
+        warnings.warn(DataQualityWarning(note), stacklevel=2)
     if progress is not None:
         progress(len(raw), len(raw))
     return FlightLog(

@@ -9,6 +9,7 @@ column and the line or row.
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from flightlogs.errors import DataError, LogFormatError
+from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
 from flightlogs.readers import ReadOptions, TableColumn, is_table, parse_table_map, read_log, read_table
 
 T = np.round(np.arange(0.0, 4.0, 0.02), 6)  # 50 Hz, s
@@ -47,7 +48,9 @@ def test_every_layout_reads_to_the_same_si_signals(
     tmp_path: Path, delimiter: str, header: str | None, time_scale: float, text: str
 ) -> None:
     path = _write(tmp_path / "sweep.csv", None if header is None else header, _rows(delimiter, time_scale))
-    log = read_log(path, reading=ReadOptions(table_map=parse_table_map(text)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataQualityWarning)  # the time unit found, not given: tested below
+        log = read_log(path, reading=ReadOptions(table_map=parse_table_map(text)))
     assert (log.log_format, log.autopilot, sorted(log.signals)) == ("table", "unknown", ["delta_lat", "p"])
     np.testing.assert_allclose(log["p"].time_s, T, atol=1e-9)
     np.testing.assert_allclose(log["p"].values, np.radians(P_DEG_S), rtol=1e-8, atol=1e-12)
@@ -58,7 +61,8 @@ def test_every_layout_reads_to_the_same_si_signals(
 
 def test_a_time_unit_found_from_the_interval_is_said(tmp_path: Path) -> None:
     path = _write(tmp_path / "t.csv", "t,p", [f"{t * 1e3:.3f},{p}" for t, p in zip(T, P_DEG_S)])
-    log = read_table(path, parse_table_map("time=t,p=p:deg/s"))
+    with pytest.warns(DataQualityWarning, match="read in ms"):
+        log = read_table(path, parse_table_map("time=t,p=p:deg/s"))
     np.testing.assert_allclose(log["p"].time_s, T, atol=1e-9)
     assert log.warnings == (
         "t.csv: time column 't' read in ms (its median interval is 20, 50 Hz in ms); give time=t:<unit> if it is not",
@@ -149,6 +153,7 @@ def test_a_bad_map_is_one_sentence(text: str, message: str) -> None:
             DataError,
             "column map: p is in rad/s; unknown unit 'furlong/s'",
         ),
+        ("t,p\n0,\n0.02,nan\n", "time=t:s,p=p", DataError, "bad.csv: column 'p' (p) has no value in any row"),
     ],
 )
 def test_a_bad_table_is_one_sentence_naming_the_column_and_line(
