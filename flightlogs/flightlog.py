@@ -83,6 +83,9 @@ class Signal:
     source : str
         Where the values came from, ``"topic[instance].field"`` or
         ``"MESSAGE[instance].Field"``, with the conversion applied if any.
+    derived : bool, optional
+        True when the values were computed from other signals, not measured
+        (a motion-capture table's specific forces from its velocities).
 
     Attributes
     ----------
@@ -102,8 +105,11 @@ class Signal:
     stored_values: np.ndarray = field(init=False)  # so ``dataclasses.replace(signal, values=...)`` works
     unit: str
     source: str
+    derived: bool = False
 
-    def __init__(self, *, name: str, time_s: np.ndarray, values: np.ndarray, unit: str, source: str) -> None:
+    def __init__(
+        self, *, name: str, time_s: np.ndarray, values: np.ndarray, unit: str, source: str, derived: bool = False
+    ) -> None:
         time_s = np.ascontiguousarray(time_s, dtype=np.float64)
         stored = np.ascontiguousarray(values, dtype=_held_dtype(np.asarray(values).dtype))
         if time_s.ndim != 1 or stored.shape != time_s.shape:
@@ -120,6 +126,7 @@ class Signal:
             ("stored_values", stored),
             ("unit", unit),
             ("source", source),
+            ("derived", derived),
         ):
             object.__setattr__(self, attribute, value)
 

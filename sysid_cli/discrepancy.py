@@ -86,7 +86,7 @@ def discrepancy(
         compare_model_responses,
         compare_responses,
         discover,
-        flight_series,
+        flights_series,
         read_simulation_model,
         simulated_flight,
         write_corrected_model,
@@ -114,7 +114,7 @@ def discrepancy(
         quiet=quiet,
         reading=reading_from(table_map, vehicle),
     )
-    real_series = [flight_series(f.source.name, f.records) for f in flown]
+    real_series = flights_series(flown)
     if model is None:
         simulated = conditioned_flights(
             list(sim_logs),
@@ -124,7 +124,8 @@ def discrepancy(
             quiet=quiet,
             reading=reading_from(table_map, vehicle),
         )
-        sim_series = [flight_series(f.source.name, f.records) for f in simulated]
+        real_series = flights_series(flown, like=simulated)  # like with like: a table's rate, its derived forces
+        sim_series = flights_series(simulated, like=flown)
     else:
         sim_series = [simulated_flight(model, s, source=models[0].name) for s in real_series]
     with staged_progress("discrepancy", quiet=quiet) as progress:

@@ -158,6 +158,9 @@ class ConditionedFlight:
     warnings : tuple of str
         Gaps, doubtful wind, dropped signals (the messages of the warnings
         raised while conditioning).
+    derived : tuple of str
+        The signals computed from others, not measured (a motion-capture
+        table's specific forces, :attr:`flightlogs.flightlog.Signal.derived`).
     """
 
     source: Path
@@ -166,6 +169,7 @@ class ConditionedFlight:
     rate_hz: float
     wind: WindAlignment | None = None
     warnings: tuple[str, ...] = ()
+    derived: tuple[str, ...] = ()
 
 
 def condition_flight(
@@ -257,7 +261,10 @@ def _one_pass(log: FlightLog, wind: Any | None, options: ConditioningOptions) ->
         _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}", holds)
         for k, span in enumerate(spans.spans)
     )
-    return ConditionedFlight(source=log.path, records=records, segments=segments, rate_hz=rate_hz, wind=alignment)
+    derived = tuple(sorted(name for name, signal in log.signals.items() if signal.derived))
+    return ConditionedFlight(
+        source=log.path, records=records, segments=segments, rate_hz=rate_hz, wind=alignment, derived=derived
+    )
 
 
 _CUT_WARN = 0.2  # the anemometer's overlap cutting more than this fraction off the log is said

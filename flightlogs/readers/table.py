@@ -31,6 +31,7 @@ import numpy as np
 
 from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
 from flightlogs.flightlog import FlightLog, Signal
+from flightlogs.readers._table_derived import FRAMES, RotorLayout, derived_signals
 from flightlogs.readers._units import AS_LOGGED, SI_SIZES, canonical_unit, si_factor
 from flightlogs.signals import describe, is_canonical
 
@@ -70,6 +71,10 @@ class TableMap:
     ----------
     columns : Mapping[str, TableColumn]
         By canonical name; must hold ``"time"``.
+    rotors : RotorLayout or None, optional
+        The rotor layout, from a TOML map's ``[rotors]`` table: with it the
+        mixer inputs are derived from the motors (see
+        :mod:`flightlogs.readers._table_derived`).
 
     Raises
     ------
@@ -78,6 +83,7 @@ class TableMap:
     """
 
     columns: Mapping[str, TableColumn]
+    rotors: RotorLayout | None = None
 
     def __post_init__(self) -> None:
         if "time" not in self.columns:
@@ -102,7 +108,10 @@ def parse_table_map(text: str) -> TableMap:
         ``time=0,delta_lat=1,p=2:deg/s``, or the path of a ``.toml`` file
         whose keys are canonical names (at the top level or under
         ``[columns]``) and whose values are ``"column[:unit]"`` strings or
-        column indices.
+        column indices; its ``[rotors]`` table (``frame = "quad_x"`` or
+        ``angles_deg`` and ``spins``; ``full_scale`` for rotor speeds;
+        ``gains``, the mixer's roll, pitch and yaw gains, 1 by default) lets
+        the mixer inputs be derived from the motors.
 
     Returns
     -------
@@ -139,13 +148,49 @@ def _toml_map(path: Path) -> TableMap:
         raise DataError(f"{path}: the column map cannot be read ({err.strerror or err})") from err
     except tomllib.TOMLDecodeError as err:
         raise DataError(f"{path}: not a TOML column map ({err})") from err
-    table = document.get("columns", document)
+    table = document.get("columns", {k: v for k, v in document.items() if k != "rotors"})
     entries: dict[str, TableColumn] = {}
     for name, spec in table.items():
         if isinstance(spec, bool) or not isinstance(spec, (int, str)):
             raise DataError(f"{path}: {name} = {spec!r} is neither a column name nor a column index")
         entries[name] = TableColumn(spec) if isinstance(spec, int) else _column(name, spec)
-    return TableMap(entries)
+    return TableMap(entries, _rotors(path, document.get("rotors")))
+
+
+def _rotors(path: Path, table: object) -> RotorLayout | None:
+    """The ``[rotors]`` table of a TOML map: a named frame or angles and spins, and the full-scale speed."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise DataError(f"{path}: rotors must be a table ([rotors] with frame or angles_deg and spins)")
+    unknown = set(table) - {"frame", "angles_deg", "spins", "full_scale", "gains"}
+    if unknown:
+        raise DataError(
+            f"{path}: [rotors] has {', '.join(sorted(unknown))}; it takes frame or angles_deg and spins, "
+            "full_scale and gains"
+        )
+    frame = table.get("frame")
+    if frame is not None:
+        if frame not in FRAMES:
+            raise DataError(
+                f"{path}: [rotors] frame {frame!r} is not one of {', '.join(FRAMES)} (or give angles_deg and spins)"
+            )
+        angles, spins = FRAMES[frame]
+    else:
+        angles, spins = table.get("angles_deg", ()), table.get("spins", ())
+    full_scale, gains = table.get("full_scale"), table.get("gains", (1.0, 1.0, 1.0))
+    try:
+        roll, pitch, yaw = (float(g) for g in gains)
+        return RotorLayout(
+            tuple(float(a) for a in angles),
+            tuple(int(s) for s in spins),
+            None if full_scale is None else float(full_scale),
+            (roll, pitch, yaw),
+        )
+    except (TypeError, ValueError) as err:
+        raise DataError(
+            f"{path}: [rotors] angles_deg, spins, full_scale and gains (3) must be numbers ({err})"
+        ) from err
 
 
 def _column(name: str, spec: str) -> TableColumn:
@@ -251,6 +296,7 @@ def read_table(
             unit=unit,
             source=f"{path.name} {shown}",
         )
+    signals.update(derived_signals(signals, table_map.rotors))
     if note:
         warnings.warn(DataQualityWarning(note), stacklevel=2)
     if progress is not None:

@@ -15,7 +15,8 @@ Layout (schema version 2; version 1 held variable-length strings, still read)::
     /wind/<key>/                    attrs: path, sha256, and the measurement's scalar
                                            fields; JSON for mappings and tuples
     /wind/<key>/<array field>       float64 (n_samples,) (``utc_s`` in UNIX s, winds m/s)
-    /conditioned/<key>/             attrs: source, rate_hz, warnings (JSON), wind_alignment (JSON or "null")
+    /conditioned/<key>/             attrs: source, rate_hz, warnings (JSON), derived (JSON: the signals
+                                           computed, not measured), wind_alignment (JSON or "null")
     /conditioned/<key>/segments     compound (axis, kind, start_s, end_s, source, f_min_hz, f_max_hz, detail)
     /conditioned/<key>/records/<i>/ attrs: label, units (JSON), trim (JSON)
     /conditioned/<key>/records/<i>/time_s, /<signal>   float64 (n_samples,), trim removed
@@ -215,6 +216,8 @@ def _write_log(group: h5py.Group, log: FlightLog) -> None:
         sub = signals.create_group(name)
         put_text(sub.attrs, "unit", signal.unit)
         put_text(sub.attrs, "source", signal.source)
+        if signal.derived:
+            sub.attrs["derived"] = True
         sub["time_s"] = times.dataset(signal.time_s)
         sub.create_dataset("values", data=_narrowed(signal.stored_values))
 
@@ -248,6 +251,7 @@ def _read_log(group: h5py.Group) -> FlightLog:
             values=sub["values"][()],  # float32 where the log logged float32: held so (Signal)
             unit=text(sub.attrs["unit"]),
             source=text(sub.attrs["source"]),
+            derived=bool(sub.attrs.get("derived", False)),
         )
         for name, sub in group["signals"].items()
     }
@@ -345,6 +349,7 @@ def _write_conditioned(group: h5py.Group, flight: Any) -> None:
     put_text(group.attrs, "source", str(flight.source))
     group.attrs["rate_hz"] = flight.rate_hz
     put_text(group.attrs, "warnings", json.dumps(list(flight.warnings)))
+    put_text(group.attrs, "derived", json.dumps(list(flight.derived)))
     put_text(group.attrs, "wind_alignment", json.dumps(jsonable(flight.wind, nonfinite="keep")))
     rows = [
         (
@@ -420,4 +425,5 @@ def _read_conditioned(group: h5py.Group) -> Any:
         rate_hz=float(group.attrs["rate_hz"]),
         wind=wind,
         warnings=tuple(json.loads(group.attrs["warnings"])),
+        derived=tuple(json.loads(group.attrs.get("derived", "[]"))),
     )

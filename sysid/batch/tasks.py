@@ -235,18 +235,19 @@ def compare_log(reference: str, log: LogSurvey) -> LogComparison:
     LogComparison
     """
     from flightlogs.store.campaign import ingest_campaign
-    from sysid.discrepancy import DiscrepancyOptions, discover, flight_series, model_flight
+    from sysid.discrepancy import DiscrepancyOptions, discover, flights_series, model_flight
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SysidWarning)
             real = ingest_campaign([Path(log.path)], options=_NO_MANEUVERS).require_flights()
-            real_series = [flight_series(f.source.name, f.records) for f in real]
             kind, simulation = _reference(reference, Path(reference).stat().st_mtime_ns)
             if kind == "model":
+                real_series = flights_series(real)
                 sim_series = [model_flight(simulation, s, source=Path(reference).name) for s in real_series]
-            else:
-                sim_series = list(simulation)
+            else:  # like with like (rates, derived specific forces)
+                real_series = flights_series(real, like=simulation)
+                sim_series = flights_series(simulation, like=real)
             result = discover(sim_series, real_series, DiscrepancyOptions())
     except SysidError as err:
         return LogComparison(path=log.path, error=str(err))
@@ -260,15 +261,13 @@ _NO_MANEUVERS = ConditioningOptions(segments=())
 
 @lru_cache(maxsize=2)
 def _reference(reference: str, _mtime_ns: int) -> tuple[str, Any]:
-    """The reference read once per worker (keyed by its modification time too): a model, or the simulated flights' series."""
+    """The reference read once per worker (keyed by its modification time too): a model, or the simulated flights."""
     from flightlogs.store.campaign import ingest_campaign
-    from sysid.discrepancy import flight_series
     from sysid.fit.model_file import read_model
 
     if reference.lower().endswith(".json"):
         return "model", read_model(reference).linear_model(include_wind=False)
-    sim = ingest_campaign([Path(reference)], options=_NO_MANEUVERS).require_flights()
-    return "flights", tuple(flight_series(f.source.name, f.records) for f in sim)
+    return "flights", tuple(ingest_campaign([Path(reference)], options=_NO_MANEUVERS).require_flights())
 
 
 def _folder_name(key: str) -> str:

@@ -1,7 +1,7 @@
 """Discrepancy discovery: where a real flight departs from its simulation, the physics left out, and the proof.
 
-:func:`discover` compares flights as :class:`FlightSeries` (:func:`flight_series`
-from a conditioned flight's records) and returns a :class:`DiscrepancyResult`. A fitted model
+:func:`discover` compares flights as :class:`FlightSeries` (:func:`flights_series`
+from conditioned flights, :func:`flight_series` from one flight's records) and returns a :class:`DiscrepancyResult`. A fitted model
 takes the simulation's place through :func:`model_flight`; the search's corrected simulation
 (``result.corrected``, :func:`write_corrected_model`) through :func:`simulated_flight`.
 """
@@ -19,7 +19,7 @@ from sysid.discrepancy.model_files import (
 from sysid.discrepancy.responses import RATE_PAIRS, ResponseComparison, compare_model_responses, compare_responses
 from sysid.discrepancy.result import Alternative, DiscrepancyResult, Finding, FittedParameter, Regime, Screening
 from sysid.discrepancy.search import DiscrepancyOptions, discover
-from sysid.discrepancy.series import FlightSeries, flight_series
+from sysid.discrepancy.series import FlightSeries, flight_series, flights_series
 
 __all__ = [
     "Alternative",
@@ -46,6 +46,7 @@ __all__ = [
     "compare_responses",
     "discover",
     "flight_series",
+    "flights_series",
     "model_flight",
     "model_outputs",
 ]

@@ -26,6 +26,7 @@ adds REAL's noise, and :func:`simulated_flight` flies whichever a model file hel
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 
 import numpy as np
 
@@ -34,7 +35,7 @@ from sysid.discrepancy.baseline import fit_baseline
 from sysid.discrepancy.catalogue import FlightContext, term_of
 from sysid.discrepancy.corrected import UNEXPLAINED, CorrectedModel, ModelTerm
 from sysid.discrepancy.generic import generic_library
-from sysid.discrepancy.series import OUTPUTS, FlightSeries, smoothed_as_derivative
+from sysid.discrepancy.series import OUTPUTS, FlightSeries, smoothed_as_derivative, smoothed_specific_forces
 from sysid.model.discrete import discretize, predict_one_step
 from sysid.model.statespace import DelayedStateSpace
 
@@ -167,13 +168,14 @@ def with_real_noise(flight: FlightSeries, outputs: Mapping[str, np.ndarray], *, 
         The same samples and signals; the six outputs replaced.
     """
     own = fit_baseline(flight).predict(flight)  # the best linear model of REAL: its residual is REAL's noise
+    outputs = smoothed_specific_forces(flight, outputs)  # as REAL's own derivative smooths them, if it does
     signals = dict(flight.signals)
     for o in OUTPUTS:
         noise = flight[o] - own[o]
         for piece in flight.pieces():
             noise[piece] = np.roll(noise[piece], piece.size // 2)
         signals[o] = np.asarray(outputs[o]) + noise
-    return FlightSeries(name=name, time_s=flight.time_s, piece=flight.piece, signals=signals, rate_hz=flight.rate_hz)
+    return replace(flight, name=name, signals=signals)
 
 
 def corrected_outputs(model: CorrectedModel, flight: FlightSeries) -> dict[str, np.ndarray]:

@@ -591,8 +591,8 @@ def _unexplained(
     residual located, not modelled).
     """
     candidate = generic.candidate(outputs)
-    if generic.chosen:
-        fit = fit_term(candidate, search.y, base, additions, search.scale)
+    if generic.chosen:  # fitted where it keeps regressors; located besides on `outputs`
+        fit = replace(fit_term(generic.candidate(), search.y, base, additions, search.scale), candidate=candidate)
     else:
         fit = TermFit(
             candidate=candidate, value=float("nan"), coefficients={}, covariance={}, value_uncertainty=float("nan")
@@ -777,6 +777,7 @@ def _joined(flights: Sequence[FlightSeries]) -> FlightSeries:
         piece=np.concatenate(pieces),
         signals={s: np.concatenate([f[s] for f in flights]) for s in sorted(common)},
         rate_hz=flights[0].rate_hz,
+        specific_force_derived=flights[0].specific_force_derived,
     )
 
 

@@ -8,6 +8,12 @@ apart (lags never reach across a gap); only the samples where the vehicle
 flies (thrust above a third of its 95th percentile and above 85 % of the
 hover's, and off the ground where a height is logged) are used.
 
+A flight whose specific forces were derived from its velocities (a
+motion-capture table, :attr:`flightlogs.flightlog.Signal.derived`) is
+compared like with like: the flights it is compared with have theirs derived
+the same way (:func:`flightlogs.kinematics.specific_force`), and a model's
+are smoothed as that derivative smooths (:func:`smoothed_as_derivative`).
+
 The body velocities ``u v w`` are ground-relative here, whatever the
 conditioning made of them: a simulation flown in a calm and a model of it
 know nothing of the air, so drag on the wind is a discrepancy to find, not
@@ -19,16 +25,26 @@ was given, else the autopilot's own estimate.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import DataError
 from flightlogs.frames import earth_to_body, wind_to_body_axes
+from flightlogs.kinematics import SPECIFIC_FORCE_WINDOW_S, specific_force
 from flightlogs.record import Record
 from sysid.discrepancy._filters import butterworth_zero_phase, savgol_slope
 
-__all__ = ["OUTPUTS", "COMMANDS", "FlightSeries", "flight_series", "smoothed_as_derivative"]
+__all__ = [
+    "OUTPUTS",
+    "COMMANDS",
+    "FlightSeries",
+    "flight_series",
+    "flights_series",
+    "smoothed_as_derivative",
+    "smoothed_specific_forces",
+]
 
 #: Outputs the terms act on: specific forces (m/s²) and angular accelerations (rad/s²).
 OUTPUTS: tuple[str, ...] = ("ax", "ay", "az", "p_dot", "q_dot", "r_dot")
@@ -37,12 +53,16 @@ COMMANDS: tuple[str, ...] = ("delta_lat", "delta_lon", "delta_yaw", "delta_thr")
 _NEEDED = ("p", "q", "r", "ax", "ay", "az", *COMMANDS)
 _RATE_HZ = 50.0  # the search's sample rate
 _SMOOTH_S = 0.1  # Savitzky-Golay window of the rate derivatives
+_SLOWER = 1.2  # a record logged this many times faster than the flights it is compared with is sampled at their rate
+_FINE_HZ = 100.0  # a record slower than this has its rates interpolated finer before they are differentiated
 _THRUST_ON = 1.0 / 3.0  # flying: thrust above this fraction of its 95th percentile
 _LIFT_OFF = 0.85  # and above this fraction of its median there (a take-off ramp on the ground is not flight)
 _ON_GROUND_M = 0.05  # and, where a height is logged, above this
 _WIND = ("wind_lon", "wind_lat")
 _CALM_M_S = 0.5  # RMS wind below which a flight flew in a calm: its drag is below anything the search tells from noise
-_VIBRATING = ("ax", "ay", "az")  # signals low-passed before they are sampled at the search's rate
+_FORCES = ("ax", "ay", "az")
+_VELOCITIES = ("vn", "ve", "vd", "phi", "theta", "psi")  # what derived specific forces are made of
+_VIBRATING = _FORCES  # signals low-passed before they are sampled at the search's rate
 _FILTER_PAD = 60  # samples the anti-alias filter pads each record's ends with
 
 
@@ -63,6 +83,9 @@ class FlightSeries:
         (s since the first flown sample).
     rate_hz : float
         Sample rate, Hz.
+    specific_force_derived : bool, optional
+        Whether ``ax ay az`` are derived from the velocities, not measured
+        (:func:`flightlogs.kinematics.specific_force`).
     """
 
     name: str
@@ -70,6 +93,7 @@ class FlightSeries:
     piece: np.ndarray
     signals: Mapping[str, np.ndarray]
     rate_hz: float
+    specific_force_derived: bool = False
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.signals[name]
@@ -102,22 +126,60 @@ class FlightSeries:
     def without(self, names: Sequence[str]) -> FlightSeries:
         """The same samples without the signals `names`."""
         kept = {k: v for k, v in self.signals.items() if k not in names}
-        return FlightSeries(name=self.name, time_s=self.time_s, piece=self.piece, signals=kept, rate_hz=self.rate_hz)
+        return replace(self, signals=kept)
 
     def subset(self, rows: np.ndarray) -> FlightSeries:
         """The samples `rows` (sorted indices), pieces split where rows skip samples."""
         rows = np.asarray(rows)
         breaks = np.concatenate([[0], np.cumsum((np.diff(rows) != 1) | (np.diff(self.piece[rows]) != 0))])
-        return FlightSeries(
-            name=self.name,
-            time_s=self.time_s[rows],
-            piece=breaks,
-            signals={k: v[rows] for k, v in self.signals.items()},
-            rate_hz=self.rate_hz,
+        return replace(
+            self, time_s=self.time_s[rows], piece=breaks, signals={k: v[rows] for k, v in self.signals.items()}
         )
 
 
-def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_HZ) -> FlightSeries:
+def flights_series(
+    flights: Sequence[ConditionedFlight], *, like: Sequence[ConditionedFlight] = ()
+) -> list[FlightSeries]:
+    """Each conditioned flight as the search sees it, sampled as the flights it is compared with are.
+
+    Like is compared with like: when any flight of `flights` or `like` has specific forces derived from
+    its velocities (:attr:`ConditionedFlight.derived`, a motion-capture table), every flight's are derived
+    so; and every flight is first sampled at the slowest rate any of them was logged at (a 250 Hz log
+    compared with a 50 Hz table is sampled at 50 Hz, as the table's logger sampled its flight).
+
+    Parameters
+    ----------
+    flights : sequence of ConditionedFlight
+        The flights.
+    like : sequence of ConditionedFlight, optional
+        The flights they are compared with (the simulation's for the real ones, and the other way round).
+
+    Returns
+    -------
+    list of FlightSeries
+        One per flight, in order.
+
+    Raises
+    ------
+    DataError
+        As :func:`flight_series`.
+    """
+    every = [*flights, *like]
+    derived = any(set(_FORCES) & set(f.derived) for f in every)
+    slowest = min((f.rate_hz for f in every), default=None)
+    return [
+        flight_series(f.source.name, f.records, specific_force_derived=derived, logged_rate_hz=slowest) for f in flights
+    ]
+
+
+def flight_series(
+    name: str,
+    records: Sequence[Record],
+    rate_hz: float = _RATE_HZ,
+    *,
+    specific_force_derived: bool = False,
+    logged_rate_hz: float | None = None,
+) -> FlightSeries:
     """The flown samples of a flight's records, at `rate_hz`, with the angular accelerations.
 
     Parameters
@@ -128,6 +190,12 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
         A conditioned flight's records (trim is added back).
     rate_hz : float, optional
         Sample rate of the search, Hz.
+    specific_force_derived : bool, optional
+        Derive ``ax ay az`` from the velocities and the attitude
+        (:func:`flightlogs.kinematics.specific_force`), whatever the records hold.
+    logged_rate_hz : float, optional
+        Sample a record logged faster than this at this rate first, as a slower logger would have
+        (no filter: a logger samples); by default each record as it is.
 
     Returns
     -------
@@ -141,22 +209,34 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
     times: list[np.ndarray] = []
     pieces: list[np.ndarray] = []
     columns: dict[str, list[np.ndarray]] = {}
+    needed = _NEEDED if not specific_force_derived else (*_VELOCITIES, *(s for s in _NEEDED if s not in _FORCES))
     for k, record in enumerate(records):
-        missing = [s for s in _NEEDED if s not in record.signals]
+        missing = [s for s in needed if s not in record.signals]
         if missing:
-            raise DataError(f"{name}: {', '.join(missing)} not logged; the discrepancy search needs them")
+            hint = ""
+            if set(missing) & set(COMMANDS) and any(s.startswith("motor_") for s in record.signals):
+                hint = " (a table derives the mixer inputs from its motors given a [rotors] layout in its map)"
+            raise DataError(f"{name}: {', '.join(missing)} not logged; the discrepancy search needs them{hint}")
         t = record.time_s
         if t[-1] - t[0] < 2.0:
             continue
         grid = np.arange(t[0], t[-1], 1.0 / rate_hz)
-        window = max(5, int(round(_SMOOTH_S * record.rate_hz)) | 1)
         absolute = {s: record.absolute(s) for s in record.signals}
-        for s in _VIBRATING:  # the accelerometer: where the rotors' vibration lives (the rates are smoothed below)
-            absolute[s] = _anti_aliased(absolute[s], record.rate_hz, rate_hz)
+        logged_hz = record.rate_hz
+        if logged_rate_hz is not None and logged_hz > _SLOWER * logged_rate_hz:
+            slow = np.arange(t[0], t[-1], 1.0 / logged_rate_hz)
+            absolute = {s: np.interp(slow, t, x) for s, x in absolute.items()}
+            t, logged_hz = slow, logged_rate_hz
+        if specific_force_derived:
+            velocity = np.column_stack([absolute[v] for v in ("vn", "ve", "vd")])
+            force = specific_force(t, velocity, absolute["phi"], absolute["theta"], absolute["psi"])
+            absolute.update({s: force[:, j] for j, s in enumerate(_FORCES)})
+        else:
+            for s in _VIBRATING:  # the accelerometer: where the rotors' vibration lives (the rates are smoothed below)
+                absolute[s] = _anti_aliased(absolute[s], logged_hz, rate_hz)
         values = {s: np.interp(grid, t, x) for s, x in absolute.items()}
         for rate in ("p", "q", "r"):
-            derivative = savgol_slope(absolute[rate], window, 2, 1.0 / record.rate_hz)
-            values[f"{rate}_dot"] = np.interp(grid, t, derivative)
+            values[f"{rate}_dot"] = np.interp(grid, t, _angular_acceleration(t, absolute[rate], logged_hz))
         times.append(grid)
         pieces.append(np.full(grid.size, k))
         for s, v in values.items():
@@ -171,11 +251,34 @@ def flight_series(name: str, records: Sequence[Record], rate_hz: float = _RATE_H
         raise DataError(f"{name}: less than 10 s of flight (thrust on, off the ground)")
     signals["t_flight"] = time_s - time_s[flown][0]
     _ground_relative(signals)
-    whole = FlightSeries(name=name, time_s=time_s, piece=piece, signals=signals, rate_hz=rate_hz)
+    whole = FlightSeries(
+        name=name,
+        time_s=time_s,
+        piece=piece,
+        signals=signals,
+        rate_hz=rate_hz,
+        specific_force_derived=specific_force_derived,
+    )
     series = whole.subset(np.flatnonzero(flown))
     if not all(np.all(np.isfinite(series[w])) for w in _WIND if w in series):
         return series.without(_WIND)  # a wind with holes is no regressor
     return series
+
+
+def _angular_acceleration(t: np.ndarray, rate: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The slope of a quadratic over 0.1 s of a uniform record's rate, rad/s², shape (n,).
+
+    A centred window holds an odd number of samples: at 100 Hz 11 span 0.1 s, at 50 Hz 5 span 0.08 s and
+    7 span 0.12 s. A record slower than 100 Hz is interpolated onto a grid an integer times finer (at
+    least 100 Hz) first, so that its window spans 0.1 s as a faster log's does; a 50 Hz table and a
+    100 Hz log of one flight then differ by no smoothing of their own.
+    """
+    finer = max(1, int(np.ceil(_FINE_HZ / rate_hz - 1e-9)))
+    fine_hz = rate_hz * finer
+    fine_t = t[0] + np.arange((t.size - 1) * finer + 1) / fine_hz if finer > 1 else t
+    fine = np.interp(fine_t, t, rate) if finer > 1 else rate
+    slope = savgol_slope(fine, max(5, int(round(_SMOOTH_S * fine_hz)) | 1), 2, 1.0 / fine_hz)
+    return np.interp(t, fine_t, slope) if finer > 1 else slope
 
 
 def _anti_aliased(x: np.ndarray, from_hz: float, to_hz: float) -> np.ndarray:
@@ -192,7 +295,7 @@ def _anti_aliased(x: np.ndarray, from_hz: float, to_hz: float) -> np.ndarray:
     return butterworth_zero_phase(x, 0.4 * to_hz, from_hz, order=4, pad=min(_FILTER_PAD, x.size - 1))
 
 
-def smoothed_as_derivative(series: FlightSeries, x: np.ndarray) -> np.ndarray:
+def smoothed_as_derivative(series: FlightSeries, x: np.ndarray, window_s: float = _SMOOTH_S) -> np.ndarray:
     """An angular acceleration smoothed as :func:`flight_series` smooths the logged ones, shape (n,).
 
     The slope of a quadratic fitted over a window is the rate's change across it weighted by a
@@ -204,9 +307,12 @@ def smoothed_as_derivative(series: FlightSeries, x: np.ndarray) -> np.ndarray:
     series : FlightSeries
         Its sample rate and pieces (no kernel reaches across a gap).
     x : ndarray, shape (n,)
-        Angular acceleration at the series' samples, rad/s².
+        Angular acceleration at the series' samples, rad/s² (or a specific force, m/s²).
+    window_s : float, optional
+        The derivative's window, s: 0.1 s for the rates, :data:`~flightlogs.kinematics.SPECIFIC_FORCE_WINDOW_S`
+        for a velocity.
     """
-    half = _SMOOTH_S / 2.0
+    half = window_s / 2.0
     reach = int(half * series.rate_hz)
     offsets = np.arange(-reach, reach + 1) / series.rate_hz
     kernel = half**2 - offsets**2
@@ -214,6 +320,30 @@ def smoothed_as_derivative(series: FlightSeries, x: np.ndarray) -> np.ndarray:
     out = np.empty_like(x, dtype=float)
     for rows in series.pieces():
         out[rows] = np.convolve(np.pad(x[rows], reach, mode="edge"), kernel, mode="valid")
+    return out
+
+
+def smoothed_specific_forces(series: FlightSeries, outputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """`outputs` with ``ax ay az`` smoothed as the series' own are when it derives them from its velocities.
+
+    Parameters
+    ----------
+    series : FlightSeries
+        The flight a model's outputs are compared with.
+    outputs : Mapping[str, ndarray]
+        A model's outputs along `series`, shape (n,) each.
+
+    Returns
+    -------
+    dict of str to ndarray
+        The same outputs; the specific forces smoothed over
+        :data:`~flightlogs.kinematics.SPECIFIC_FORCE_WINDOW_S` if ``series.specific_force_derived``.
+    """
+    out = dict(outputs)
+    if series.specific_force_derived:
+        for name in _FORCES:
+            if name in out:
+                out[name] = smoothed_as_derivative(series, np.asarray(out[name]), SPECIFIC_FORCE_WINDOW_S)
     return out
 
 

@@ -157,12 +157,13 @@ def test_ground_effect_fit_reads_a_motion_capture_table(chapter2: tuple[Path, Pa
 
 @pytest.mark.slow
 def test_discrepancy_reads_the_table_and_says_what_a_motion_capture_lacks(chapter2: tuple[Path, Path, Path]) -> None:
-    """The table is read through the map; the search needs the mixer inputs and accelerations, which a
-    motion-capture rig does not record: one sentence naming them, exit 1 (issue 32 keeps deriving them open)."""
+    """The table is read through the map and its specific forces derived from its velocities; the mixer inputs
+    need the rotor layout (``[rotors]``), which this map does not give: one sentence naming them and the way,
+    exit 1. (With a layout, tests/cli/test_mocap_discrepancy.py.)"""
     log_path, csv, mapping = chapter2
     result = CliRunner().invoke(cli, ["discrepancy", str(log_path), str(csv), "--map", str(mapping), "-q"])
     assert result.exit_code == 1, result.output
     assert result.stderr.strip().splitlines()[-1] == (
-        "error: mocap.csv: ax, ay, az, delta_lat, delta_lon, delta_yaw, delta_thr not logged; "
-        "the discrepancy search needs them"
+        "error: mocap.csv: delta_lat, delta_lon, delta_yaw, delta_thr not logged; the discrepancy search needs them "
+        "(a table derives the mixer inputs from its motors given a [rotors] layout in its map)"
     )
