@@ -92,7 +92,10 @@ class IdentifyOptions:
         its periods (Tischler's guideline, 4-5), so ``omega_min`` is raised
         to ``2 pi min_record_periods / T_record`` (0.87 rad/s for the
         dissertation's 36 s sweep records); below it, closed-loop responses
-        of short records are biased by leakage.
+        of short records are biased by leakage. Where a sweep's band (its
+        segment's ``f_min_hz``) starts below ``responses.omega_min``, the grid
+        starts there instead, as far as this allows: a 240 s sweep from
+        0.15 rad/s is fitted from 0.15 rad/s.
     pairs : tuple of (str, str) or None
         ``(output, input)`` pairs to fit; None for :data:`FIT_PAIRS` of every
         axis flown (outputs the records or the structure lack are left out).
@@ -174,7 +177,10 @@ def _axis_responses(
     winds = [s for s in dict.fromkeys(c.signal for c in structure.wind_inputs) if s in logged]
     inputs = [control] + (winds if options.condition_on_wind else [])
     longest = max(r.end_s - r.start_s for r in records)
-    lowest = max(options.responses.omega_min, 2.0 * np.pi * options.min_record_periods / longest)
+    low = options.responses.omega_min
+    if band is not None and band[0] < low:  # a sweep flown below the grid: fitted down to where it starts
+        low = band[0]
+    lowest = max(low, 2.0 * np.pi * options.min_record_periods / longest)
     grid = dataclasses.replace(options.responses, omega_min=min(lowest, options.responses.omega_max / 2.0))
     grid, note = reference_options(records, axis, inputs, options.kind, grid, options.use_excitation)
     grid = within_band(grid, band)

@@ -12,10 +12,15 @@ find) and a log that carries the autopilot's own wind estimate, lagging the
 air by a first-order time constant (``WindModel.estimate_time_constant_s``);
 ``heldout-wind-calm`` is the calm airframe in a breath of wind (0.8 m/s,
 turbulence 0.05 m/s): no G_w to find.
+
+The ``*-long-low`` cases fly without position hold (attitude hold only) a long,
+low pitch and roll attitude sweep each, from 0.15 rad/s with two periods
+there first (issue 32): the speed derivatives' own band.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Literal
 
@@ -92,6 +97,22 @@ def _doublets(axes: Sequence[Axis], amplitude: float = 0.06, width_s: float = 1.
 
 _LOG = Chirp()  # 0.1-10 Hz, 34 s, fade-in 3 s: the dissertation's sweep
 _STRONG = WindModel(mean_speed_m_s=5.4, from_deg=250.0)
+
+
+def _long_low_steps() -> list[_Step]:
+    """Pitch and roll attitude sweeps of 240 s from 0.15 rad/s (two periods there first) to 2 Hz, then yaw and thr."""
+    low = Chirp(
+        duration_s=240.0, f_min_hz=0.15 / (2 * math.pi), f_max_hz=2.0, fade_in_s=5.0, fade_out_s=2.0, dwell_periods=2.0
+    )
+    return [
+        ("lon", low, 0.08, "attitude"),
+        8.0,
+        ("lat", low, 0.08, "attitude"),
+        6.0,
+        ("yaw", Chirp(duration_s=36.0, f_max_hz=5.0), 0.08, "mixer"),
+        6.0,
+        ("thr", Chirp(duration_s=30.0, f_max_hz=8.0), 0.05, "mixer"),
+    ]
 
 
 def _clock_steps(second_lon: Design, thrust: Design) -> list[_Step]:
@@ -230,6 +251,15 @@ TUNING_CASES: tuple[Case, ...] = (
         condition="calm",
         description="ArduPilot, the calm airframe in 1 m/s of wind (turbulence 0.08 m/s; no G_w), anemometer clock "
         "0.7 s behind, wind estimate lagging 2.5 s: two lon sweeps, a thr sweep, doublets",
+    ),
+    _flight(
+        "tune-px4-long-low",
+        "ulog",
+        _long_low_steps(),
+        seed=131,
+        heading_deg=40.0,
+        position_hold=False,
+        description="PX4 in attitude hold (no position hold): long, low pitch and roll attitude sweeps, yaw, thr",
     ),
 )
 
@@ -446,6 +476,15 @@ HELDOUT_CASES: tuple[Case, ...] = (
         condition="calm",
         description="PX4, the calm airframe in a breath of wind (0.8 m/s, turbulence 0.05 m/s; no G_w), anemometer "
         "clock 1.2 s ahead, wind estimate lagging 3 s: two lon sweeps, a thr sweep, doublets",
+    ),
+    _flight(
+        "heldout-px4-long-low",
+        "ulog",
+        _long_low_steps(),
+        seed=210,
+        heading_deg=-65.0,
+        position_hold=False,
+        description="PX4 in attitude hold (no position hold): long, low pitch and roll attitude sweeps, yaw, thr",
     ),
 )
 

@@ -71,6 +71,7 @@ def chirp(
     direction: Literal["up", "down"] = "up",
     fade_in_s: float = 3.0,
     fade_out_s: float = 1.0,
+    dwell_s: float = 0.0,
 ) -> Excitation:
     """A frequency sweep with a raised-cosine fade-in and fade-out.
 
@@ -92,6 +93,8 @@ def chirp(
         Rising or falling frequency.
     fade_in_s, fade_out_s : float
         Fade lengths, s.
+    dwell_s : float, optional
+        Time spent at `f_min_hz` before the sweep (a rising one only), s; part of `duration_s`.
 
     Returns
     -------
@@ -108,14 +111,18 @@ def chirp(
         raise ValueError(f"need 0 < {f_min_hz=} < {f_max_hz=}")
     if fade_in_s + fade_out_s > duration_s:
         raise ValueError(f"fades {fade_in_s} + {fade_out_s} s are longer than {duration_s=} s")
+    if dwell_s and (direction != "up" or not 0.0 < dwell_s < duration_s):
+        raise ValueError(f"a dwell of {dwell_s} s needs a rising sweep longer than it ({duration_s=} s)")
     mask, relative = _inside(time_s, start_s, duration_s)
     tau = relative[mask] if direction == "up" else duration_s - relative[mask]
     f0, f1 = f_min_hz, f_max_hz
+    sweep_s, swept = duration_s - dwell_s, np.maximum(tau - dwell_s, 0.0)
     if law == "linear":
-        phase = 2 * np.pi * (f0 * tau + (f1 - f0) * tau**2 / (2 * duration_s))
+        phase = 2 * np.pi * (f0 * swept + (f1 - f0) * swept**2 / (2 * sweep_s))
     else:
         ratio = math.log(f1 / f0)
-        phase = 2 * np.pi * f0 * duration_s / ratio * (np.exp(ratio * tau / duration_s) - 1.0)
+        phase = 2 * np.pi * f0 * sweep_s / ratio * (np.exp(ratio * swept / sweep_s) - 1.0)
+    phase = phase + 2 * np.pi * f0 * np.minimum(tau, dwell_s)
     values = np.zeros(np.shape(time_s))
     values[mask] = amplitude * _fade(relative[mask], duration_s, fade_in_s, fade_out_s) * np.sin(phase)
     return Excitation(values, start_s, start_s + duration_s)

@@ -51,6 +51,7 @@ class Chirp:
     direction: Literal["up", "down"] = "up"
     fade_in_s: float = 3.0
     fade_out_s: float = 1.0
+    dwell_periods: float = 0.0  # periods of f_min_hz flown before the sweep rises
     kind = "sweep"
 
     def render(self, time_s: np.ndarray, start_s: float, amplitude: float, rng: np.random.Generator) -> Excitation:
@@ -66,6 +67,7 @@ class Chirp:
             direction=self.direction,
             fade_in_s=self.fade_in_s,
             fade_out_s=self.fade_out_s,
+            dwell_s=self.dwell_periods / self.f_min_hz,
         )
 
     @property

@@ -197,6 +197,9 @@ class Case:
         included.
     nuisances : Nuisances or None
         Rotor vibration, gyro bias drift and logging dropouts (:mod:`independent_sim.nuisances`); None: none.
+    position_hold : bool
+        Whether the autopilot holds the horizontal position and velocity (False: attitude hold only, the
+        vehicle drifts with what moves it).
     """
 
     name: str
@@ -213,6 +216,7 @@ class Case:
     plant_changes: tuple[tuple[str, float], ...] = ()
     effects: tuple[AnyEffect, ...] = ()
     nuisances: Nuisances | None = None
+    position_hold: bool = True
 
     def __post_init__(self) -> None:
         if self.fmt not in ("ulog", "dataflash"):

@@ -71,6 +71,8 @@ def simulate(case: Case, fmt: LogFormat | None = None) -> Flight:
     if case.wind is not None and not plant.has_wind_terms:  # the calm airframe flown in wind
         plant = in_wind(plant, case.wind.mean_speed_m_s, psi0)
     gains = px4_gains(plant) if fmt == "ulog" else ardupilot_gains(plant)
+    if not case.position_hold:  # attitude hold only: no horizontal position or velocity loop
+        gains = replace(gains, pos_xy_p=0.0, vel_xy_p=0.0, vel_xy_i=0.0)
     loop = closed_loop(plant, gains, n_sub=_SUB_STEPS[fmt])
     grid = _Grid.of(case, gains.rate_hz, loop.n_sub)
     field_ = None
