@@ -132,6 +132,7 @@ def main() -> None:
 def _campaign(folder: Path, repeat: int) -> None:
     """Time ``sysid fit`` of the chapter 3 campaign's 60 sweeps, whole process, best of `repeat`."""
     logs_dir = folder / "chapter3-campaign"
+    folder.mkdir(parents=True, exist_ok=True)  # a --folder given need not exist yet
     if not any(logs_dir.glob("*-sweep-*.bin")):
         start = time.perf_counter()
         subprocess.run(["sysid", "simulate", "chapter3-campaign", "-o", str(logs_dir), "-q"], check=True)

@@ -20,6 +20,7 @@ __all__ = [
     "OutputPath",
     "SysidCommand",
     "json_option",
+    "JSON_ON_STDOUT",
     "json_owns_stdout",
     "emit_json",
     "progress_bar",
@@ -43,6 +44,9 @@ class OutputPath(click.Path):
         Accept ``-`` (standard output) as it is.
     path_type : type
         What the value converts to: `Path` or `str`.
+    within : str or None
+        The parameter name of a folder output of the same command: a path inside that folder (which the
+        command creates) may have a folder that does not exist yet (checked by :class:`SysidCommand`).
 
     Examples
     --------
@@ -56,9 +60,12 @@ class OutputPath(click.Path):
     nodir/x.json: folder nodir does not exist
     """
 
-    def __init__(self, *, folder: bool = False, allow_dash: bool = False, path_type: type = Path) -> None:
+    def __init__(
+        self, *, folder: bool = False, allow_dash: bool = False, path_type: type = Path, within: str | None = None
+    ) -> None:
         super().__init__(file_okay=not folder, dir_okay=folder, allow_dash=allow_dash, path_type=path_type)
         self.folder = folder
+        self.within = within
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         """The path, once its folder is known to exist (click.BadParameter otherwise)."""
@@ -67,8 +74,10 @@ class OutputPath(click.Path):
             return converted
         path = Path(os.fsdecode(converted))
         parent = path.parent
-        if not parent.exists():
+        if not parent.exists() and self.within is None:
             self.fail(f"{path}: folder {parent} does not exist", param, ctx)
+        if not parent.exists():
+            return converted  # inside the folder output `within`, or not: SysidCommand.invoke tells
         if not parent.is_dir():
             self.fail(f"{path}: {parent} is a file, not a folder", param, ctx)
         if not os.access(parent, os.W_OK | os.X_OK):
@@ -115,6 +124,8 @@ class SysidCommand(click.Command):
         no_clobber = bool(ctx.params.get("no_clobber", False))
         inputs = [Path(os.fsdecode(v)) for p in self.params if _is_input(p) for v in _values(ctx.params.get(p.name))]
         for param in self.params:
+            if isinstance(param.type, OutputPath) and param.type.within is not None:
+                _inside_folder_output(ctx, param, param.type.within)
             if not isinstance(param.type, OutputPath) or param.type.folder:
                 continue
             for value in _values(ctx.params.get(param.name)):
@@ -130,8 +141,26 @@ class SysidCommand(click.Command):
                     raise DataError(
                         f"{out}: exists, and --no-clobber leaves it as it is; give another {param.opts[-1]}"
                     )
+        if ctx.params.get("json_path") == "-":
+            ctx.meta[JSON_ON_STDOUT] = True  # a failure then prints {"error": ...} there (sysid_cli.main)
         with json_owns_stdout(ctx.params.get("json_path")):
             return super().invoke(ctx)
+
+
+def _inside_folder_output(ctx: click.Context, param: click.Parameter, within: str) -> None:
+    """A path whose folder does not exist must lie inside the folder output `within` (exit 2 otherwise)."""
+    for value in _values(ctx.params.get(param.name)):
+        path = Path(os.fsdecode(value))
+        folder = ctx.params.get(within)
+        if path.parent.exists():
+            continue
+        if folder is None or Path(os.fsdecode(folder)).resolve() not in (
+            path.parent.resolve(),
+            *path.parent.resolve().parents,
+        ):
+            raise click.BadParameter(
+                f"{path}: folder {path.parent} does not exist (and is not inside the results folder)", ctx, param
+            )
 
 
 def _is_input(param: click.Parameter) -> bool:
@@ -152,6 +181,9 @@ json_option = click.option(
     help="Write a machine-readable summary to PATH ('-' for stdout).",
 )
 
+
+#: ``ctx.meta`` key set when the command's ``--json`` is ``-``: its stdout is JSON, even on failure.
+JSON_ON_STDOUT = "sysid.json_on_stdout"
 
 #: The real stdout while a command runs under :func:`json_owns_stdout` (``sys.stdout`` is then stderr).
 _JSON_STDOUT: ContextVar[TextIO | None] = ContextVar("sysid_json_stdout", default=None)

@@ -81,7 +81,9 @@ def expand_logs(paths: tuple[Path, ...], *, tables: bool = False) -> list[Path]:
 @click.option(
     "--workers", type=click.IntRange(min=1), help="Worker processes of the local cluster [default: one per core]."
 )
-@click.option("--report", type=OutputPath(), help="Write the fleet report (HTML).")
+@click.option(
+    "--report", type=OutputPath(within="out_dir"), help="Write the fleet report (HTML); it may lie inside -o."
+)
 @click.option("--no-group-reports", is_flag=True, help="Skip each group's HTML model report (faster).")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")
@@ -175,11 +177,19 @@ def batch(
         "model": model_name,
     }
     if report is not None:
+        report.parent.mkdir(parents=True, exist_ok=True)  # inside -o (checked before any work)
         write_fleet_report(report, result, run=run, drift=drift)
     summary = _summary(result, tables, report, seconds, n_workers)
     if not quiet:
         _print(summary)
     emit_json(summary, json_path)
+    if summary["groups"] and not summary["fitted"]:
+        click.secho(
+            f"error: none of the {summary['groups']} group(s) was fitted; why, log by log: {summary['failures_csv']}",
+            fg="red",
+            err=True,
+        )
+        click.get_current_context().exit(1)
 
 
 def _summary(
@@ -223,7 +233,7 @@ def _print(summary: dict[str, Any]) -> None:
     )
     for d in summary["drifts"]:
         say(f"  {'drift' if d['confirmed'] else 'watch'}: {d['vehicle']}: {d['text']}")
-    if not any(d["confirmed"] for d in summary["drifts"]):
+    if summary["fitted"] and not any(d["confirmed"] for d in summary["drifts"]):
         say("  drift: none flagged")
     for f in summary["failures"]:
         say(f"  failed ({f['stage']}): {f['reason']}")

@@ -26,7 +26,7 @@ _BEFORE_S, _AFTER_S = 0.5, 1.0
 
 def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
     """Verify the model (with and without G_w) on the dataset's doublets, save it, and say how it went."""
-    from flightlogs.store.dataset import read_dataset
+    from flightlogs.store.dataset import file_sha256, read_dataset
     from sysid.fit import read_model
     from sysid.verify import VerificationOptions, axis_outputs, doublet_records, verify
     from sysid.verify.io import write_verification
@@ -52,7 +52,14 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
         "judged": "on-axis outputs of each doublet's axis",
         "dataset": dataset.name,
     }
-    write_verification(out, verification, model=model_path.name, options=options, created_utc=created)
+    write_verification(
+        out,
+        verification,
+        model=model_path.name,
+        model_sha256=file_sha256(model_path),
+        options=options,
+        created_utc=created,
+    )
     worst = max(verification.summary, key=lambda s: s.tic)
     text = (
         f"  {len(verification.records)} doublets, each judged on its axis' outputs: overall TIC "

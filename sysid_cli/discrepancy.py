@@ -89,6 +89,7 @@ def discrepancy(
         flights_series,
         read_simulation_model,
         simulated_flight,
+        simulation_misfit,
         write_corrected_model,
     )
     from sysid.model.statespace import DelayedStateSpace
@@ -129,7 +130,9 @@ def discrepancy(
     else:
         sim_series = [simulated_flight(model, s, source=models[0].name) for s in real_series]
     with staged_progress("discrepancy", quiet=quiet) as progress:
-        result = discover(sim_series, real_series, DiscrepancyOptions(rotor_radius_m=rotor_radius), progress=progress)
+        misfit = simulation_misfit(models[0]) if models else None
+        options = DiscrepancyOptions(rotor_radius_m=rotor_radius, simulation_misfit=misfit)
+        result = discover(sim_series, real_series, options, progress=progress)
     summary = result.to_dict()
     if out is not None:
         write_json(out, summary)

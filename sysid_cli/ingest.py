@@ -221,6 +221,12 @@ def _print_summary(summary: dict[str, Any]) -> None:
             say(
                 f"  {segment['kind']:<8} {axis:<4} {segment['start_s']:8.2f}-{segment['end_s']:8.2f} s  ({segment['source']})"
             )
+        if "segments" in entry and all(s["kind"] == "hover" for s in entry["segments"]):
+            hovers = len(entry["segments"])
+            say(
+                "  no maneuver found (no sweep, doublet, 3-2-1-1, multisine or pilot's broadband input)"
+                + (f"; {hovers} hover stretch{'es' if hovers > 1 else ''}" if hovers else "")
+            )
         for warning in entry["warnings"]:
             say(f"  warning: {warning}")
         mark_reported(entry["warnings"])

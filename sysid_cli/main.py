@@ -7,6 +7,7 @@ import logging
 import signal
 import sys
 import types
+from typing import NoReturn
 
 import click
 
@@ -92,26 +93,31 @@ class _SysidGroup(click.Group):
         except SysidError as err:
             if ctx.meta.get("sysid.debug"):
                 raise
-            click.secho(f"error: {err}", fg="red", err=True)
-            ctx.exit(1)
+            _failed(ctx, str(err))
         except SysidWarning as err:  # -W error
             if ctx.meta.get("sysid.debug"):
                 raise
-            click.secho(f"error: {err} ({type(err).__name__}, an error under -W error)", fg="red", err=True)
-            ctx.exit(1)
+            _failed(ctx, f"{err} ({type(err).__name__}, an error under -W error)")
         except BrokenPipeError:
             raise
         except Exception as err:  # a bug or an unwrapped library failure
             if ctx.meta.get("sysid.debug"):
                 raise
-            click.secho(
-                f"error: unexpected {type(err).__name__}: {err} (run with --debug for the traceback)",
-                fg="red",
-                err=True,
-            )
-            ctx.exit(1)
+            _failed(ctx, f"unexpected {type(err).__name__}: {err} (run with --debug for the traceback)")
         finally:
             signal.signal(signal.SIGTERM, previous)
+
+
+def _failed(ctx: click.Context, message: str) -> NoReturn:
+    """End the command with `message` on stderr and exit 1; with ``--json -`` also ``{"error": message}`` on stdout."""
+    click.secho(f"error: {message}", fg="red", err=True)
+    from ._common import JSON_ON_STDOUT  # numpy and the writers: only once a command ran
+
+    if ctx.meta.get(JSON_ON_STDOUT):
+        from flightlogs.writers.jsonio import json_text
+
+        click.echo(json_text({"error": message, "exit_code": 1}, indent=2), nl=False)
+    ctx.exit(1)
 
 
 @click.group(cls=_SysidGroup, epilog=_EPILOG, context_settings={"help_option_names": ["-h", "--help"]})

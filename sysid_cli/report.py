@@ -115,10 +115,12 @@ def report(
     from reports.html import write_html
     from reports.model_report import model_report_html
     from sysid.fit import model_verdict, read_model
-    from sysid.verify.io import read_verification
+    from sysid.verify.io import read_verification, require_verified_model
 
     model = read_model(model_path)
     saved = read_verification(validation_path) if validation_path is not None else None
+    if saved is not None:
+        require_verified_model(saved, model_path, source=str(validation_path))
     card = ingest_card(_read_json(ingest_path), source=str(ingest_path)) if ingest_path is not None else None
     verification = saved.verification if saved is not None else None
     verdict = model_verdict(model, verification)  # by the guidelines the model was fitted with

@@ -96,6 +96,7 @@ def validate(
     import datetime as dt
 
     from flightlogs.conditioning.condition import ConditioningOptions
+    from flightlogs.store.dataset import file_sha256
     from reports.model_report import write_model_report
     from sysid.fit import read_model
     from sysid.verify.io import write_verification
@@ -144,7 +145,14 @@ def validate(
     }
     if out is not None:
         created = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
-        write_verification(out, verification, model=model_path.name, options=saved, created_utc=created)
+        write_verification(
+            out,
+            verification,
+            model=model_path.name,
+            model_sha256=file_sha256(model_path),
+            options=saved,
+            created_utc=created,
+        )
     if report is not None:
         write_model_report(report, identified, verification=verification, verification_options=saved)
     if measured is not None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 from sysid.fit.result import ParameterEstimate
 
@@ -199,7 +200,7 @@ class BatchResult:
         """Logs that could not be read, groups that could not be fitted, comparisons not made."""
         return (
             *(Failure(what=s.path, stage="read", reason=s.error) for s in self.surveys if s.error),
-            *(Failure(what=f"group {g.key}", stage="fit", reason=g.error) for g in self.groups if g.error),
+            *(Failure(what=_group_named(g), stage="fit", reason=g.error) for g in self.groups if g.error),
             *(Failure(what=c.path, stage="discrepancy", reason=c.error) for c in self.comparisons if c.error),
         )
 
@@ -207,3 +208,10 @@ class BatchResult:
     def cached(self) -> int:
         """Logs and groups taken from the cache."""
         return sum(s.cached for s in self.surveys) + sum(g.cached for g in self.groups)
+
+
+def _group_named(group: GroupFit, shown: int = 5) -> str:
+    """``group KEY (a.ulg, b.ulg and 3 more)``: a group by its key and the files it holds."""
+    names = [Path(path).name for path in group.logs]
+    more = f" and {len(names) - shown} more" if len(names) > shown else ""
+    return f"group {group.key} ({', '.join(names[:shown])}{more})" if names else f"group {group.key}"

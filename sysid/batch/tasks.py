@@ -162,6 +162,7 @@ def fit_group(group: Group, settings: BatchSettings, results: str, report: Group
 
 def _fit(group: Group, settings: BatchSettings, folder: Path, base: GroupFit, report: GroupReport | None) -> GroupFit:
     from flightlogs.store.campaign import ingest_campaign
+    from flightlogs.store.dataset import file_sha256
     from sysid.fit import identify_flights, write_model
     from sysid.model.modes import modes
     from sysid.verify import VerificationOptions, axis_outputs, verify_flights
@@ -197,7 +198,12 @@ def _fit(group: Group, settings: BatchSettings, folder: Path, base: GroupFit, re
         created = datetime.now(UTC).isoformat(timespec="seconds")
         options = {"initial_state": settings.initial_state, "judged": "on-axis outputs of each doublet's axis"}
         verification_file = write_verification(
-            folder / "verification.json", verification, model="model.json", options=options, created_utc=created
+            folder / "verification.json",
+            verification,
+            model="model.json",
+            model_sha256=file_sha256(model_file),
+            options=options,
+            created_utc=created,
         )
     report_file = None
     if report is not None:
@@ -235,20 +241,21 @@ def compare_log(reference: str, log: LogSurvey) -> LogComparison:
     LogComparison
     """
     from flightlogs.store.campaign import ingest_campaign
-    from sysid.discrepancy import DiscrepancyOptions, discover, flights_series, model_flight
+    from sysid.discrepancy import DiscrepancyOptions, discover, flights_series, model_flight, simulation_misfit
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SysidWarning)
             real = ingest_campaign([Path(log.path)], options=_NO_MANEUVERS).require_flights()
             kind, simulation = _reference(reference, Path(reference).stat().st_mtime_ns)
+            misfit = simulation_misfit(reference) if kind == "model" else None
             if kind == "model":
                 real_series = flights_series(real)
                 sim_series = [model_flight(simulation, s, source=Path(reference).name) for s in real_series]
             else:  # like with like (rates, derived specific forces)
                 real_series = flights_series(real, like=simulation)
                 sim_series = flights_series(simulation, like=real)
-            result = discover(sim_series, real_series, DiscrepancyOptions())
+            result = discover(sim_series, real_series, DiscrepancyOptions(simulation_misfit=misfit))
     except SysidError as err:
         return LogComparison(path=log.path, error=str(err))
     effects = tuple(finding.effect for finding in result.findings)

@@ -14,6 +14,7 @@ from sysid.discrepancy.model_files import (
     SimulationModel,
     read_corrected_model,
     read_simulation_model,
+    simulation_misfit,
     write_corrected_model,
 )
 from sysid.discrepancy.responses import RATE_PAIRS, ResponseComparison, compare_model_responses, compare_responses
@@ -28,6 +29,7 @@ __all__ = [
     "read_corrected_model",
     "read_simulation_model",
     "simulated_flight",
+    "simulation_misfit",
     "write_corrected_model",
     "CATALOGUE",
     "EFFECTS",

@@ -90,7 +90,11 @@ def _ambiguity(finding: Finding, term: Term) -> str:
 
 
 def summary_of(
-    findings: Sequence[Finding], noise_floor: Mapping[str, float], unexplained: Mapping[str, float] | None = None
+    findings: Sequence[Finding],
+    noise_floor: Mapping[str, float],
+    unexplained: Mapping[str, float] | None = None,
+    *,
+    misfit: str | None = None,
 ) -> str:
     """Plain-language summary, the most important finding first (or that nothing is missing).
 
@@ -103,6 +107,9 @@ def summary_of(
     unexplained : Mapping[str, float], optional
         Per output, the real residual left with the findings modelled, over the noise floor; where it stays
         above :data:`FAR_FROM_FLOOR` the summary says the simulation is no close model of the real vehicle.
+    misfit : str, optional
+        Why the simulation (a fitted model) is no close model of its own flights: the summary then says the
+        search could not judge, not that nothing is missing.
     """
     left = dict(unexplained or {})
     far = sorted((o for o, r in left.items() if r > FAR_FROM_FLOOR), key=lambda o: -left[o])
@@ -115,6 +122,14 @@ def summary_of(
             "vehicle (another airframe, controller or mission, or far noisier sensors), or what differs is outside the "
             "library; read the findings as leads, not as the answer."
         )
+    if misfit:
+        judged = "Not judged" if not findings else "Read the findings as leads only"
+        caveat += (
+            f" {judged}: {misfit}, so it is not close enough to its own flights to tell what it leaves out "
+            "from its own misfit."
+        )
+        if not findings:
+            return caveat.strip()
     if not findings:
         floor = ", ".join(f"{o} {v:.3g}" for o, v in noise_floor.items())
         what = "No candidate term" if far else "Nothing is missing: no candidate term"

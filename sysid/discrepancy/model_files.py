@@ -30,6 +30,7 @@ __all__ = [
     "corrected_to_dict",
     "read_corrected_model",
     "read_simulation_model",
+    "simulation_misfit",
     "write_corrected_model",
 ]
 
@@ -59,6 +60,40 @@ def read_simulation_model(path: str | Path) -> SimulationModel:
     from sysid.fit.model_file import model_from_dict  # the fit's package: 0.5 s to import, only for its files
 
     return model_from_dict(doc, source=str(path)).linear_model(include_wind=False)
+
+
+def simulation_misfit(path: str | Path) -> str | None:
+    """Why a fitted model is no close model of its own flights, or None when it is (or is a corrected simulation).
+
+    A model whose J_ave (eq. 3.9) is beyond an acceptable fit's (Tischler & Remple: 150) misses its own
+    responses by more than any physics the search could name: finding nothing along a real flight is then
+    no evidence that nothing is missing.
+
+    Parameters
+    ----------
+    path : str or Path
+        A model from ``sysid fit -o`` or a corrected simulation.
+
+    Returns
+    -------
+    str or None
+        One clause, e.g. ``"model.json fits its own responses with J_ave 216, beyond the 150 of an
+        acceptable fit"``.
+
+    Raises
+    ------
+    ModelError
+        As :func:`read_simulation_model`.
+    """
+    from sysid.fit.guidelines import Guidelines
+
+    doc = read_json_object(path, ModelError, "model")
+    cost = doc.get("cost")
+    average = cost.get("average") if isinstance(cost, dict) else None
+    limit = Guidelines().j_average_acceptable
+    if doc.get("schema") == SCHEMA or not isinstance(average, (int, float)) or not average > limit:
+        return None
+    return f"{Path(path).name} fits its own responses with J_ave {average:.0f}, beyond the {limit:.0f} of an acceptable fit"
 
 
 def corrected_to_dict(model: CorrectedModel) -> dict[str, Any]:

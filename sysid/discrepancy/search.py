@@ -138,6 +138,9 @@ class DiscrepancyOptions:
         outputs (and the term explain under 80 % of what it does) for the term not to be named.
     rotor_radius_m : float or None
         Propeller radius, m, if known: the ground effect's end is also given as Z/R.
+    simulation_misfit : str or None
+        Why the simulation is no close model of its own flights (:func:`~.model_files.simulation_misfit`):
+        then finding nothing is the verdict ``not_judged``, not ``none``, and the summary says why.
     """
 
     min_improvement: float = 0.05
@@ -146,6 +149,7 @@ class DiscrepancyOptions:
     max_findings: int = 3
     generic_margin: float = 0.10
     rotor_radius_m: float | None = None
+    simulation_misfit: str | None = None
 
 
 def discover(
@@ -353,10 +357,11 @@ def discover(
     )
     floor = {o: float(np.sqrt(scale[o])) for o in OUTPUTS}
     unexplained = {o: round(_spread(y[o] - held_out[o]) / floor[o], 2) for o in OUTPUTS}
+    misfit = options.simulation_misfit
     return DiscrepancyResult(
-        verdict=findings[0].effect if findings else "none",
+        verdict=findings[0].effect if findings else ("not_judged" if misfit else "none"),
         findings=tuple(findings),
-        summary=summary_of(findings, floor, unexplained),
+        summary=summary_of(findings, floor, unexplained, misfit=misfit),
         unexplained=unexplained,
         screened=tuple(screened),
         noise_floor=floor,

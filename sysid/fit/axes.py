@@ -288,7 +288,7 @@ def partial_warning(axes: Sequence[AxisStatus], *, model: str) -> str:
     return f"model {model} is partial: it covers {covered} only; unidentified, so without values and not simulated: {missing}"
 
 
-def unidentified_message(axes: Sequence[AxisStatus], *, model: str) -> str:
+def unidentified_message(axes: Sequence[AxisStatus], *, model: str, partial: bool = False) -> str:
     """The error of a fit that left axes unidentified: one sentence per axis, naming it, why, and what to do.
 
     Parameters
@@ -297,6 +297,8 @@ def unidentified_message(axes: Sequence[AxisStatus], *, model: str) -> str:
         Every axis of the structure; each unidentified one gets its sentence.
     model : str
         Name of the structure fitted, for the first line.
+    partial : bool, optional
+        Whether a partial model was asked for (then no axis was identified: the advice is not to ask for it).
 
     Examples
     --------
@@ -305,11 +307,17 @@ def unidentified_message(axes: Sequence[AxisStatus], *, model: str) -> str:
     >>> print(unidentified_message([lon], model="hover"))
     model hover: 1 of its 1 axes cannot be identified.
     lon: no sweep found in 3 logs; give the maneuvers with --segments, or --partial to write a model of the other axes.
+    >>> print(unidentified_message([lon], model="hover", partial=True))
+    model hover: 1 of its 1 axes cannot be identified, so a partial model has no axis to write.
+    lon: no sweep found in 3 logs; give the maneuvers with --segments.
     """
     missing = [a for a in axes if not a.identified]
     head = f"model {model}: {len(missing)} of its {len(axes)} axes cannot be identified."
-    partial = "--partial to write a model of the other axes"
-    return "\n".join([head] + [a.sentence + (", or " if a.remedy else "; ") + partial + "." for a in missing])
+    if partial:  # asked for, and there is no axis to write
+        head = head[:-1] + ", so a partial model has no axis to write."
+        return "\n".join([head] + [a.sentence + "." for a in missing])
+    advice = "--partial to write a model of the other axes"
+    return "\n".join([head] + [a.sentence + (", or " if a.remedy else "; ") + advice + "." for a in missing])
 
 
 def axes_from_parameters(parts: Mapping[str, Sequence[str]], statuses: Mapping[str, str]) -> tuple[AxisStatus, ...]:

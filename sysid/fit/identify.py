@@ -300,7 +300,7 @@ def _identified(
     gated = gate_responses(responses, **rule)
     axes = structure_axes(structure, flights, used, responses, gated, kind=options.kind, **rule)
     if flights and any(not a.identified for a in axes) and not (options.partial and gated.kept):
-        raise FitError(unidentified_message(axes, model=structure.name))
+        raise FitError(unidentified_message(axes, model=structure.name, partial=options.partial))
     if not responses:
         given = ", ".join(Path(f).name for f in files) or "the data given"
         if not flights:

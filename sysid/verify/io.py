@@ -32,6 +32,7 @@ __all__ = [
     "verification_from_dict",
     "write_verification",
     "read_verification",
+    "require_verified_model",
 ]
 
 VERIFICATION_SCHEMA = "flight-sysid/verification"
@@ -49,6 +50,8 @@ class SavedVerification:
         The result of :func:`sysid.verify.verify`.
     model : str, optional
         The model file verified (its name or path).
+    model_sha256 : str, optional
+        SHA-256 of that file's bytes when it was verified ("" in files written before it was kept).
     options : Mapping[str, Any], optional
         Options of the verification (JSON-compatible: initial state, seconds
         kept before and after each doublet ...).
@@ -58,6 +61,7 @@ class SavedVerification:
 
     verification: Verification
     model: str = ""
+    model_sha256: str = ""
     options: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     created_utc: str = ""
 
@@ -104,7 +108,12 @@ def _record_to_dict(r: RecordVerification) -> dict[str, Any]:
 
 
 def verification_to_dict(
-    verification: Verification, *, model: str = "", options: Mapping[str, Any] | None = None, created_utc: str = ""
+    verification: Verification,
+    *,
+    model: str = "",
+    model_sha256: str = "",
+    options: Mapping[str, Any] | None = None,
+    created_utc: str = "",
 ) -> dict[str, Any]:
     """The JSON document of a verification (schema ``flight-sysid/verification`` version 2).
 
@@ -114,6 +123,8 @@ def verification_to_dict(
         The result to save.
     model : str, optional
         The model file verified.
+    model_sha256 : str, optional
+        SHA-256 of the model file's bytes (:func:`flightlogs.store.dataset.file_sha256`).
     options : Mapping[str, Any], optional
         JSON-compatible options of the verification.
     created_utc : str, optional
@@ -145,6 +156,7 @@ def verification_to_dict(
         "schema": VERIFICATION_SCHEMA,
         "schema_version": VERIFICATION_SCHEMA_VERSION,
         "model": model,
+        "model_sha256": model_sha256,
         "options": dict(options or {}),
         "created_utc": created_utc,
         "rmse": _num(v.rmse),
@@ -263,6 +275,7 @@ def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") ->
         return SavedVerification(
             verification=verification,
             model=str(doc.get("model", "")),
+            model_sha256=str(doc.get("model_sha256", "")),
             options=dict(doc.get("options") or {}),
             created_utc=str(doc.get("created_utc", "")),
         )
@@ -275,6 +288,7 @@ def write_verification(
     verification: Verification,
     *,
     model: str = "",
+    model_sha256: str = "",
     options: Mapping[str, Any] | None = None,
     created_utc: str = "",
 ) -> Path:
@@ -288,6 +302,8 @@ def write_verification(
         The result to save.
     model : str, optional
         The model file verified.
+    model_sha256 : str, optional
+        SHA-256 of the model file's bytes, by which a report checks it is given the model verified.
     options : Mapping[str, Any], optional
         JSON-compatible options of the verification.
     created_utc : str, optional
@@ -313,7 +329,42 @@ def write_verification(
     >>> read_verification(path).verification.records[0].output("q").simulated.tolist()
     [0.0, 0.9, 0.1]
     """
-    return write_json(path, verification_to_dict(verification, model=model, options=options, created_utc=created_utc))
+    document = verification_to_dict(
+        verification, model=model, model_sha256=model_sha256, options=options, created_utc=created_utc
+    )
+    return write_json(path, document)
+
+
+def require_verified_model(saved: SavedVerification, model_path: str | Path, *, source: str = "verification") -> None:
+    """Refuse a verification of another model than `model_path`'s.
+
+    Parameters
+    ----------
+    saved : SavedVerification
+        The verification read.
+    model_path : str or Path
+        The model file it is to be reported with.
+    source : str, optional
+        The verification's file, for the message.
+
+    Raises
+    ------
+    DataError
+        When the file it verified had other contents (SHA-256) or, in a file that kept no hash, another name.
+    """
+    model_path = Path(model_path)
+    if saved.model_sha256:
+        from flightlogs.store.dataset import file_sha256
+
+        same = file_sha256(model_path) == saved.model_sha256
+    else:
+        same = not saved.model or Path(saved.model).name == model_path.name
+    if not same:
+        verified = Path(saved.model).name or "another model"
+        raise DataError(
+            f"{source}: verifies {verified}, not {model_path} (the files differ); a report shows a model with "
+            "its own verification: verify this model, or give the model that was verified"
+        )
 
 
 def read_verification(path: str | Path) -> SavedVerification:

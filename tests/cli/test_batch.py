@@ -372,3 +372,23 @@ def _state(pid: int) -> str:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
     except OSError:
         return "Z"
+
+
+def test_a_batch_that_fits_nothing_fails_and_says_so(tmp_path: Path, real_data: Path) -> None:
+    """Issue 33: an ordinary flight (no sweep) fits no group: exit 1 in one red sentence pointing at the failures
+    table, which names the group by its files; no green "drift: none flagged"; the fleet report may lie inside
+    -o, a folder the batch creates."""
+    log = real_data / "pyulog" / "sample.ulg"
+    out = tmp_path / "results"
+    done = _batch(log, "-o", out, "--report", out / "fleet.html", "--workers", "1", "--json", "-")
+    assert done.returncode == 1, done.stderr
+    summary = json.loads(done.stdout)
+    assert (summary["groups"], summary["fitted"]) == (1, 0)
+    (failure,) = summary["failures"]
+    assert failure["stage"] == "fit" and failure["what"].endswith("(sample.ulg)")
+    assert done.stderr.strip().splitlines()[-1] == (
+        f"error: none of the 1 group(s) was fitted; why, log by log: {out / 'failures.csv'}"
+    )
+    assert "drift: none flagged" not in done.stderr and (out / "fleet.html").is_file()
+    elsewhere = _batch(log, "-o", out, "--report", tmp_path / "nowhere" / "fleet.html", "--workers", "1")
+    assert elsewhere.returncode == 2 and "is not inside the results folder" in elsewhere.stderr

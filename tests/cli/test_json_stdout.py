@@ -143,6 +143,25 @@ def test_a_command_in_its_own_process_writes_only_json_on_its_stdout(tmp_path: P
     assert stderr.startswith("modes of hover")
 
 
+@pytest.mark.parametrize("own_process", [False, True])
+@pytest.mark.parametrize("command", ["ingest", "fit", "validate", "discrepancy"])
+def test_a_failure_with_json_to_stdout_is_json_too(tmp_path: Path, command: str, own_process: bool) -> None:
+    """Issue 33: ``--json -`` that fails prints ``{"error": ..., "exit_code": 1}`` on stdout (the sentence it
+    prints on stderr), so a pipe into jq reads why; without ``--json -`` stdout stays empty."""
+    bad = tmp_path / "bad.ulg"
+    bad.write_bytes(b"not a log at all")
+    args = {"discrepancy": [command, str(bad), str(bad)], "validate": [command, str(bad), str(bad)]}.get(
+        command, [command, str(bad)]
+    )
+    code, stdout, stderr = _run([*args, "--json", "-"], tmp_path, own_process=own_process)
+    assert code == 1
+    sentence = stderr.strip().splitlines()[-1]
+    assert sentence.startswith("error: ") and "bad.ulg" in sentence
+    assert json.loads(stdout) == {"error": sentence.removeprefix("error: "), "exit_code": 1}
+    code, stdout, _ = _run(args, tmp_path, own_process=own_process)
+    assert code == 1 and stdout == ""
+
+
 def _json_commands(group: click.Group, ctx: click.Context, prefix: tuple[str, ...] = ()) -> dict[str, click.Command]:
     """Every command under `group`, groups walked into, that has a ``--json`` option: by its path."""
     found: dict[str, click.Command] = {}

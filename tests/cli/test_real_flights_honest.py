@@ -69,6 +69,14 @@ def test_no_maneuver_is_found_and_a_hover_only_where_airborne(name: str) -> None
         assert landed is None or np.all(landed == 0.0), hover
 
 
+def test_ingest_says_when_it_finds_no_maneuver() -> None:
+    """Issue 33: the summary says so, rather than printing no segment line at all."""
+    result = CliRunner().invoke(cli, ["ingest", str(REAL / "pyulog/sample.ulg")])
+    assert result.exit_code == 0, result.output
+    (line,) = [line for line in result.stdout.splitlines() if "no maneuver found" in line]
+    assert line.startswith("  no maneuver found (no sweep, doublet, 3-2-1-1, multisine or pilot's broadband input)")
+
+
 @pytest.mark.slow
 def test_the_hovers_of_a_telemetry_log_lie_inside_its_armed_periods() -> None:
     """phoenix: 1 Hz telemetry of auto missions, six armed periods of at most 72 s (before: 209 s of "hover")."""
@@ -108,3 +116,5 @@ def test_fit_partial_gives_no_green_verdict(name: str, kind: str) -> None:
         assert "come from a pilot's broadband input found in the flight" in verdict["sentence"]
     else:
         assert result.exit_code == 1 and "\nerror: " in "\n" + result.stderr, result.output  # no model, no verdict
+        assert "--partial to write" not in result.stderr  # asked for already: not advised again (issue 33)
+        assert json.loads(result.stdout)["error"] == result.stderr.split("error: ", 1)[1].strip()

@@ -14,6 +14,7 @@ import pytest
 from click.testing import CliRunner
 
 from flightlogs.errors import DataError
+from flightlogs.store.dataset import file_sha256
 from reports.model_report import model_report_html
 from simulator.campaign.fly import run_scenario
 from simulator.campaign.scenario import read_scenario
@@ -85,6 +86,47 @@ def test_without_a_verification_the_default_output_sits_beside_the_model(
     assert 'id="verification"' not in page
     assert "ArduCopter V4.5.7 &lt;octo&gt;" in page and "transport delay 1.74 s (geometry)" in page
     assert result.output.strip().endswith(f"wrote {tmp_path / 'm.html'}")
+
+
+def test_a_verification_of_another_model_is_refused(
+    saved: tuple[Path, Path, IdentifiedModel, Verification], tmp_path: Path
+) -> None:
+    """Issue 33: the verification keeps the SHA-256 of the model it verified; a report of another model with
+    it is one sentence naming both, exit 1, nothing written. A file from before the hash was kept is judged
+    by the model's name."""
+    model_path, _, model, verification = saved
+    verified = tmp_path / "model.json"
+    write_model(verified, model)
+    validation = write_verification(
+        tmp_path / "validation.json",
+        verification,
+        model=verified.name,
+        model_sha256=file_sha256(verified),
+    )
+    other = tmp_path / "other.json"
+    document = json.loads(verified.read_text())
+    name = next(iter(document["parameters"]))
+    document["parameters"][name]["value"] *= 1.5
+    for candidate, code in ((verified, 0), (other, 1)):
+        if candidate is other:
+            other.write_text(json.dumps(document))
+        out = tmp_path / f"{candidate.stem}.html"
+        result = CliRunner().invoke(cli, ["report", str(candidate), str(validation), "-o", str(out), "-q"])
+        assert result.exit_code == code, result.output
+        assert out.exists() == (code == 0)
+    assert result.stderr.strip() == (
+        f"error: {validation}: verifies model.json, not {other} (the files differ); a report shows a model with its "
+        "own verification: verify this model, or give the model that was verified"
+    )
+    renamed = tmp_path / "renamed.json"  # the verified model's bytes under another name: the same model
+    renamed.write_bytes(verified.read_bytes())
+    assert CliRunner().invoke(cli, ["report", str(renamed), str(validation), "-q"]).exit_code == 0
+    legacy = json.loads(validation.read_text())
+    legacy.pop("model_sha256")
+    old = tmp_path / "old-validation.json"
+    old.write_text(json.dumps(legacy))
+    assert CliRunner().invoke(cli, ["report", str(verified), str(old), "-q"]).exit_code == 0
+    assert CliRunner().invoke(cli, ["report", str(other), str(old), "-q"]).exit_code == 1
 
 
 def _ingest(folder: Path) -> str:

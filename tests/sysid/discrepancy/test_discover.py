@@ -314,6 +314,31 @@ def test_a_fitted_model_as_sim_through_the_command(
     assert mixed.exit_code == 1 and "a fitted model is the whole simulation" in mixed.output
 
 
+def test_a_model_beyond_the_j_guideline_is_not_close_enough_to_judge(
+    pairs: dict[str, tuple[Path, dict[str, Path]]], models: dict[str, Path], tmp_path: Path
+) -> None:
+    """Issue 33: with the simulator's own model nothing is missing on the null flight; the same model in a file
+    whose J_ave is 216 (beyond the 150 of an acceptable fit) is not judged: it cannot tell what it leaves out
+    from its own misfit, and says so."""
+    _, reals = pairs["octo"]
+    document = json.loads(models["exact"].read_text())
+    assert document["cost"]["average"] <= 150.0
+    poor = tmp_path / "poor.json"
+    poor.write_text(json.dumps(document | {"cost": document["cost"] | {"average": 216.0}}))
+    verdicts = {}
+    for model in (models["exact"], poor):
+        result = CliRunner().invoke(cli, ["discrepancy", str(model), str(reals["none"]), "--json", "-", "-q"])
+        assert result.exit_code == 0, result.output
+        verdicts[model.name] = json.loads(result.stdout)
+    assert verdicts["exact.json"]["verdict"] == "none"
+    assert verdicts["exact.json"]["summary"].startswith("Nothing is missing")
+    assert verdicts["poor.json"]["verdict"] == "not_judged" and verdicts["poor.json"]["findings"] == []
+    assert verdicts["poor.json"]["summary"] == (
+        "Not judged: poor.json fits its own responses with J_ave 216, beyond the 150 of an acceptable fit, so it is "
+        "not close enough to its own flights to tell what it leaves out from its own misfit."
+    )
+
+
 def test_bad_input_is_one_sentence_and_exit_1(
     pairs: dict[str, tuple[Path, dict[str, Path]]], tmp_path: Path, real_data: Path
 ) -> None:
