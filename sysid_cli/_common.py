@@ -16,6 +16,8 @@ import click
 from flightlogs.errors import DataError
 from flightlogs.writers.jsonio import json_text, write_json
 
+from ._warnings import QUIET
+
 __all__ = [
     "OutputPath",
     "SysidCommand",
@@ -141,6 +143,8 @@ class SysidCommand(click.Command):
                     raise DataError(
                         f"{out}: exists, and --no-clobber leaves it as it is; give another {param.opts[-1]}"
                     )
+        if ctx.params.get("quiet"):
+            ctx.meta[QUIET] = True  # its warnings counted, not listed (sysid_cli._warnings)
         if ctx.params.get("json_path") == "-":
             ctx.meta[JSON_ON_STDOUT] = True  # a failure then prints {"error": ...} there (sysid_cli.main)
         with json_owns_stdout(ctx.params.get("json_path")):

@@ -10,7 +10,7 @@ import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
 from ._flights import reading_from, reading_options
-from ._warnings import mark_reported
+from ._warnings import grouped, mark_reported
 from ._wind_options import (
     anemometer_at_option,
     parse_position,
@@ -227,7 +227,7 @@ def _print_summary(summary: dict[str, Any]) -> None:
                 "  no maneuver found (no sweep, doublet, 3-2-1-1, multisine or pilot's broadband input)"
                 + (f"; {hovers} hover stretch{'es' if hovers > 1 else ''}" if hovers else "")
             )
-        for warning in entry["warnings"]:
+        for warning in grouped(entry["warnings"]):
             say(f"  warning: {warning}")
         mark_reported(entry["warnings"])
     if summary["output"]:
