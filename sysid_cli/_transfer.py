@@ -33,6 +33,7 @@ def fit_transfer(
     *,
     delay: bool,
     band: tuple[float, float] | None,
+    windows: tuple[float, ...] | None,
     kind: str,
     min_coherence: float,
     max_cr: float,
@@ -55,6 +56,8 @@ def fit_transfer(
         Fit a transport delay.
     band : tuple of (float, float) or None
         ``--band``, rad/s.
+    windows : tuple of float or None
+        ``--windows``: the composite's window lengths, s.
     kind : str
         Maneuvers used.
     min_coherence : float
@@ -73,6 +76,7 @@ def fit_transfer(
     from flightlogs.writers.jsonio import write_json
     from sysid.fit.guidelines import Guidelines
     from sysid.fit.transfer import TransferOptions, fit_transfer_functions
+    from sysid.freqresp import ResponseOptions
     from sysid.model.transfer import parse_transfer_function
 
     structures = [parse_transfer_function(text) for text in texts]
@@ -84,6 +88,7 @@ def fit_transfer(
             band_rad_s=band,
             guidelines=Guidelines(max_cr_percent=max_cr, max_insensitivity_percent=max_insensitivity),
         ),
+        responses=ResponseOptions(window_lengths_s=windows),
         kind=kind,
         min_coherence=min_coherence,
     )

@@ -10,6 +10,7 @@ import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
 from ._flights import check_sources, conditioned_flights, dataset_flights, reading_from, reading_options
+from ._response_options import windows_option
 from ._transfer import fit_transfer, parse_band
 from ._wind_options import (
     anemometer_at_option,
@@ -165,6 +166,7 @@ class _GuidelineOption(click.Option):
     '"p/delta_lat = b2*s^2/(s^4 + a3*s^3 + a2*s^2 + a1*s + a0)".',
 )
 @click.option("--delay", is_flag=True, help="With --tf: fit a transport delay exp(-tau s) too.")
+@windows_option()
 @click.option("--band", callback=parse_band, metavar="LO,HI", help="With --tf: fit only within LO-HI rad/s.")
 @click.option("-o", "--out", type=OutputPath(), help="Write the identified model (versioned JSON).")
 @click.option("--mat", type=OutputPath(), help="Also write the model for MATLAB (.mat).")
@@ -195,6 +197,7 @@ def fit(
     partial: bool,
     tf_texts: tuple[str, ...],
     delay: bool,
+    windows: tuple[float, ...] | None,
     band: tuple[float, float] | None,
     out: Path | None,
     mat: Path | None,
@@ -218,6 +221,7 @@ def fit(
         write_mat,
         write_model,
     )
+    from sysid.freqresp import ResponseOptions
     from sysid.model import load_structure
 
     log_only = {
@@ -249,6 +253,7 @@ def fit(
             tf_texts,
             delay=delay,
             band=band,
+            windows=windows,
             kind=kind,
             min_coherence=min_coherence,
             max_cr=max_cr,
@@ -277,6 +282,7 @@ def fit(
         constants=constants or None,
         initial=initial or None,
         partial=partial,
+        responses=ResponseOptions(window_lengths_s=windows),
     )
     dataset = check_sources(logs, log_only)
     with staged_progress("identifying", quiet=quiet) as progress:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
@@ -10,6 +9,7 @@ import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option
 from ._flights import conditioned_flights, reading_from, reading_options
+from ._response_options import windows_option
 from ._wind_options import segments_from, segments_option, wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["freqresp"]
@@ -23,21 +23,6 @@ Examples:
   sysid freqresp px4_sweeps/*.ulg --reference none --no-whole-record -o fr.h5
   sysid freqresp flight.ulg --segments maneuvers.csv --pairs q/delta_lon --json -
 """
-
-
-def _floats(_ctx: click.Context, _param: click.Parameter, value: str | None) -> tuple[float, ...] | None:
-    if not value:
-        return None
-    try:
-        lengths = tuple(float(part) for part in value.split(","))
-    except ValueError:
-        raise click.BadParameter(f"{value!r} is not a comma-separated list of seconds (e.g. 2,4,8,12,17)") from None
-    bad = [
-        part.strip() for part, length in zip(value.split(","), lengths) if not (math.isfinite(length) and length > 0)
-    ]
-    if bad:
-        raise click.BadParameter(f"{', '.join(bad)}: window lengths must be positive seconds (e.g. 2,4,8,12,17)")
-    return lengths
 
 
 def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> tuple[tuple[str, str], ...] | None:
@@ -102,12 +87,7 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
 @click.option(
     "--n-freq", type=click.IntRange(min=2), default=150, show_default=True, help="Points of the log-spaced grid."
 )
-@click.option(
-    "--windows",
-    callback=_floats,
-    metavar="S,S,...",
-    help="Window lengths, s (default: five from 2π/(5·omega-min) to half the longest record).",
-)
+@windows_option()
 @click.option(
     "--overlap",
     type=click.FloatRange(0.0, 0.95, max_open=True),

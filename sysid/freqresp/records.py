@@ -456,7 +456,7 @@ def reference_options(
         )
     which = "none" if not carrying else f"only {len(carrying)} of {len(records)}"
     return options, (
-        f"{axis}: {which} of the {kind} pieces carry a logged {EXCITATION} (PX4 logs none): responses "
+        f"{axis}: {which} of the {kind} pieces carry a logged {EXCITATION} (only ArduPilot's System ID mode logs one, SIDD): responses "
         f"computed from the mixer input {mixer}, which in closed loop also carries the feedback of "
         f"noise and turbulence."
     )

@@ -142,6 +142,19 @@ def test_partial_writes_a_model_of_the_identified_axes(runner: CliRunner, flight
     assert model.linear_model().inputs == ("delta_lat", "delta_lon")
 
 
+def test_the_windows_are_chosen_from_fit_as_from_freqresp(runner: CliRunner, flights: Path, tmp_path: Path) -> None:
+    """Issue 33: ``--windows`` is the option ``sysid freqresp`` has (one definition): every response the model
+    was fitted to used those windows (the longest a record cannot hold left out)."""
+    logs = [str(p) for p in sorted(flights.glob("*l[ao][nt]-*.bin"))]
+    out = tmp_path / "model.json"
+    result = runner.invoke(cli, ["fit", *logs, "--partial", "--windows", "2.5,5,10", "-o", str(out), "-q"])
+    assert result.exit_code == 0, result.output
+    windows = {tuple(r["windows_s"]) for r in json.loads(out.read_text())["responses"]}
+    assert windows == {(2.5, 5.0, 10.0)}
+    bad = runner.invoke(cli, ["fit", *logs, "--windows", "2,-1"])
+    assert bad.exit_code == 2 and "-1: window lengths must be positive seconds" in bad.output
+
+
 def test_help_has_an_example(runner: CliRunner) -> None:
     result = runner.invoke(cli, ["fit", "--help"])
     assert result.exit_code == 0 and "sysid fit sweeps/*.bin" in result.output

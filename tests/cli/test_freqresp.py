@@ -106,7 +106,7 @@ def test_a_px4_log_has_no_excitation_and_the_mixer_input_is_used(tmp_path: Path)
     summary = json.loads(result.stdout)
     assert summary["responses"][0]["reference"] is None and summary["responses"][0]["kept"]
     assert summary["notes"] == [
-        "lon: none of the sweep pieces carry a logged excitation (PX4 logs none): responses "
+        "lon: none of the sweep pieces carry a logged excitation (only ArduPilot's System ID mode logs one, SIDD): responses "
         "computed from the mixer input delta_lon, which in closed loop also carries the "
         "feedback of noise and turbulence."
     ]

@@ -291,7 +291,7 @@ def test_without_a_logged_excitation_the_mixer_input_is_used_and_said_so() -> No
     px4 = flight_responses([_flight()], [("q", "delta_lon")], options=options)
     assert px4.responses[0].reference is None
     assert px4.notes == (
-        "lon: none of the sweep pieces carry a logged excitation (PX4 logs none): responses "
+        "lon: none of the sweep pieces carry a logged excitation (only ArduPilot's System ID mode logs one, SIDD): responses "
         "computed from the mixer input delta_lon, which in closed loop also carries the feedback "
         "of noise and turbulence.",
     )
