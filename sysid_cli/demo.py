@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import datetime as _dt
 from pathlib import Path
 
 import click
@@ -26,7 +25,7 @@ _BEFORE_S, _AFTER_S = 0.5, 1.0
 
 def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
     """Verify the model (with and without G_w) on the dataset's doublets, save it, and say how it went."""
-    from flightlogs.store.dataset import file_sha256, read_dataset
+    from flightlogs.store.dataset import read_dataset
     from sysid.fit import read_model
     from sysid.verify import VerificationOptions, axis_outputs, doublet_records, verify
     from sysid.verify.io import write_verification
@@ -43,7 +42,6 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
         wind_model=with_wind if with_wind.inputs != model.inputs else None,
         options=VerificationOptions(initial_state="estimated"),
     )
-    created = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
     options = {
         "initial_state": "estimated",
         "before_s": _BEFORE_S,
@@ -52,14 +50,7 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
         "judged": "on-axis outputs of each doublet's axis",
         "dataset": dataset.name,
     }
-    write_verification(
-        out,
-        verification,
-        model=model_path.name,
-        model_sha256=file_sha256(model_path),
-        options=options,
-        created_utc=created,
-    )
+    write_verification(out, verification, model=model_path, options=options)
     worst = max(verification.summary, key=lambda s: s.tic)
     text = (
         f"  {len(verification.records)} doublets, each judged on its axis' outputs: overall TIC "

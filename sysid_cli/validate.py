@@ -93,10 +93,8 @@ def validate(
     Theil inequality coefficient per output (with bias and reference shift estimated, as VERIFY does), judging
     each doublet on the outputs of the axis it excites; with --wind, also how much the wind term G_w reduces
     the error."""
-    import datetime as dt
 
     from flightlogs.conditioning.condition import ConditioningOptions
-    from flightlogs.store.dataset import file_sha256
     from reports.model_report import write_model_report
     from sysid.fit import read_model
     from sysid.verify.io import write_verification
@@ -144,15 +142,7 @@ def validate(
         "wind": [p.name for p in wind_paths],
     }
     if out is not None:
-        created = dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
-        write_verification(
-            out,
-            verification,
-            model=model_path.name,
-            model_sha256=file_sha256(model_path),
-            options=saved,
-            created_utc=created,
-        )
+        write_verification(out, verification, model=model_path, options=saved)
     if report is not None:
         write_model_report(report, identified, verification=verification, verification_options=saved)
     if measured is not None:

@@ -162,7 +162,6 @@ def fit_group(group: Group, settings: BatchSettings, results: str, report: Group
 
 def _fit(group: Group, settings: BatchSettings, folder: Path, base: GroupFit, report: GroupReport | None) -> GroupFit:
     from flightlogs.store.campaign import ingest_campaign
-    from flightlogs.store.dataset import file_sha256
     from sysid.fit import identify_flights, write_model
     from sysid.model.modes import modes
     from sysid.verify import VerificationOptions, axis_outputs, verify_flights
@@ -195,15 +194,9 @@ def _fit(group: Group, settings: BatchSettings, folder: Path, base: GroupFit, re
     model_file = write_model(folder / "model.json", model)
     verification_file = None
     if verification is not None:
-        created = datetime.now(UTC).isoformat(timespec="seconds")
         options = {"initial_state": settings.initial_state, "judged": "on-axis outputs of each doublet's axis"}
         verification_file = write_verification(
-            folder / "verification.json",
-            verification,
-            model="model.json",
-            model_sha256=file_sha256(model_file),
-            options=options,
-            created_utc=created,
+            folder / "verification.json", verification, model=model_file, options=options
         )
     report_file = None
     if report is not None:

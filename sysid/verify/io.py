@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from datetime import UTC, datetime
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -287,10 +288,9 @@ def write_verification(
     path: str | Path,
     verification: Verification,
     *,
-    model: str = "",
-    model_sha256: str = "",
+    model: str | Path = "",
     options: Mapping[str, Any] | None = None,
-    created_utc: str = "",
+    created_utc: str | None = None,
 ) -> Path:
     """Write a verification as versioned JSON, atomically.
 
@@ -300,14 +300,13 @@ def write_verification(
         Destination (``validation.json``); its folder must exist.
     verification : Verification
         The result to save.
-    model : str, optional
-        The model file verified.
-    model_sha256 : str, optional
-        SHA-256 of the model file's bytes, by which a report checks it is given the model verified.
+    model : str or Path, optional
+        The model file verified: a `Path` keeps its name and the SHA-256 of its bytes (by which a report
+        checks it is given the model verified, :func:`require_verified_model`); a `str` its name only.
     options : Mapping[str, Any], optional
         JSON-compatible options of the verification.
     created_utc : str, optional
-        ISO 8601 time of the verification.
+        ISO 8601 time of the verification (default: now).
 
     Returns
     -------
@@ -329,8 +328,15 @@ def write_verification(
     >>> read_verification(path).verification.records[0].output("q").simulated.tolist()
     [0.0, 0.9, 0.1]
     """
+    sha256 = ""
+    if isinstance(model, Path):
+        from flightlogs.store.dataset import file_sha256
+
+        model, sha256 = model.name, file_sha256(model)
+    if created_utc is None:
+        created_utc = datetime.now(UTC).isoformat(timespec="seconds")
     document = verification_to_dict(
-        verification, model=model, model_sha256=model_sha256, options=options, created_utc=created_utc
+        verification, model=model, model_sha256=sha256, options=options, created_utc=created_utc
     )
     return write_json(path, document)
 

@@ -14,7 +14,6 @@ import pytest
 from click.testing import CliRunner
 
 from flightlogs.errors import DataError
-from flightlogs.store.dataset import file_sha256
 from reports.model_report import model_report_html
 from simulator.campaign.fly import run_scenario
 from simulator.campaign.scenario import read_scenario
@@ -97,12 +96,7 @@ def test_a_verification_of_another_model_is_refused(
     model_path, _, model, verification = saved
     verified = tmp_path / "model.json"
     write_model(verified, model)
-    validation = write_verification(
-        tmp_path / "validation.json",
-        verification,
-        model=verified.name,
-        model_sha256=file_sha256(verified),
-    )
+    validation = write_verification(tmp_path / "validation.json", verification, model=verified)  # name and SHA
     other = tmp_path / "other.json"
     document = json.loads(verified.read_text())
     name = next(iter(document["parameters"]))
