@@ -3,14 +3,16 @@
 Each subpackage is a namespace of its own (``from sysid.fit import identify_logs``):
 :mod:`sysid.model` (model structures), :mod:`sysid.freqresp` (frequency
 responses), :mod:`sysid.fit` (identification), :mod:`sysid.verify` (time-domain
-verification) and :mod:`sysid.groundeffect` (ground-effect models of chapter 2).
+verification), :mod:`sysid.groundeffect` (ground-effect models of chapter 2),
+:mod:`sysid.discrepancy` (what a real flight does that its simulation leaves out)
+and :mod:`sysid.batch` (fleets of logs on a Dask cluster).
 ``import sysid`` loads none of them; ``sysid.fit`` loads one on first use.
 """
 
 import importlib as _importlib
 from types import ModuleType as _ModuleType
 
-_SUBPACKAGES = ("fit", "freqresp", "groundeffect", "model", "verify")
+_SUBPACKAGES = ("batch", "discrepancy", "fit", "freqresp", "groundeffect", "model", "verify")
 __all__ = list(_SUBPACKAGES)
 
 
