@@ -126,6 +126,8 @@ def test_verdict_on_the_average_cost(average: float, grade: str) -> None:
         ({"q/delta_lon": 200.0}, "good", ""),
         ({"q/delta_lon": 201.0}, "acceptable", "1 response cost exceeds 200 (q/delta_lon 201)"),  # a few may pass 200
         ({"q/delta_lon": 201.0, "p/delta_lat": 250.0}, "acceptable", "2 response costs exceed 200"),
+        ({"q/delta_lon": 300.0}, "acceptable", "1 response cost exceeds 200"),  # 200 x 150/100: as J_ave's margin
+        ({"q/delta_lon": 1012.0}, "poor", "1 response cost exceeds 200 (q/delta_lon 1012)"),  # issue 33: not "nearly"
     ],
 )
 def test_verdict_on_each_response_cost(costs: dict[str, float], grade: str, problem: str) -> None:
@@ -210,6 +212,18 @@ def test_a_model_with_an_unidentified_axis_is_never_good_and_says_which() -> Non
     assert (check.value, check.grade) == ("3 of 4", "acceptable")
     said = with_unidentified(_model(), LON, {"lon": "no sweep found in 3 logs"})
     assert "lon unidentified (no sweep found in 3 logs)" in model_verdict(said).sentence
+
+
+def test_a_model_of_fewer_than_half_its_axes_is_poor() -> None:
+    """Issue 33: 1 of 4 axes identified was graded as 2 of 4 or 3 of 4 are; fewer than half is poor."""
+    lat = {"Y_v", "L_v", "Y_lat", "L_lat", "tau_lat"}
+    yaw = {"N_r", "N_yaw", "tau_yaw"}
+    grades = {}
+    for name, removed in (("two", LON | lat), ("three", LON | lat | yaw)):
+        model = with_unidentified(_model(), removed)
+        check = next(c for c in model_verdict(model).checks if c.guideline == "every axis identified")
+        grades[name] = (check.value, check.grade)
+    assert grades == {"two": ("2 of 4", "acceptable"), "three": ("1 of 4", "poor")}
 
 
 def test_a_fit_of_two_parameters_is_not_good() -> None:
