@@ -195,7 +195,8 @@ def flight_series(
         (:func:`flightlogs.kinematics.specific_force`), whatever the records hold.
     logged_rate_hz : float, optional
         Sample a record logged faster than this at this rate first, as a slower logger would have
-        (no filter: a logger samples); by default each record as it is.
+        (no filter: a logger samples; only the accelerometer's vibration is anti-aliased first); by
+        default each record as it is.
 
     Returns
     -------
@@ -224,7 +225,10 @@ def flight_series(
         absolute = {s: record.absolute(s) for s in record.signals}
         logged_hz = record.rate_hz
         if logged_rate_hz is not None and logged_hz > _SLOWER * logged_rate_hz:
+            # sampled as the slower logger samples; the accelerometer's vibration anti-aliased first
             slow = np.arange(t[0], t[-1], 1.0 / logged_rate_hz)
+            for s in _VIBRATING:
+                absolute[s] = _anti_aliased(absolute[s], logged_hz, logged_rate_hz)
             absolute = {s: np.interp(slow, t, x) for s, x in absolute.items()}
             t, logged_hz = slow, logged_rate_hz
         if specific_force_derived:
