@@ -84,6 +84,11 @@ def expand_logs(paths: tuple[Path, ...], *, tables: bool = False) -> list[Path]:
 @click.option(
     "--report", type=OutputPath(within="out_dir"), help="Write the fleet report (HTML); it may lie inside -o."
 )
+@click.option(
+    "--partial",
+    is_flag=True,
+    help="Fit the axes a group's sweeps identify; the rest unidentified (as sysid fit --partial).",
+)
 @click.option("--no-group-reports", is_flag=True, help="Skip each group's HTML model report (faster).")
 @json_option
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar and no summary.")
@@ -103,6 +108,7 @@ def batch(
     scheduler: str | None,
     workers: int | None,
     report: Path | None,
+    partial: bool,
     no_group_reports: bool,
     json_path: str | None,
     quiet: bool,
@@ -122,6 +128,7 @@ def batch(
     from reports.model_report import write_model_report
     from sysid.batch import BatchSettings, DriftOptions, batch_client, run_batch
     from sysid.batch.groups import check_keys
+    from sysid.fit.identify import IdentifyOptions
     from sysid.model import load_structure
 
     if scheduler is not None and workers is not None:
@@ -143,6 +150,7 @@ def batch(
         wind_paths=tuple(str(Path(w).resolve()) for w in winds),
         wind_sha256=tuple(file_sha256(w) for w in winds),
         reading=reading_from(table_map, vehicle),
+        identify=IdentifyOptions(partial=partial),
     )
     drift = DriftOptions()
     start = time.perf_counter()

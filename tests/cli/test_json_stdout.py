@@ -74,7 +74,7 @@ CASES: dict[str, str] = {
     "ground-effect spacing": f"ground-effect spacing {{rig}} {{rig_spaced}} --spacing 0,10 --rotor-radius {R}",
     "mrac compare": "mrac compare --height-ratio 3 --trials 1 --pid-phase 2 --mrac-phase 2",
     "discrepancy": "discrepancy {doublet} {sweep} -o findings.json",  # printed "verdict: ..." before the JSON
-    "batch": "batch {doublet} -o batch --workers 1 --group-by file --no-group-reports",
+    "batch": "batch {sweep} -o batch --workers 1 --group-by file --no-group-reports --partial",
 }
 
 
