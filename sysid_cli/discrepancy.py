@@ -115,7 +115,6 @@ def discrepancy(
         quiet=quiet,
         reading=reading_from(table_map, vehicle),
     )
-    real_series = flights_series(flown)
     if model is None:
         simulated = conditioned_flights(
             list(sim_logs),
@@ -128,6 +127,7 @@ def discrepancy(
         real_series = flights_series(flown, like=simulated)  # like with like: a table's rate, its derived forces
         sim_series = flights_series(simulated, like=flown)
     else:
+        real_series = flights_series(flown)
         sim_series = [simulated_flight(model, s, source=models[0].name) for s in real_series]
     with staged_progress("discrepancy", quiet=quiet) as progress:
         misfit = simulation_misfit(models[0]) if models else None

@@ -234,14 +234,14 @@ def compare_log(reference: str, log: LogSurvey) -> LogComparison:
     LogComparison
     """
     from flightlogs.store.campaign import ingest_campaign
-    from sysid.discrepancy import DiscrepancyOptions, discover, flights_series, model_flight, simulation_misfit
+    from sysid.discrepancy import DiscrepancyOptions, discover, flights_series, model_flight
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SysidWarning)
             real = ingest_campaign([Path(log.path)], options=_NO_MANEUVERS).require_flights()
             kind, simulation = _reference(reference, Path(reference).stat().st_mtime_ns)
-            misfit = simulation_misfit(reference) if kind == "model" else None
+            misfit = _misfit(reference, Path(reference).stat().st_mtime_ns) if kind == "model" else None
             if kind == "model":
                 real_series = flights_series(real)
                 sim_series = [model_flight(simulation, s, source=Path(reference).name) for s in real_series]
@@ -268,6 +268,14 @@ def _reference(reference: str, _mtime_ns: int) -> tuple[str, Any]:
     if reference.lower().endswith(".json"):
         return "model", read_model(reference).linear_model(include_wind=False)
     return "flights", tuple(ingest_campaign([Path(reference)], options=_NO_MANEUVERS).require_flights())
+
+
+@lru_cache(maxsize=2)
+def _misfit(reference: str, _mtime_ns: int) -> str | None:
+    """Why the reference model is no close model of its own flights, read once per worker (as :func:`_reference`)."""
+    from sysid.discrepancy import simulation_misfit
+
+    return simulation_misfit(reference)
 
 
 def _folder_name(key: str) -> str:
