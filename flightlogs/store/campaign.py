@@ -12,10 +12,15 @@ from flightlogs.conditioning.align import pair_winds
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions, condition_flight
 from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
 from flightlogs.flightlog import FlightLog
+from flightlogs.parallel import map_forked
 from flightlogs.readers.anemometer import WindMeasurement, read_anemometer_csv
 from flightlogs.readers.dispatch import ReadOptions, read_log
 
 __all__ = ["Campaign", "ingest_campaign", "expand_wind_paths"]
+
+_MAX_FORKED_BYTES = (
+    256 * 2**20
+)  # logs conditioned in worker processes up to this much in all: each sends its result back
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -147,18 +152,27 @@ def ingest_campaign(
         logs.append(read_log(path, progress=report, reading=reading))
     winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
     paired = pair_winds(logs, winds, clock_offset_s=options.wind_offset_s)
+
+    def condition(k: int) -> ConditionedFlight | DataError:
+        try:
+            return condition_flight(logs[k], paired[k], options)
+        except DataError as err:
+            return err
+        finally:
+            give_back_freed_memory()  # segmentation's working arrays, before the next log or the writing
+
+    forked = sum(sizes) <= _MAX_FORKED_BYTES  # larger logs one at a time, each spread over the cores by trace
     conditioned: list[ConditionedFlight | None] = []
     notes: list[tuple[str, ...]] = []
-    for log, wind in zip(logs, paired):
-        try:
-            conditioned.append(condition_flight(log, wind, options))
-            give_back_freed_memory()  # segmentation's working arrays, before the next log or the writing
+    for wind, flight in zip(paired, map_forked(condition, len(logs)) if forked else map(condition, range(len(logs)))):
+        if isinstance(flight, ConditionedFlight):
+            conditioned.append(flight)
             notes.append(())
-        except DataError as err:
-            if wind is not None:
-                raise  # the user asked for wind alignment: its failure is the answer
-            conditioned.append(None)
-            message = f"not conditioned: {err}"
-            warnings.warn(DataQualityWarning(message), stacklevel=2)
-            notes.append((message,))
+            continue
+        if wind is not None:
+            raise flight  # the user asked for wind alignment: its failure is the answer
+        conditioned.append(None)
+        message = f"not conditioned: {flight}"
+        warnings.warn(DataQualityWarning(message), stacklevel=2)
+        notes.append((message,))
     return Campaign(logs=tuple(logs), winds=tuple(winds), conditioned=tuple(conditioned), notes=tuple(notes))

@@ -24,6 +24,7 @@ from scipy import linalg
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import FitError, FitWarning, collected_warnings
+from flightlogs.parallel import map_forked
 from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.record import Record
 from flightlogs.store.dataset import file_sha256
@@ -283,19 +284,20 @@ def _identified(
     if isinstance(structure, str):
         structure = load_structure(structure)
     structure.check_constants(options.constants or {})
-    used: dict[str, list[Record]] = {}
+    used = {axis: records for axis in _AXES if (records := maneuver_records(flights, axis, kind=options.kind))}
+    flown = list(used)
+
+    def axis_responses(k: int) -> tuple[tuple[FrequencyResponse, ...], str | None]:
+        band = maneuver_band(flights, flown[k], kind=options.kind)
+        return _axis_responses(structure, used[flown[k]], flown[k], options, band, quiet_records(flights, flown[k]))
+
     responses: list[FrequencyResponse] = []
     notes: list[str] = []
-    for k, axis in enumerate(_AXES):
-        _report(progress, f"responses {axis}", k, len(_AXES) + 2)
-        records = maneuver_records(flights, axis, kind=options.kind)
-        if records:
-            used[axis] = records
-            band = maneuver_band(flights, axis, kind=options.kind)
-            quiet = quiet_records(flights, axis)
-            found, note = _axis_responses(structure, records, axis, options, band, quiet)
-            responses += found
-            notes += [note] if note is not None else []
+    _report(progress, "responses", 0, len(_AXES) + 2)
+    for k, (found, note) in enumerate(map_forked(axis_responses, len(flown))):  # the axes on the cores
+        _report(progress, f"responses {flown[k]}", k + 1, len(_AXES) + 2)
+        responses += found
+        notes += [note] if note is not None else []
     rule = {"min_coherence": options.min_coherence, "min_decades": options.min_decades}  # eq. 3.8
     gated = gate_responses(responses, **rule)
     axes = structure_axes(structure, flights, used, responses, gated, kind=options.kind, **rule)
@@ -353,8 +355,8 @@ def _identified(
         else:
             notes.append(f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give --wind)")
     _report(progress, "done", len(_AXES) + 2, len(_AXES) + 2)
-    flown = sorted({f"{s.kind} {s.axis} {s.source}" for f in flights for s in f.segments if s.kind == options.kind})
-    provenance = dataclasses.replace(_provenance(files, options), maneuvers=tuple(flown))
+    maneuvers = sorted({f"{s.kind} {s.axis} {s.source}" for f in flights for s in f.segments if s.kind == options.kind})
+    provenance = dataclasses.replace(_provenance(files, options), maneuvers=tuple(maneuvers))
     return model_from_fit(fit, wind, trim=trim, provenance=provenance, notes=notes)
 
 

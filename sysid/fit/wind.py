@@ -43,8 +43,10 @@ from typing import Literal
 
 import numpy as np
 from scipy import linalg, optimize
+from scipy.fft import next_fast_len
 
 from flightlogs.errors import FitError, FitWarning
+from flightlogs.parallel import map_forked
 from flightlogs.record import Record
 from sysid.fit.accuracy import Accuracy, accuracy
 from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
@@ -254,6 +256,7 @@ class _Problem:
         self.columns = [j for j, c in enumerate(self.assembler.channels) if c.wind]
         self.start = np.array([values[n] for n in self.free])
         self._cache: dict[tuple[int, float], list[np.ndarray]] = {}
+        self._stacked: dict[tuple[int, float], np.ndarray] = {}
 
     def shifted(self, k: int, tau: float) -> list[np.ndarray]:
         """Wind channel `k` delayed by `tau`, per record."""
@@ -264,6 +267,15 @@ class _Problem:
             shifted = [np.interp(t - tau, t, w[:, k]) for t, w in zip(self.data.times, self.data.winds)]
             self._cache[key] = [x - x.mean() for x in shifted]  # as the residual: each record's bias taken out
         return self._cache[key]
+
+    def stacked(self, k: int, tau: float) -> np.ndarray:
+        """:meth:`shifted`, the records end to end, shape (n_samples,)."""
+        key = (k, round(float(tau), 12))
+        if key not in self._stacked:
+            if len(self._stacked) > 64:
+                self._stacked.clear()
+            self._stacked[key] = np.concatenate(self.shifted(k, tau))
+        return self._stacked[key]
 
     def parts(self, theta: np.ndarray) -> tuple[SystemMatrices, list[np.ndarray]]:
         m = self.assembler.matrices(theta)
@@ -302,7 +314,7 @@ class _Normal:
     def solve(self, theta: np.ndarray) -> tuple[np.ndarray, float]:
         """Least-squares gains at the delays of `theta` (entries linear in their gains) and the cost."""
         delays = self.problem.assembler.matrices(theta).delays[self.problem.columns]
-        winds = np.column_stack([np.concatenate(self.problem.shifted(k, tau)) for k, tau in enumerate(delays)])
+        winds = np.column_stack([self.problem.stacked(k, tau) for k, tau in enumerate(delays)])
         return self.solve_for(theta, winds, self.residual)
 
     def solve_for(self, theta: np.ndarray, winds: np.ndarray, residual: np.ndarray) -> tuple[np.ndarray, float]:
@@ -361,7 +373,8 @@ def residual_inflation(residual: np.ndarray) -> float:
     factor = 0.0
     for column in residual.T:
         c = column - column.mean()
-        acf = np.fft.irfft(np.abs(np.fft.rfft(c, 2 * c.size)) ** 2)[: c.size]
+        size = next_fast_len(2 * c.size - 1, real=True)  # a 5-smooth length: 2 n may be a large prime's multiple
+        acf = np.fft.irfft(np.abs(np.fft.rfft(c, size)) ** 2, size)[: c.size]
         rho = acf / acf[0] if acf[0] > 0 else np.zeros(1)
         cut = int(np.argmax(rho < 0.05)) if np.any(rho < 0.05) else rho.size
         factor = max(factor, (1.0 + 2.0 * float(np.sum(rho[1:cut]))) * float(np.mean(column**2)))
@@ -900,13 +913,16 @@ def step_one_spread(
     ]
     if not base.names or not moved:
         return {}
-    changes = []
-    for k in moved:
+
+    def change(j: int) -> np.ndarray:
+        k = moved[j]
         nudged = dict(values) | {step_one.names[k]: values[step_one.names[k]] + float(step_one.cramer_rao[k])}
         _, again = speed_derivatives(
             structure, nudged, constants, records, estimated, outputs=outputs, delays=delays, with_accuracy=False
         )
-        changes.append(again.values - base.values if again.names == base.names else np.zeros(len(base.names)))
+        return again.values - base.values if again.names == base.names else np.zeros(len(base.names))
+
+    changes = list(map_forked(change, len(moved)))  # the moves on the cores
     sensitivity = np.array(changes)  # (n_moved, n_joint): the change for a 1-sigma move of each
     correlation = np.nan_to_num(step_one.correlation[np.ix_(moved, moved)], nan=0.0)
     np.fill_diagonal(correlation, 1.0)
@@ -978,11 +994,14 @@ def speed_spread(
     squares: dict[str, float] = {}
     if not any(status == "estimated" for status in base.status.values()):
         return squares  # nothing to move
-    for k, name in enumerate(speed_accuracy.names):
-        bound = float(speed_accuracy.cramer_rao[k])
-        if name not in speed or not math.isfinite(bound) or bound <= 0:
-            continue
-        again = fitted(dict(speed) | {name: speed[name] + bound})
+    moves = [
+        (name, bound)
+        for name, bound in zip(speed_accuracy.names, map(float, speed_accuracy.cramer_rao))
+        if name in speed and math.isfinite(bound) and bound > 0
+    ]
+    for again in map_forked(
+        lambda j: fitted(dict(speed) | {moves[j][0]: speed[moves[j][0]] + moves[j][1]}), len(moves)
+    ):
         for n, status in base.status.items():
             if status == "estimated" and again.status.get(n) == "estimated":
                 squares[n] = squares.get(n, 0.0) + (again.values[n] - base.values[n]) ** 2
