@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -127,6 +128,7 @@ def verification_context(verification: Verification | None, guidelines: Guidelin
         "verification": verification,
         "output_rows": _output_rows(verification.summary, verification.records, guidelines),
         "off_axis_rows": _output_rows(verification.off_axis, verification.records, guidelines, judged=False),
+        "wind_band_hz": next((c.band_hz for c in verification.wind_correction if math.isfinite(c.band_hz)), None),
         "wind_rows": [
             (
                 c.name,
@@ -134,6 +136,7 @@ def verification_context(verification: Verification | None, guidelines: Guidelin
                 c.rmse_without * display_scale(c.unit)[0],
                 c.rmse_with * display_scale(c.unit)[0],
                 c.reduction_percent,
+                c.reduction_in_band_percent,
             )
             for c in verification.wind_correction
         ],

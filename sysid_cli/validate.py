@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
@@ -288,15 +287,7 @@ def _summary(
         "notes": notes,
     }
     if verification.wind_correction:
-        summary["wind_correction"] = {
-            c.name: {
-                "unit": c.unit,
-                "rmse_without": c.rmse_without,
-                "rmse_with": c.rmse_with,
-                "reduction_percent": c.reduction_percent,
-            }
-            for c in verification.wind_correction
-        }
+        summary["wind_correction"] = {c.name: c.to_dict() for c in verification.wind_correction}
     return summary
 
 
@@ -305,12 +296,15 @@ def _print(summary: dict[str, Any]) -> None:
     say(f"{summary['model']}: {len(summary['records'])} records, each judged on the outputs of its axis")
     wind = summary.get("wind_correction", {})
     header = f"  {'output':<8} {'unit':<8} {'RMS error':>10} {'TIC':>6}"
-    say(header + (f" {'without G_w':>12} {'reduction':>9}" if wind else ""))
+    band = next((c["band_hz"] for c in wind.values() if c["band_hz"] is not None), None)
+    in_band = f"< {band:g} Hz" if band is not None else ""
+    say(header + (f" {'without G_w':>12} {'reduction':>9}" + (f" {in_band:>9}" if in_band else "") if wind else ""))
     for name, row in summary["summary"].items():
         line = f"  {name:<8} {row['unit']:<8} {row['rmse']:>10.4g} {row['tic']:>6.2f}"
-        if name in wind:
-            reduction = wind[name]["reduction_percent"]
-            line += f" {wind[name]['rmse_without']:>12.4g} {reduction:>8.1f}%" if math.isfinite(reduction) else ""
+        if name in wind and wind[name]["reduction_percent"] is not None:
+            line += f" {wind[name]['rmse_without']:>12.4g} {wind[name]['reduction_percent']:>8.1f}%"
+            if in_band and wind[name]["reduction_in_band_percent"] is not None:
+                line += f" {wind[name]['reduction_in_band_percent']:>8.1f}%"
         say(line)
     from sysid.verify import mode_names
 

@@ -40,6 +40,7 @@ Per record:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal, cast
@@ -410,6 +411,25 @@ def _pooled(records: Sequence[RecordVerification], *, judged: bool = True) -> tu
     return tuple(summaries)
 
 
+def _pooled_in_wind_band(records: Sequence[RecordVerification]) -> dict[str, float]:
+    """Per judged output, the RMS error pooled over the records after the wind step's own low-pass of the wind.
+
+    The anemometer's wind drives G_w low-passed at :data:`~sysid.fit.wind_offset.SMOOTHING_HZ` (zero
+    phase): filtered the same way, the error keeps what G_w can correct.
+    """
+    from sysid.fit.wind_offset import smoothed
+
+    squares: dict[str, list[float]] = {}
+    for record in records:
+        rate_hz = 1.0 / float(np.median(np.diff(record.time_s))) if record.time_s.size > 1 else math.nan
+        for o in record.judged:
+            error = smoothed((o.measured - o.simulated)[:, None], rate_hz)[:, 0]
+            total = squares.setdefault(o.name, [0.0, 0.0])
+            total[0] += float(np.sum(error**2))
+            total[1] += error.size
+    return {name: math.sqrt(s / n) for name, (s, n) in squares.items() if n > 0}
+
+
 def _overall_pooled(records: Sequence[RecordVerification]) -> tuple[float, float]:
     measured = np.concatenate([o.measured * _weight(o.unit) for r in records for o in r.judged])
     simulated = np.concatenate([o.simulated * _weight(o.unit) for r in records for o in r.judged])
@@ -488,9 +508,20 @@ def verify(
     rmse, tic = _overall_pooled(final)
     if wind_model is None:
         return Verification(records=final, summary=summary, rmse=rmse, tic=tic, off_axis=off_axis)
+    from sysid.fit.wind_offset import SMOOTHING_HZ  # here: sysid.fit loads SciPy's optimisers
+
     before = {s.name: s for s in _pooled(without)}
+    band_without, band_with = _pooled_in_wind_band(without), _pooled_in_wind_band(final)
     corrections = tuple(
-        WindCorrection(name=s.name, unit=s.unit, rmse_without=before[s.name].rmse, rmse_with=s.rmse)
+        WindCorrection(
+            name=s.name,
+            unit=s.unit,
+            rmse_without=before[s.name].rmse,
+            rmse_with=s.rmse,
+            band_hz=SMOOTHING_HZ,
+            rmse_without_in_band=band_without.get(s.name, math.nan),
+            rmse_with_in_band=band_with.get(s.name, math.nan),
+        )
         for s in summary
         if s.name in before
     )

@@ -166,10 +166,7 @@ def verification_to_dict(
         "off_axis": summaries(v.off_axis),
         "records": [_record_to_dict(r) for r in v.records],
         "without_wind": [_record_to_dict(r) for r in v.without_wind],
-        "wind_correction": [
-            {"name": c.name, "unit": c.unit, "rmse_without": _num(c.rmse_without), "rmse_with": _num(c.rmse_with)}
-            for c in v.wind_correction
-        ],
+        "wind_correction": [c.to_dict() for c in v.wind_correction],
         "unverified": list(v.unverified),
     }
 
@@ -261,15 +258,7 @@ def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") ->
             rmse=_float(doc["rmse"]),
             tic=_float(doc["tic"]),
             without_wind=tuple(_record_from_dict(r) for r in doc.get("without_wind", [])),
-            wind_correction=tuple(
-                WindCorrection(
-                    name=c["name"],
-                    unit=c["unit"],
-                    rmse_without=_float(c["rmse_without"]),
-                    rmse_with=_float(c["rmse_with"]),
-                )
-                for c in doc.get("wind_correction", [])
-            ),
+            wind_correction=tuple(WindCorrection.from_dict(c) for c in doc.get("wind_correction", [])),
             off_axis=tuple(_summary_from_dict(s) for s in doc.get("off_axis", [])),
             unverified=tuple(str(text) for text in doc.get("unverified", [])),
         )

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Protocol, TypeVar
+from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
@@ -305,7 +306,7 @@ class OutputSummary:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class WindCorrection:
-    """What the wind term G_w buys on one output (dissertation Table 3.6).
+    """What the wind term G_w buys on one output (dissertation Table 3.6), over all of it and in the wind's band.
 
     Parameters
     ----------
@@ -317,29 +318,80 @@ class WindCorrection:
         Pooled RMS error of the model without G_w, in `unit`.
     rmse_with : float
         Pooled RMS error of the model with G_w, in `unit`.
+    band_hz : float, optional
+        Upper edge of the wind's band, Hz: the wind step low-passes the anemometer's wind there, so
+        G_w predicts nothing above it (NaN: not computed).
+    rmse_without_in_band, rmse_with_in_band : float, optional
+        The same errors low-passed at `band_hz` (zero phase) before pooling, in `unit`: what G_w can
+        correct, without the errors of faster dynamics it cannot (a thrust response's at 2-10 Hz).
 
     Attributes
     ----------
     reduction_percent : float
         ``100 (1 - rmse_with / rmse_without)``: the dissertation's 13-16 % on
         a_x and 7-15 % on a_z (Table 3.6); NaN when `rmse_without` is 0.
+    reduction_in_band_percent : float
+        The same of the errors in the wind's band; NaN when not computed.
 
     Examples
     --------
     >>> strong = WindCorrection(name="ax", unit="m/s^2", rmse_without=0.4129, rmse_with=0.3480)  # Table 3.6, strong wind
     >>> round(strong.reduction_percent, 1)
     15.7
+    >>> WindCorrection.from_dict(strong.to_dict()) == strong
+    True
     """
 
     name: str
     unit: str
     rmse_without: float
     rmse_with: float
+    band_hz: float = math.nan
+    rmse_without_in_band: float = math.nan
+    rmse_with_in_band: float = math.nan
     reduction_percent: float = field(init=False)
+    reduction_in_band_percent: float = field(init=False)
 
     def __post_init__(self) -> None:
-        reduction = 100.0 * (1.0 - self.rmse_with / self.rmse_without) if self.rmse_without > 0 else float("nan")
-        object.__setattr__(self, "reduction_percent", reduction)
+        object.__setattr__(self, "reduction_percent", _reduction(self.rmse_without, self.rmse_with))
+        object.__setattr__(
+            self, "reduction_in_band_percent", _reduction(self.rmse_without_in_band, self.rmse_with_in_band)
+        )
+
+    def to_dict(self) -> dict[str, str | float | None]:
+        """Its JSON form, the same in the verification file and in ``sysid validate --json`` (NaN as null)."""
+        numbers = {
+            "rmse_without": self.rmse_without,
+            "rmse_with": self.rmse_with,
+            "reduction_percent": self.reduction_percent,
+            "band_hz": self.band_hz,
+            "rmse_without_in_band": self.rmse_without_in_band,
+            "rmse_with_in_band": self.rmse_with_in_band,
+            "reduction_in_band_percent": self.reduction_in_band_percent,
+        }
+        return {"name": self.name, "unit": self.unit} | {k: v if math.isfinite(v) else None for k, v in numbers.items()}
+
+    @classmethod
+    def from_dict(cls, doc: Mapping[str, Any]) -> WindCorrection:
+        """Read :meth:`to_dict`'s form (the band's fields may be missing: files written before them)."""
+
+        def number(key: str) -> float:
+            value = doc.get(key)
+            return math.nan if value is None else float(value)
+
+        return cls(
+            name=str(doc["name"]),
+            unit=str(doc["unit"]),
+            rmse_without=number("rmse_without"),
+            rmse_with=number("rmse_with"),
+            band_hz=number("band_hz"),
+            rmse_without_in_band=number("rmse_without_in_band"),
+            rmse_with_in_band=number("rmse_with_in_band"),
+        )
+
+
+def _reduction(without: float, with_: float) -> float:
+    return 100.0 * (1.0 - with_ / without) if without > 0 else math.nan
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -115,9 +115,12 @@ def test_validate_reports_the_wind_correction(flights: tuple[Path, list[Path], l
         assert summary["summary"][name]["tic"] <= 0.25
     assert summary["wind_correction"]["ax"]["reduction_percent"] >= 13.0  # Table 3.6, strong wind
     assert summary["wind_correction"]["ax"]["rmse_with"] < summary["wind_correction"]["ax"]["rmse_without"]
+    ax = summary["wind_correction"]["ax"]  # the same entry as the verification file's (one vocabulary)
+    assert ax["band_hz"] == 2.0 and ax["reduction_in_band_percent"] >= ax["reduction_percent"]
     assert summary["unstable"] is True and summary["summary"]["q"]["one_step_tic"] is not None
     page = report.read_text()  # the model report, with the verification
     assert 'id="verification"' in page and "With and without the wind term" in page
+    assert "change in the wind's band" in page and f"{-ax['reduction_in_band_percent']:+.1f} %" in page
     assert 'id="parameters"' in page and page.count("<svg ") == 1 + 1 + 2  # poles, wind bars, two records
 
 

@@ -171,12 +171,32 @@ def test_the_wind_term_cuts_az_as_much_as_the_true_model_does(outcomes: dict[str
 @pytest.mark.xfail(
     strict=True,
     reason="az cut 19.8 % and 16.1 % on the two ArduPilot cases (77 % and 28 % on PX4); the true parameters "
-    "themselves cut it by 20.8 % and 5.2 % there: on heldout-wind-clock-ap-none no model reaches the floor "
-    "(issue 31 stays open on it; see test_the_wind_term_cuts_az_as_much_as_the_true_model_does)",
+    "themselves cut it by 20.8 % and 5.2 % there: on heldout-wind-clock-ap-none no model reaches the floor. "
+    "In the wind's band (below 2 Hz) the fitted model cuts az by 37-85 % on all four: the error left is the "
+    "thrust response's at 2-10 Hz (issue 31 stays open on the whole-band floor; see "
+    "test_the_wind_term_cuts_az_as_much_as_the_true_model_does)",
 )
 def test_the_wind_term_cuts_every_cases_az_error_by_20_percent(outcomes: dict[str, _Outcome]) -> None:
     cuts = {n: o.validation["wind_correction"]["az"]["reduction_percent"] for n, o in outcomes.items()}
     assert min(cuts.values()) >= 20.0, cuts
+
+
+@pytest.mark.slow
+def test_in_the_winds_band_the_wind_term_cuts_every_cases_ax_and_az_error_by_20_percent(
+    outcomes: dict[str, _Outcome],
+) -> None:
+    """The errors low-passed as the wind step low-passes the anemometer's wind (2 Hz): what G_w can correct.
+
+    Measured, fitted model (true parameters): ax 83.7 (83.9), 83.7 (83.0), 91.7 (91.7), 86.2 (83.4) %; az 41.3
+    (38.4), 84.5 (84.8), 37.0 (52.0), 50.1 (35.4) % on ap-ahead, px4-behind, px4-slight, ap-none. Over the
+    whole band the az cut is 19.8, 77.1, 28.0 and 16.1 %: on the ArduPilot cases the heave doublets' az error
+    is mostly the thrust response's at 2-10 Hz (on ap-none 0.20 of the 0.25 m/s² left, 0.09 below 2 Hz),
+    which no wind term predicts."""
+    for name, outcome in outcomes.items():
+        correction = outcome.validation["wind_correction"]
+        for output in ("ax", "az"):
+            assert correction[output]["band_hz"] == 2.0, correction[output]
+            assert correction[output]["reduction_in_band_percent"] >= 20.0, (name, output, correction[output])
 
 
 def _inside_2_cr(outcome: _Outcome, term: str) -> bool:

@@ -614,6 +614,9 @@ def test_wind_term_reduces_the_error_on_strong_wind_doublets(strong_flights: lis
     assert result.correction("ax").reduction_percent >= 13.0
     assert result.correction("az").reduction_percent >= 7.0
     assert result.correction("ay").reduction_percent == pytest.approx(0.0)  # no lateral wind term in the truth
+    for name in ("ax", "az"):  # G_w predicts below the wind's low-pass only: there it cuts more (ax 89.7 -> 94.5 %,
+        correction = result.correction(name)  # az 90.9 -> 96.5 %: the error it leaves is the sensors' noise)
+        assert correction.band_hz == 2.0 and correction.reduction_in_band_percent > correction.reduction_percent
     for name in ("u", "q", "theta", "ax", "w", "az"):
         assert result.output(name).tic <= 0.25
     assert len(result.without_wind) == len(result.records) == 12
@@ -633,3 +636,57 @@ def test_with_exactly_held_inputs_the_residual_is_the_sensor_noise() -> None:
     result = verify(truth_models()["thr"], records)
     ratio = result.output("az").rmse / 0.05
     assert abs(ratio - np.sqrt(1 - 2 / n)) < 4 / np.sqrt(2 * n)
+
+
+def test_the_error_in_the_winds_band_is_the_error_low_passed_as_the_wind_is() -> None:
+    """An error of a 0.3 Hz sine (the wind's band) and a 7 Hz one (a thrust response's): in the band, the first alone.
+
+    The wind step's low-pass (4th-order Butterworth at 2 Hz, zero phase) passes 0.3 Hz with a gain of
+    1 - 1e-7 and 7 Hz with 4e-5: the pooled in-band RMS is the slow sine's, a / sqrt(2), within the
+    filter's edge transients over 20 s; records at 100 and 400 Hz pool by their samples.
+    """
+    from sysid.verify import OutputVerification
+    from sysid.verify.engine import _pooled_in_wind_band
+
+    def record(rate_hz: float, slow: float, fast: float) -> RecordVerification:
+        t = np.arange(0.0, 20.0, 1.0 / rate_hz)
+        error = slow * np.sin(2 * np.pi * 0.3 * t) + fast * np.sin(2 * np.pi * 7.0 * t)
+        out = OutputVerification(
+            name="az", unit="m/s^2", measured=error, simulated=np.zeros(t.size), bias=0.0, rmse=0.0, tic=0.0
+        )
+        return RecordVerification(
+            label="r",
+            source=Path("f.bin"),
+            time_s=t,
+            inputs=("delta_thr",),
+            outputs=(out,),
+            reference_shifts={},
+            rmse=0.0,
+            tic=0.0,
+            growth=1.0,
+            unstable=False,
+        )
+
+    (rms,) = _pooled_in_wind_band([record(100.0, 0.4, 0.3)]).values()
+    assert rms == pytest.approx(0.4 / np.sqrt(2), rel=2e-3)
+    pooled = _pooled_in_wind_band([record(100.0, 0.4, 0.3), record(400.0, 0.2, 0.5)])["az"]
+    assert pooled == pytest.approx(np.sqrt((2000 * 0.4**2 + 8000 * 0.2**2) / 2 / 10000), rel=2e-3)
+
+
+def test_the_wind_correction_round_trips_with_its_band() -> None:
+    from sysid.verify import WindCorrection
+
+    correction = WindCorrection(
+        name="az",
+        unit="m/s^2",
+        rmse_without=0.29,
+        rmse_with=0.243,
+        band_hz=2.0,
+        rmse_without_in_band=0.27,
+        rmse_with_in_band=0.135,
+    )
+    assert correction.reduction_in_band_percent == pytest.approx(50.0)
+    assert WindCorrection.from_dict(correction.to_dict()) == correction
+    older = {"name": "az", "unit": "m/s^2", "rmse_without": 0.29, "rmse_with": 0.243}  # a file from before the band
+    assert np.isnan(WindCorrection.from_dict(older).reduction_in_band_percent)
+    assert WindCorrection.from_dict(older).to_dict()["reduction_in_band_percent"] is None
