@@ -284,7 +284,7 @@ def model_report_html(
     verdict = model_verdict(model, verification) if verdict is None else verdict
     linear = model.linear_model(include_wind=False)
     found = modes(linear)
-    min_coherence = model.provenance.options.get("min_coherence")
+    gating = model.gating
     estimated = [k for k, name in enumerate(model.correlation_names) if model.parameter(name).status == "estimated"]
     names = [model.correlation_names[k] for k in estimated]
     matrix = model.correlation[np.ix_(estimated, estimated)] if estimated else np.zeros((0, 0))
@@ -298,7 +298,7 @@ def model_report_html(
         "bode": [
             _shown(f, caption)
             for f, caption in response_figures(
-                model, min_coherence=float(min_coherence) if isinstance(min_coherence, (int, float)) else None
+                model, min_coherence=gating.min_coherence if gating is not None else None
             )
         ],
         "parameters": _parameter_rows(model, verdict.guidelines),

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import importlib
+import inspect
 import os
 import sys
 from collections.abc import Callable, Iterator
@@ -19,6 +22,7 @@ from flightlogs.writers.jsonio import json_text, write_json
 from ._warnings import QUIET
 
 __all__ = [
+    "LibraryDefault",
     "OutputPath",
     "SysidCommand",
     "json_option",
@@ -28,6 +32,36 @@ __all__ = [
     "progress_bar",
     "staged_progress",
 ]
+
+
+class LibraryDefault(click.Option):
+    """An option whose default is the library's own: a field of a dataclass's defaults, or of a constant.
+
+    ``default_from=("sysid.freqresp", "Gating", "min_coherence")`` reads the default ``Gating`` declares;
+    ``("sysid.fit", "DEFAULT_GUIDELINES", "max_cr_percent")`` reads the constant's field, and
+    ``("sysid.verify", "doublet_records", "before_s")`` the function's keyword default. The value has
+    one owner, the library; the module is imported when the default is needed (a run, or ``--help``),
+    not with the command line.
+    """
+
+    def __init__(self, *args: Any, default_from: tuple[str, str, str], **kwargs: Any) -> None:
+        super().__init__(*args, default=None, **kwargs)
+        self.default_from = default_from
+
+    def get_default(self, ctx: click.Context, call: bool = True) -> Any:
+        value = super().get_default(ctx, call=call)
+        if value is None:
+            module, name, field = self.default_from
+            owner = getattr(importlib.import_module(module), name)
+            if isinstance(owner, type):  # a dataclass: the field's declared default
+                (declared,) = [f for f in dataclasses.fields(owner) if f.name == field]
+                assert declared.default is not dataclasses.MISSING, f"{name}.{field} declares no default"
+                value = declared.default
+            elif callable(owner):  # a function: its keyword's default
+                value = inspect.signature(owner).parameters[field].default
+            else:
+                value = getattr(owner, field)
+        return value
 
 
 class OutputPath(click.Path):

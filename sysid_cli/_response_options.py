@@ -8,7 +8,9 @@ from typing import Any
 
 import click
 
-__all__ = ["windows_option"]
+from ._common import LibraryDefault
+
+__all__ = ["gating_options", "windows_option"]
 
 _Decorator = Callable[[Callable[..., Any]], Callable[..., Any]]
 
@@ -36,3 +38,28 @@ def windows_option() -> _Decorator:
         metavar="S,S,...",
         help="Window lengths, s (default: five from 2π/(5·omega-min) to half the longest record).",
     )
+
+
+def gating_options() -> _Decorator:
+    """``--min-coherence`` and ``--min-decades``: the gating rule of eq. 3.8, defaults :class:`sysid.freqresp.Gating`'s.
+
+    The command receives ``min_coherence`` and ``min_decades``; ``Gating(min_coherence=..., min_decades=...)``
+    checks them.
+    """
+    coherence = click.option(
+        "--min-coherence",
+        type=click.FloatRange(0.0, 1.0, min_open=True, max_open=True),
+        cls=LibraryDefault,
+        default_from=("sysid.freqresp", "Gating", "min_coherence"),
+        show_default=True,
+        help="Coherence γ² a response's fit range must keep (eq. 3.8; 0.6 for noisy data).",
+    )
+    decades = click.option(
+        "--min-decades",
+        type=click.FloatRange(min=0, min_open=True),
+        cls=LibraryDefault,
+        default_from=("sysid.freqresp", "Gating", "min_decades"),
+        show_default=True,
+        help="Shortest fit range, decades (eq. 3.8).",
+    )
+    return lambda command: coherence(decades(command))

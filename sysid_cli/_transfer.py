@@ -35,9 +35,8 @@ def fit_transfer(
     band: tuple[float, float] | None,
     windows: tuple[float, ...] | None,
     kind: str,
-    min_coherence: float,
-    max_cr: float,
-    max_insensitivity: float,
+    gating: Any,
+    guidelines: Any,
     sources: Sequence[Path],
     out: Path | None,
     report: Path | None,
@@ -60,10 +59,10 @@ def fit_transfer(
         ``--windows``: the composite's window lengths, s.
     kind : str
         Maneuvers used.
-    min_coherence : float
-        Gating threshold.
-    max_cr, max_insensitivity : float
-        The guidelines the fits are judged by, % (``--max-cr``, ``--max-insensitivity``).
+    gating : Gating
+        The gating rule (``--min-coherence``, ``--min-decades``).
+    guidelines : Guidelines
+        The guidelines the fits are judged by (``--max-cr``, ``--max-insensitivity``).
     sources : sequence of Path
         The files read.
     out, report : Path or None
@@ -74,7 +73,6 @@ def fit_transfer(
         No table.
     """
     from flightlogs.writers.jsonio import write_json
-    from sysid.fit.guidelines import Guidelines
     from sysid.fit.transfer import TransferOptions, fit_transfer_functions
     from sysid.freqresp import ResponseOptions
     from sysid.model.transfer import parse_transfer_function
@@ -86,11 +84,11 @@ def fit_transfer(
         options=TransferOptions(
             delay=delay,
             band_rad_s=band,
-            guidelines=Guidelines(max_cr_percent=max_cr, max_insensitivity_percent=max_insensitivity),
+            guidelines=guidelines,
         ),
         responses=ResponseOptions(window_lengths_s=windows),
         kind=kind,
-        min_coherence=min_coherence,
+        gating=gating,
     )
     summary: dict[str, Any] = {
         "tf": [fit.to_dict() for fit in fits],

@@ -17,23 +17,24 @@ Examples:
   sysid demo --discrepancy -o /tmp/gap-demo
 """
 
-#: The demo's verification: VERIFY's bias, reference shift and initial state estimated together (the bare
-#: airframe is unstable open loop, so a measured initial state alone lets small errors grow), the
-#: records cut as ``sysid validate`` cuts them by default.
-_BEFORE_S, _AFTER_S = 0.5, 1.0
-
 
 def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
-    """Verify the model (with and without G_w) on the dataset's doublets, save it, and say how it went."""
+    """Verify the model (with and without G_w) on the dataset's doublets, save it, and say how it went.
+
+    VERIFY's bias, reference shift and initial state are estimated together (the bare airframe is unstable
+    open loop, so a measured initial state alone lets small errors grow); the records are cut as
+    ``sysid validate`` cuts them by default.
+    """
     from flightlogs.store.dataset import read_dataset
     from sysid.fit import read_model
     from sysid.verify import VerificationOptions, axis_outputs, doublet_records, verify
     from sysid.verify.io import write_verification
+    from sysid.verify.records import AFTER_S, BEFORE_S
 
     identified = read_model(model_path)
     model, with_wind = identified.linear_model(include_wind=False), identified.linear_model(include_wind=True)
     flights = list(read_dataset(dataset).conditioned)
-    cut = doublet_records(flights, before_s=_BEFORE_S, after_s=_AFTER_S)
+    cut = doublet_records(flights)
     verification = verify(
         model,
         cut.records,
@@ -44,8 +45,8 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
     )
     options = {
         "initial_state": "estimated",
-        "before_s": _BEFORE_S,
-        "after_s": _AFTER_S,
+        "before_s": BEFORE_S,
+        "after_s": AFTER_S,
         "inputs": "all measured",
         "judged": "on-axis outputs of each doublet's axis",
         "dataset": dataset.name,

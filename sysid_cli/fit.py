@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import click
 
-from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
+from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option, staged_progress
 from ._flights import check_sources, conditioned_flights, dataset_flights, reading_from, reading_options
-from ._response_options import windows_option
+from ._response_options import gating_options, windows_option
 from ._transfer import fit_transfer, parse_band
 from ._wind_options import (
     anemometer_at_option,
@@ -51,25 +52,6 @@ def parse_assignments(_ctx: click.Context, _param: click.Parameter, value: tuple
             if not sep or not name.strip() or not math.isfinite(found[name.strip()]):
                 raise click.BadParameter(f"{part!r} is not NAME=VALUE with a finite value")
     return found
-
-
-class _GuidelineOption(click.Option):
-    """A number option whose default is a limit of :data:`sysid.fit.DEFAULT_GUIDELINES` (Tischler's).
-
-    The guidelines are imported when the default is needed (a run, or ``sysid fit --help``), not with the CLI.
-    """
-
-    def __init__(self, *args: Any, guideline: str, **kwargs: Any) -> None:
-        super().__init__(*args, default=None, **kwargs)
-        self.guideline = guideline
-
-    def get_default(self, ctx: click.Context, call: bool = True) -> Any:
-        value = super().get_default(ctx, call=call)
-        if value is None:
-            from sysid.fit import DEFAULT_GUIDELINES
-
-            value = getattr(DEFAULT_GUIDELINES, self.guideline)
-        return value
 
 
 @click.command(cls=SysidCommand, epilog=_EPILOG)
@@ -116,23 +98,24 @@ class _GuidelineOption(click.Option):
 @click.option(
     "--starts",
     type=click.IntRange(min=1),
-    default=1,
+    cls=LibraryDefault,
+    default_from=("sysid.fit", "FitOptions", "starts"),
     show_default=True,
     help="Starting points of the search (more guard against local minima).",
 )
 @click.option("--no-reduce", is_flag=True, help="Keep every parameter (no structure reduction).")
 @click.option(
     "--max-cr",
-    cls=_GuidelineOption,
-    guideline="max_cr_percent",
+    cls=LibraryDefault,
+    default_from=("sysid.fit", "DEFAULT_GUIDELINES", "max_cr_percent"),
     type=click.FloatRange(min=0, min_open=True),
     show_default=True,
     help="Cramér–Rao bound guideline, % of the value (reduction and the report's verdict).",
 )
 @click.option(
     "--max-insensitivity",
-    cls=_GuidelineOption,
-    guideline="max_insensitivity_percent",
+    cls=LibraryDefault,
+    default_from=("sysid.fit", "DEFAULT_GUIDELINES", "max_insensitivity_percent"),
     type=click.FloatRange(min=0, min_open=True),
     show_default=True,
     help="Insensitivity guideline, % of the value (reduction and the report's verdict).",
@@ -144,13 +127,7 @@ class _GuidelineOption(click.Option):
     metavar="R",
     help="Also remove one of two parameters correlated beyond |R| (default: correlation not used).",
 )
-@click.option(
-    "--min-coherence",
-    type=click.FloatRange(0, 1, min_open=True, max_open=True),
-    default=0.5,
-    show_default=True,
-    help="Gating threshold on the coherence (eq. 3.8).",
-)
+@gating_options()
 @click.option(
     "--partial",
     is_flag=True,
@@ -194,6 +171,7 @@ def fit(
     max_insensitivity: float,
     max_correlation: float | None,
     min_coherence: float,
+    min_decades: float,
     partial: bool,
     tf_texts: tuple[str, ...],
     delay: bool,
@@ -213,6 +191,7 @@ def fit(
     --partial: a parameter no response informs is unidentified, never given a value."""
     from flightlogs.conditioning.condition import ConditioningOptions
     from sysid.fit import (
+        DEFAULT_GUIDELINES,
         FitOptions,
         IdentifyOptions,
         fit_summary,
@@ -221,8 +200,11 @@ def fit(
         write_mat,
         write_model,
     )
-    from sysid.freqresp import ResponseOptions
+    from sysid.freqresp import Gating, ResponseOptions
     from sysid.model import load_structure
+
+    gating = Gating(min_coherence=min_coherence, min_decades=min_decades)
+    guidelines = replace(DEFAULT_GUIDELINES, max_cr_percent=max_cr, max_insensitivity_percent=max_insensitivity)
 
     log_only = {
         "--wind": wind_paths,
@@ -255,9 +237,8 @@ def fit(
             band=band,
             windows=windows,
             kind=kind,
-            min_coherence=min_coherence,
-            max_cr=max_cr,
-            max_insensitivity=max_insensitivity,
+            gating=gating,
+            guidelines=guidelines,
             sources=list(logs),
             out=out,
             report=report,
@@ -273,12 +254,11 @@ def fit(
         fit=FitOptions(
             starts=starts,
             reduce=not no_reduce,
-            max_cr_percent=max_cr,
-            max_insensitivity_percent=max_insensitivity,
+            guidelines=guidelines,
             max_correlation=max_correlation,
         ),
         kind=kind,
-        min_coherence=min_coherence,
+        gating=gating,
         constants=constants or None,
         initial=initial or None,
         partial=partial,

@@ -7,10 +7,12 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, SysidCommand, emit_json, json_option
+from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option
 from ._flights import conditioned_flights, reading_from, reading_options
-from ._response_options import windows_option
+from ._response_options import gating_options, windows_option
 from ._wind_options import segments_from, segments_option, wind_distance_option, wind_offset_option, wind_option
+
+_RESPONSES = ("sysid.freqresp", "ResponseOptions")  # the grid options' defaults are the library's
 
 __all__ = ["freqresp"]
 
@@ -73,42 +75,37 @@ def _pairs(_ctx: click.Context, _param: click.Parameter, value: str | None) -> t
 @click.option(
     "--omega-min",
     type=click.FloatRange(min=0, min_open=True),
-    default=0.5,
+    cls=LibraryDefault,
+    default_from=_RESPONSES + ("omega_min",),
     show_default=True,
     help="Lowest frequency, rad/s.",
 )
 @click.option(
     "--omega-max",
     type=click.FloatRange(min=0, min_open=True),
-    default=70.0,
+    cls=LibraryDefault,
+    default_from=_RESPONSES + ("omega_max",),
     show_default=True,
     help="Highest frequency, rad/s.",
 )
 @click.option(
-    "--n-freq", type=click.IntRange(min=2), default=150, show_default=True, help="Points of the log-spaced grid."
+    "--n-freq",
+    type=click.IntRange(min=2),
+    cls=LibraryDefault,
+    default_from=_RESPONSES + ("n_freq",),
+    show_default=True,
+    help="Points of the log-spaced grid.",
 )
 @windows_option()
 @click.option(
     "--overlap",
     type=click.FloatRange(0.0, 0.95, max_open=True),
-    default=0.8,
+    cls=LibraryDefault,
+    default_from=_RESPONSES + ("overlap",),
     show_default=True,
     help="Window overlap, fraction.",
 )
-@click.option(
-    "--min-coherence",
-    type=click.FloatRange(0.0, 1.0, min_open=True, max_open=True),
-    default=0.5,
-    show_default=True,
-    help="Coherence γ² a fit range must keep (0.6 for noisy data).",
-)
-@click.option(
-    "--min-decades",
-    type=click.FloatRange(min=0, min_open=True),
-    default=0.3,
-    show_default=True,
-    help="Shortest fit range, decades.",
-)
+@gating_options()
 @click.option(
     "--reference",
     default="auto",
@@ -158,7 +155,7 @@ def freqresp(
 ) -> None:
     """Compute composite (multi-window, chirp-z) frequency responses from the maneuvers of a DATASET
     (`sysid ingest -o`) or of LOGs ingested on the fly, gate them by coherence, and write them."""
-    from sysid.freqresp import ResponseOptions, flight_responses, gate_responses, write_responses
+    from sysid.freqresp import Gating, ResponseOptions, flight_responses, gate_responses, write_responses
 
     forced = None if reference in ("auto", "none") else reference
     if omega_min >= omega_max:
@@ -172,11 +169,10 @@ def freqresp(
             n_freq=n_freq,
             window_lengths_s=windows,
             overlap=overlap,
-            min_coherence=min_coherence,
-            min_decades=min_decades,
             reference=forced,
             whole_record=whole_record,
         )
+        gating = Gating(min_coherence=min_coherence, min_decades=min_decades)
     except ValueError as err:
         raise click.UsageError(str(err)) from None
     from flightlogs.conditioning.condition import ConditioningOptions
@@ -201,7 +197,7 @@ def freqresp(
     computed = flight_responses(
         flights, pairs, axis=axis, kind=kind, options=options, use_excitation=reference != "none"
     )
-    gated = gate_responses(computed.responses, min_coherence=min_coherence, min_decades=min_decades)
+    gated = gate_responses(computed.responses, gating)
     kept = {response.pair: response for response in gated.kept}
     ordered = [kept.get(response.pair, response) for response in computed.responses]
     if plot is not None:
@@ -210,7 +206,7 @@ def freqresp(
         write_bode_svg(plot, ordered, min_coherence=min_coherence)
     if out is not None:
         write_responses(out, ordered)
-    summary = _summary(ordered, gated.dropped, dict(computed.pieces), options, out, plot) | {
+    summary = _summary(ordered, gated.dropped, dict(computed.pieces), options, gating, out, plot) | {
         "notes": list(computed.notes)
     }
     if not quiet:
@@ -223,6 +219,7 @@ def _summary(
     dropped: tuple[Any, ...],
     pieces: dict[str, int],
     options: Any,
+    gating: Any,
     out: Path | None,
     plot: Path | None,
 ) -> dict[str, Any]:
@@ -258,8 +255,8 @@ def _summary(
             "omega_max": options.omega_max,
             "n_freq": options.n_freq,
             "overlap": options.overlap,
-            "min_coherence": options.min_coherence,
-            "min_decades": options.min_decades,
+            "min_coherence": gating.min_coherence,
+            "min_decades": gating.min_decades,
             "reference": options.reference,
             "whole_record": options.whole_record,
         },

@@ -9,9 +9,11 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
+from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option, progress_bar
 from ._flights import reading_from, reading_options
 from .ingest import parse_columns
+
+_CONFIG = ("sysid.groundeffect.records", "GroundEffectDataConfig")  # the flight options' defaults are the library's
 
 __all__ = ["ground_effect"]
 
@@ -97,7 +99,8 @@ def _data_options(command: Callable[..., Any]) -> Callable[..., Any]:
         click.option(
             "--kf",
             type=click.FloatRange(min=0, min_open=True),
-            default=2.083e-6,
+            cls=LibraryDefault,
+            default_from=_CONFIG + ("kf_n_per_count",),
             show_default=True,
             metavar="N",
             help="Flight: k_f of eq. 2.6, N per PWM count (Table 2.1).",
@@ -111,14 +114,16 @@ def _data_options(command: Callable[..., Any]) -> Callable[..., Any]:
         click.option(
             "--pwm-full-scale",
             type=click.FloatRange(min=0, min_open=True),
-            default=65535.0,
+            cls=LibraryDefault,
+            default_from=_CONFIG + ("pwm_full_scale",),
             show_default=True,
             help="Flight: PWM counts of a full command, for motors logged as 0..1.",
         ),
         click.option(
             "--rotor-offset",
             type=float,
-            default=0.0,
+            cls=LibraryDefault,
+            default_from=_CONFIG + ("rotor_offset_m",),
             show_default=True,
             metavar="M",
             help="Flight: rotor plane above the height sensor's reference, m.",
@@ -126,7 +131,8 @@ def _data_options(command: Callable[..., Any]) -> Callable[..., Any]:
         click.option(
             "--min-hold",
             type=click.FloatRange(min=0, min_open=True),
-            default=6.0,
+            cls=LibraryDefault,
+            default_from=_CONFIG + ("min_hold_s",),
             show_default=True,
             metavar="S",
             help="Flight: shortest hover step, s (its second half is used).",
@@ -140,14 +146,16 @@ def _data_options(command: Callable[..., Any]) -> Callable[..., Any]:
         click.option(
             "--criterion",
             type=click.Choice(["aicc", "bic"]),
-            default="aicc",
+            cls=LibraryDefault,
+            default_from=("sysid.groundeffect.fitting", "FitConfig", "criterion"),
             show_default=True,
             help="Model selection: corrected Akaike or Bayesian information criterion.",
         ),
         click.option(
             "--confidence",
             type=click.FloatRange(0, 1, min_open=True, max_open=True),
-            default=0.95,
+            cls=LibraryDefault,
+            default_from=("sysid.groundeffect.fitting", "FitConfig", "confidence"),
             show_default=True,
             help="Level of the parameter confidence intervals.",
         ),
@@ -238,7 +246,8 @@ def fit(data: Path, out: Path | None, report: Path | None, json_path: str | None
 @click.option(
     "--rotors",
     type=click.IntRange(min=2),
-    default=4,
+    cls=LibraryDefault,
+    default_from=("sysid.groundeffect.spacing", "spacing_study", "rotors"),
     show_default=True,
     help="Rotors running: 2 reports rho of eq. 2.2; more compares piecewise linear with eq. 2.2.",
 )

@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
+from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option, progress_bar
 
 __all__ = ["mrac"]
 
@@ -66,7 +66,8 @@ def mrac() -> None:
 @click.option(
     "--trials",
     type=click.IntRange(min=1),
-    default=3,
+    cls=LibraryDefault,
+    default_from=("simulator.mrac.compare", "CompareConfig", "trials"),
     show_default=True,
     help="Trials per case and controller (they differ by the noise seed).",
 )
@@ -74,7 +75,8 @@ def mrac() -> None:
 @click.option(
     "--pid-phase",
     type=click.FloatRange(min=2.0),
-    default=40.0,
+    cls=LibraryDefault,
+    default_from=("simulator.mrac.compare", "CompareConfig", "pid_phase_s"),
     show_default=True,
     metavar="S",
     help="Length of the PID's take-off and of its landing, s.",
@@ -82,7 +84,8 @@ def mrac() -> None:
 @click.option(
     "--mrac-phase",
     type=click.FloatRange(min=2.0),
-    default=20.0,
+    cls=LibraryDefault,
+    default_from=("simulator.mrac.compare", "CompareConfig", "mrac_phase_s"),
     show_default=True,
     metavar="S",
     help="Length of each MRAC phase, s.",

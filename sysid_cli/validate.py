@@ -7,7 +7,7 @@ from typing import Any
 
 import click
 
-from ._common import OutputPath, SysidCommand, emit_json, json_option
+from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option
 from ._flights import conditioned_flights, is_dataset, reading_from, reading_options
 from ._wind_options import (
     segments_from,
@@ -42,7 +42,8 @@ Examples:
     "--before",
     "before_s",
     type=click.FloatRange(min=0),
-    default=0.5,
+    cls=LibraryDefault,
+    default_from=("sysid.verify", "doublet_records", "before_s"),
     show_default=True,
     metavar="S",
     help="Quiet stretch kept before each doublet, s.",
@@ -51,7 +52,8 @@ Examples:
     "--after",
     "after_s",
     type=click.FloatRange(min=0),
-    default=1.0,
+    cls=LibraryDefault,
+    default_from=("sysid.verify", "doublet_records", "after_s"),
     show_default=True,
     metavar="S",
     help="Response kept after each doublet, s (an unstable model diverges over long records).",

@@ -19,7 +19,7 @@ from typing import Literal
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.record import Record
 from sysid.freqresp import FrequencyResponse
-from sysid.freqresp.gating import DroppedResponse, GatingResult
+from sysid.freqresp.gating import DroppedResponse, Gating, GatingResult
 from sysid.model.structure import ModelStructure
 
 __all__ = [
@@ -111,8 +111,7 @@ def diagnose_axis(
     records: Sequence[Record],
     responses: Sequence[FrequencyResponse],
     dropped: Sequence[DroppedResponse],
-    min_coherence: float,
-    min_decades: float,
+    gating: Gating,
     segments_hint: str = "give the maneuvers with --segments",
 ) -> AxisStatus:
     """The status of one axis from what the identification found for it, before the fit.
@@ -131,7 +130,7 @@ def diagnose_axis(
         The responses computed from them (of `signal`).
     dropped : sequence of DroppedResponse
         Those of `responses` that gating dropped, with the reason.
-    min_coherence, min_decades : float
+    gating : Gating
         The gating rule of eq. 3.8 (gamma^2 and decades).
     segments_hint : str, optional
         How to give maneuvers that were not detected.
@@ -180,7 +179,7 @@ def diagnose_axis(
         input=signal,
         status="unidentified",
         reason=f"{_plural(len(records), kind)} {in_logs}, but no response passed the coherence gating "
-        f"(γ² ≥ {min_coherence:g} over ≥ {min_decades:g} decade): {why}",
+        f"(γ² ≥ {gating.min_coherence:g} over ≥ {gating.min_decades:g} decade): {why}",
         remedy=f"fly a longer or stronger {kind} on this axis, or lower --min-coherence",
     )
 
@@ -193,8 +192,7 @@ def structure_axes(
     gated: GatingResult,
     *,
     kind: str,
-    min_coherence: float,
-    min_decades: float,
+    gating: Gating,
 ) -> tuple[AxisStatus, ...]:
     """:func:`diagnose_axis` for every control input of `structure`, in its order.
 
@@ -212,7 +210,7 @@ def structure_axes(
         What gating kept and dropped.
     kind : str
         Maneuver kind fitted.
-    min_coherence, min_decades : float
+    gating : Gating
         The gating rule of eq. 3.8.
 
     Returns
@@ -228,8 +226,7 @@ def structure_axes(
             records=records.get(axis_name(signal), ()),
             responses=[r for r in responses if r.input == signal],
             dropped=[d for d in gated.dropped if d.input == signal],
-            min_coherence=min_coherence,
-            min_decades=min_decades,
+            gating=gating,
         )
         for signal in signals
     )

@@ -61,24 +61,17 @@ class FitOptions:
         Seed of the extra starting points.
     reduce : bool
         Run structure reduction after the first fit.
-    max_cr_percent : float
-        CR% guideline, % of ``|value|``; default Tischler's (:data:`~sysid.fit.guidelines.DEFAULT_GUIDELINES`).
-    max_insensitivity_percent : float
-        I% guideline, % of ``|value|``; default Tischler's.
+    guidelines : Guidelines
+        The guidelines the fit applies and its model is judged by: the CR% and I% limits (% of ``|value|``)
+        reduction removes parameters beyond, and the J margins a reduction step keeps within; default
+        Tischler's (:data:`~sysid.fit.guidelines.DEFAULT_GUIDELINES`).
     max_correlation : float or None
         Also remove one of a pair correlated beyond this; None to ignore.
     max_steps : int
         Most parameters reduction may remove.
     reduction_cost_check : bool
-        Take a reduction step only if the costs stay within the margins
-        below; False removes every parameter that misses CR% or I%, whatever
-        the cost.
-    reduction_j_average_rise_percent : float
-        Largest rise of J_ave a reduction step may cause, % (Tischler's 2).
-    reduction_j_response_rise_percent : float
-        Largest rise of one response's J a reduction step may cause, %.
-    reduction_j_rise_floor : float
-        A rise of J up to this counts as none (cost units).
+        Take a reduction step only if the costs stay within the guidelines' margins;
+        False removes every parameter that misses CR% or I%, whatever the cost.
     max_evaluations : int
         Most cost evaluations per fit.
     jacobian : {"analytic", "numeric"}
@@ -91,14 +84,10 @@ class FitOptions:
     starts: int = 1
     seed: int = 0
     reduce: bool = True
-    max_cr_percent: float = DEFAULT_GUIDELINES.max_cr_percent
-    max_insensitivity_percent: float = DEFAULT_GUIDELINES.max_insensitivity_percent
+    guidelines: Guidelines = DEFAULT_GUIDELINES
     max_correlation: float | None = None
     max_steps: int = 30
     reduction_cost_check: bool = True
-    reduction_j_average_rise_percent: float = DEFAULT_GUIDELINES.reduction_j_average_rise_percent
-    reduction_j_response_rise_percent: float = DEFAULT_GUIDELINES.reduction_j_response_rise_percent
-    reduction_j_rise_floor: float = DEFAULT_GUIDELINES.reduction_j_rise_floor
     max_evaluations: int = 300
     jacobian: Literal["analytic", "numeric"] = "analytic"
     rescale_controls: bool = True
@@ -106,20 +95,8 @@ class FitOptions:
     def __post_init__(self) -> None:
         if self.starts < 1:
             raise ValueError(f"starts={self.starts} must be at least 1")
-        _ = self.guidelines  # the CR% and I% limits and the reduction margins must be positive
         if self.jacobian not in ("analytic", "numeric"):
             raise ValueError(f"jacobian={self.jacobian!r} must be 'analytic' or 'numeric'")
-
-    @property
-    def guidelines(self) -> Guidelines:
-        """The guidelines of this fit: its CR% and I% limits and reduction margins, Tischler's for the rest."""
-        return Guidelines(
-            max_cr_percent=self.max_cr_percent,
-            max_insensitivity_percent=self.max_insensitivity_percent,
-            reduction_j_average_rise_percent=self.reduction_j_average_rise_percent,
-            reduction_j_response_rise_percent=self.reduction_j_response_rise_percent,
-            reduction_j_rise_floor=self.reduction_j_rise_floor,
-        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

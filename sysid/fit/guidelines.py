@@ -28,7 +28,7 @@ _ORDER: dict[str, int] = {"good": 0, "acceptable": 1, "poor": 2}
 #: A fit that estimated fewer than this fraction of the structure's free parameters (the others dropped or
 #: unidentified) says little about the structure, whatever its costs: it is not judged good.
 MIN_ESTIMATED_FRACTION = 0.5
-#: The limits a fit applies (``FitOptions`` fields of the same names), as the model's options record them.
+#: The limits a fit applied, as the options of a model written before ``FitOptions`` held a ``Guidelines`` record them.
 _FIT_LIMITS = (
     "max_cr_percent",
     "max_insensitivity_percent",
@@ -129,8 +129,9 @@ class Guidelines:
         ----------
         options : Mapping[str, Any]
             Options of the identification as ``IdentifiedModel.provenance.options``
-            holds them (``options["fit"]["max_cr_percent"]``, %); a limit they
-            do not give (a model file older than the option) is Tischler's.
+            holds them (``options["fit"]["guidelines"]``, every field; files written before
+            ``FitOptions`` held a ``Guidelines`` give the limits in ``options["fit"]`` itself, as
+            ``options["fit"]["max_cr_percent"]``, %); a limit they do not give is Tischler's.
 
         Returns
         -------
@@ -143,7 +144,9 @@ class Guidelines:
 
         Examples
         --------
-        >>> Guidelines.from_options({"fit": {"max_cr_percent": 30}}).max_cr_percent
+        >>> Guidelines.from_options({"fit": {"guidelines": {"max_cr_percent": 30, "tic_good": 0.2}}}).tic_good
+        0.2
+        >>> Guidelines.from_options({"fit": {"max_cr_percent": 30}}).max_cr_percent  # an older file
         30.0
         >>> Guidelines.from_options({}) == DEFAULT_GUIDELINES
         True
@@ -151,13 +154,19 @@ class Guidelines:
         fit = options.get("fit", {})
         if not isinstance(fit, Mapping):
             raise ValueError(f"options fit is {fit!r}, not a mapping")
+        recorded, where = fit, "fit"
+        names: tuple[str, ...] = _FIT_LIMITS
+        if "guidelines" in fit:
+            recorded, where, names = fit["guidelines"], "fit.guidelines", tuple(f.name for f in fields(cls))
+            if not isinstance(recorded, Mapping):
+                raise ValueError(f"options fit.guidelines is {recorded!r}, not a mapping")
         given: dict[str, float] = {}
-        for name in _FIT_LIMITS:
-            value = fit.get(name)
+        for name in names:
+            value = recorded.get(name)
             if value is None:
                 continue
             if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ValueError(f"options fit.{name} is {value!r}, not a number")
+                raise ValueError(f"options {where}.{name} is {value!r}, not a number")
             given[name] = float(value)
         return cls(**given)
 

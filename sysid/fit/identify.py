@@ -48,6 +48,7 @@ from sysid.fit.wind_offset import moved_flights, moved_wind, offset_given, timed
 from sysid.fit.wind_trace import wind_trace
 from sysid.freqresp import (
     FrequencyResponse,
+    Gating,
     ResponseOptions,
     coupled_inputs,
     frequency_responses,
@@ -102,10 +103,8 @@ class IdentifyOptions:
         axis flown (outputs the records or the structure lack are left out).
     kind : str
         Maneuvers the responses come from (``sweep``).
-    min_coherence : float
-        Gating threshold on gamma^2 (eq. 3.8).
-    min_decades : float
-        Shortest fit range, decades (eq. 3.8).
+    gating : Gating
+        The rule of eq. 3.8 a response must pass to be fitted (coherence and span).
     constants : Mapping[str, float] or None
         Trim constants to use instead of the flights' trim (``U0``, ``theta0`` ...).
     initial : Mapping[str, float] or None
@@ -134,8 +133,7 @@ class IdentifyOptions:
     min_record_periods: float = 5.0
     pairs: tuple[tuple[str, str], ...] | None = None
     kind: str = "sweep"
-    min_coherence: float = 0.5
-    min_decades: float = 0.3
+    gating: Gating = Gating()
     constants: Mapping[str, float] | None = None
     initial: Mapping[str, float] | None = None
     condition_on_wind: bool = True
@@ -298,9 +296,8 @@ def _identified(
         _report(progress, f"responses {flown[k]}", k + 1, len(_AXES) + 2)
         responses += found
         notes += [note] if note is not None else []
-    rule = {"min_coherence": options.min_coherence, "min_decades": options.min_decades}  # eq. 3.8
-    gated = gate_responses(responses, **rule)
-    axes = structure_axes(structure, flights, used, responses, gated, kind=options.kind, **rule)
+    gated = gate_responses(responses, options.gating)
+    axes = structure_axes(structure, flights, used, responses, gated, kind=options.kind, gating=options.gating)
     if flights and any(not a.identified for a in axes) and not (options.partial and gated.kept):
         raise FitError(unidentified_message(axes, model=structure.name, partial=options.partial))
     if not responses:
@@ -397,8 +394,7 @@ def _wind_step(
             records,
             outputs=options.wind_outputs,
             reduce=options.fit.reduce,
-            max_cr_percent=options.fit.max_cr_percent,
-            max_insensitivity_percent=options.fit.max_insensitivity_percent,
+            guidelines=options.fit.guidelines,
         )
 
     wind = fitted(speed)

@@ -15,7 +15,7 @@ from sysid.fit.axes import AxisStatus, axes_from_parameters
 from sysid.fit.cost import CostSummary
 from sysid.fit.guidelines import Guidelines
 from sysid.fit.reduce import ReductionStep
-from sysid.freqresp import FrequencyResponse
+from sysid.freqresp import FrequencyResponse, Gating
 from sysid.model.assemble import Assembler
 from sysid.model.axes import axis_parts, restrict_model
 from sysid.model.statespace import DelayedStateSpace
@@ -368,6 +368,25 @@ class IdentifiedModel:
             If the recorded limits are not positive numbers.
         """
         return Guidelines.from_options(self.provenance.options)
+
+    @property
+    def gating(self) -> Gating | None:
+        """The gating rule its responses passed, as `provenance` records it; None where it does not say.
+
+        Files written before :class:`~sysid.freqresp.Gating` record ``min_coherence`` and
+        ``min_decades`` among the options themselves; a rule that is not valid reads as None.
+        """
+        options = self.provenance.options
+        recorded = options.get("gating", options)
+        if not isinstance(recorded, Mapping) or not isinstance(recorded.get("min_coherence"), (int, float)):
+            return None
+        given = {
+            k: float(recorded[k]) for k in ("min_coherence", "min_decades") if isinstance(recorded.get(k), (int, float))
+        }
+        try:
+            return Gating(**given)
+        except ValueError:
+            return None
 
     @property
     def values(self) -> dict[str, float]:

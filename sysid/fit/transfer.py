@@ -29,7 +29,7 @@ from flightlogs.errors import FitError
 from sysid.fit.accuracy import accuracy
 from sysid.fit.cost import CostWeights, FitPoints, LogResponseCost, fit_points
 from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
-from sysid.freqresp.gating import gate_responses
+from sysid.freqresp.gating import Gating, gate_responses
 from sysid.freqresp.options import ResponseOptions
 from sysid.freqresp.records import flight_responses
 from sysid.freqresp.response import FrequencyResponse
@@ -362,8 +362,7 @@ def fit_transfer_functions(
     options: TransferOptions = TransferOptions(),
     responses: ResponseOptions = ResponseOptions(),
     kind: str = "sweep",
-    min_coherence: float = 0.5,
-    min_decades: float = 0.3,
+    gating: Gating = Gating(),
 ) -> tuple[TransferFunctionFit, ...]:
     """Compute and gate each structure's response on the flights' maneuvers, then fit it.
 
@@ -379,8 +378,8 @@ def fit_transfer_functions(
         How the responses are computed.
     kind : str, optional
         Maneuvers used (``sweep``).
-    min_coherence, min_decades : float, optional
-        Gating (eq. 3.8).
+    gating : Gating, optional
+        The gating rule (eq. 3.8).
 
     Returns
     -------
@@ -394,7 +393,7 @@ def fit_transfer_functions(
     """
     pairs = list(dict.fromkeys((s.output, s.input) for s in structures))
     computed = flight_responses(flights, pairs, kind=kind, options=responses)
-    gated = gate_responses(computed.responses, min_coherence=min_coherence, min_decades=min_decades)
+    gated = gate_responses(computed.responses, gating)
     kept = {r.pair: r for r in gated.kept}
     dropped = {f"{d.output}/{d.input}": d.reason for d in gated.dropped}
     fits = []

@@ -421,8 +421,7 @@ def fit_wind(
     *,
     outputs: Sequence[str] = ("ax", "az"),
     reduce: bool = True,
-    max_cr_percent: float = DEFAULT_GUIDELINES.max_cr_percent,
-    max_insensitivity_percent: float = DEFAULT_GUIDELINES.max_insensitivity_percent,
+    guidelines: Guidelines = DEFAULT_GUIDELINES,
 ) -> WindStepResult:
     """Fit the wind parameters of `structure` to the residual of eq. 3.14.
 
@@ -442,10 +441,9 @@ def fit_wind(
         Outputs whose residual is fitted (the accelerometers).
     reduce : bool, optional
         Drop wind parameters beyond the guidelines, one at a time.
-    max_cr_percent : float, optional
-        CR% guideline, % of ``|value|``; default Tischler's (:data:`~sysid.fit.guidelines.DEFAULT_GUIDELINES`).
-    max_insensitivity_percent : float, optional
-        I% guideline, % of ``|value|``; default Tischler's.
+    guidelines : Guidelines, optional
+        The CR% and I% limits (% of ``|value|``) wind parameters are dropped beyond; default Tischler's
+        (:data:`~sysid.fit.guidelines.DEFAULT_GUIDELINES`).
 
     Returns
     -------
@@ -477,7 +475,6 @@ def fit_wind(
     informed = _informed(structure, current, constants, data.rows, names)
     status: dict[str, WindStatus] = {n: "estimated" if n in informed else "unidentified" for n in names}
     steps: list[ReductionStep] = []
-    guidelines = Guidelines(max_cr_percent=max_cr_percent, max_insensitivity_percent=max_insensitivity_percent)
     while True:
         free = [n for n in names if status[n] == "estimated"]
         current, acc, cost, after = _fit_free(structure, current, constants, data, free)

@@ -16,7 +16,7 @@ Private modules hold the numerics: ``_spectra`` (windowed spectra), ``_whole``
 
 from sysid.freqresp.coupling import coupled_inputs
 from sysid.freqresp.estimate import automatic_window_lengths, frequency_responses
-from sysid.freqresp.gating import DroppedResponse, GatingResult, fit_range, gate_responses
+from sysid.freqresp.gating import DroppedResponse, Gating, GatingResult, fit_range, gate_responses
 from sysid.freqresp.io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
 from sysid.freqresp.options import ResponseOptions
 from sysid.freqresp.records import (
@@ -41,6 +41,7 @@ __all__ = [
     "automatic_window_lengths",
     "coupled_inputs",
     "DroppedResponse",
+    "Gating",
     "GatingResult",
     "gate_responses",
     "fit_range",

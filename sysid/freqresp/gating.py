@@ -9,10 +9,37 @@ import numpy as np
 
 from sysid.freqresp.response import FrequencyResponse
 
-__all__ = ["DroppedResponse", "GatingResult", "gate_responses", "fit_range"]
+__all__ = ["DroppedResponse", "Gating", "GatingResult", "gate_responses", "fit_range"]
 
 #: Dips below the threshold spanning at most this are bridged, decades (a few noisy points do not split a range).
 BRIDGE_DECADES = 0.05
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Gating:
+    """The rule of eq. 3.8 a response must pass to be fitted, for every command that gates.
+
+    Parameters
+    ----------
+    min_coherence : float
+        Threshold on gamma^2, in (0, 1) (dissertation eq. 3.8: 0.5; 0.6 is the stricter choice for noisy data).
+    min_decades : float
+        Shortest acceptable fit range ``log10(omega_max / omega_min)``, decades (eq. 3.8: 0.3).
+
+    Raises
+    ------
+    ValueError
+        If either is out of range.
+    """
+
+    min_coherence: float = 0.5
+    min_decades: float = 0.3
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.min_coherence < 1.0:
+            raise ValueError(f"min_coherence={self.min_coherence!r} must lie in (0, 1)")
+        if not self.min_decades > 0:
+            raise ValueError(f"min_decades={self.min_decades!r} must be > 0")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -97,19 +124,15 @@ def fit_range(omega: np.ndarray, coherence: np.ndarray, min_coherence: float) ->
     return float(omega[lo]), float(omega[hi])
 
 
-def gate_responses(
-    responses: Sequence[FrequencyResponse], *, min_coherence: float = 0.5, min_decades: float = 0.3
-) -> GatingResult:
-    """Keep the responses with a fit range of gamma^2 >= `min_coherence` spanning `min_decades`.
+def gate_responses(responses: Sequence[FrequencyResponse], gating: Gating = Gating()) -> GatingResult:
+    """Keep the responses with a fit range of gamma^2 >= ``gating.min_coherence`` spanning ``gating.min_decades``.
 
     Parameters
     ----------
     responses : sequence of FrequencyResponse
         Responses to gate.
-    min_coherence : float, optional
-        Threshold on gamma^2 (dissertation eq. 3.8: 0.5; 0.6 is the stricter choice for noisy data).
-    min_decades : float, optional
-        Shortest acceptable ``log10(omega_max / omega_min)`` (eq. 3.8: 0.3).
+    gating : Gating, optional
+        The rule (eq. 3.8's by default).
 
     Returns
     -------
@@ -127,13 +150,10 @@ def gate_responses(
     >>> result = gate_responses([h])
     >>> result.kept[0].fit_range
     (1.0, 3.981071705534973)
-    >>> print(gate_responses([h], min_decades=0.7).dropped[0].reason)
+    >>> print(gate_responses([h], Gating(min_decades=0.7)).dropped[0].reason)
     q/delta_lon: coherence reaches 0.5 over only 0.60 decade (1-3.98 rad/s), less than the 0.7 decade required.
     """
-    if not 0.0 < min_coherence < 1.0:
-        raise ValueError(f"{min_coherence=} must lie in (0, 1)")
-    if not min_decades > 0:
-        raise ValueError(f"{min_decades=} must be > 0")
+    min_coherence, min_decades = gating.min_coherence, gating.min_decades
     kept: list[FrequencyResponse] = []
     dropped: list[DroppedResponse] = []
     for response in responses:

@@ -34,11 +34,6 @@ class ResponseOptions:
         Fraction of a window shared with the next one, in [0, 0.95) (CIFER: 0.8).
     taper : str
         Window taper, any name :func:`scipy.signal.get_window` knows (``"hann"``).
-    min_coherence : float
-        Coherence gamma^2 a response must reach over its fit range (dissertation
-        eq. 3.8: 0.5; 0.6 where noise is high).
-    min_decades : float
-        Shortest fit range, decades of frequency (eq. 3.8: 0.3).
     min_cycles : float
         A window's estimate is used only at frequencies with at least this
         many periods inside it (``omega >= 2 pi min_cycles / T_window``).
@@ -93,8 +88,6 @@ class ResponseOptions:
     window_lengths_s: tuple[float, ...] | None = None
     overlap: float = 0.8
     taper: str = "hann"
-    min_coherence: float = 0.5
-    min_decades: float = 0.3
     min_cycles: float = 3.0
     spacing: Literal["log", "linear"] = "log"
     reference: str | None = None
@@ -117,10 +110,6 @@ class ResponseOptions:
             taper(self.taper, 16)
         except ValueError as err:
             raise ValueError(f"taper={self.taper!r} is not a window scipy.signal.get_window knows") from err
-        if not 0.0 < self.min_coherence < 1.0:
-            raise ValueError(f"{self.min_coherence=} must lie in (0, 1)")
-        if not self.min_decades > 0:
-            raise ValueError(f"{self.min_decades=} must be > 0")
         if not self.min_cycles > 0:
             raise ValueError(f"{self.min_cycles=} must be > 0")
         if self.spacing not in ("log", "linear"):

@@ -12,7 +12,7 @@ from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.store.campaign import ingest_campaign
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify.engine import VerificationOptions, verify
-from sysid.verify.records import MIXER_INPUTS, DoubletRecords, doublet_records
+from sysid.verify.records import AFTER_S, BEFORE_S, MIXER_INPUTS, DoubletRecords, doublet_records
 from sysid.verify.results import Verification
 
 __all__ = ["verify_logs", "verify_flights"]
@@ -27,8 +27,8 @@ def verify_logs(
     axes: Mapping[str, Sequence[str]] | None = None,
     conditioning: ConditioningOptions = ConditioningOptions(),
     options: VerificationOptions = VerificationOptions(),
-    before_s: float = 0.5,
-    after_s: float = 1.0,
+    before_s: float = BEFORE_S,
+    after_s: float = AFTER_S,
     progress: Callable[[str, int, int], None] | None = None,
     unidentified: Mapping[str, str] | None = None,
     reading: ReadOptions = ReadOptions(),
@@ -98,8 +98,8 @@ def verify_flights(
     wind_model: DelayedStateSpace | None = None,
     axes: Mapping[str, Sequence[str]] | None = None,
     options: VerificationOptions = VerificationOptions(),
-    before_s: float = 0.5,
-    after_s: float = 1.0,
+    before_s: float = BEFORE_S,
+    after_s: float = AFTER_S,
     hint: str = "give their times with --segments if they were not detected",
     unidentified: Mapping[str, str] | None = None,
 ) -> Verification:

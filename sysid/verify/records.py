@@ -8,9 +8,11 @@ from dataclasses import dataclass
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.record import Record
 
-__all__ = ["DoubletRecords", "doublet_records", "MIXER_INPUTS"]
+__all__ = ["AFTER_S", "BEFORE_S", "DoubletRecords", "doublet_records", "MIXER_INPUTS"]
 
 #: Mixer input excited by a maneuver on each axis.
+#: Quiet stretch kept before each doublet, and response after it, s (an unstable model diverges over long records).
+BEFORE_S, AFTER_S = 0.5, 1.0
 MIXER_INPUTS = {"lat": "delta_lat", "lon": "delta_lon", "yaw": "delta_yaw", "thr": "delta_thr"}
 
 
@@ -37,8 +39,8 @@ class DoubletRecords:
 def doublet_records(
     flights: Sequence[ConditionedFlight],
     *,
-    before_s: float = 0.5,
-    after_s: float = 1.0,
+    before_s: float = BEFORE_S,
+    after_s: float = AFTER_S,
     kinds: tuple[str, ...] = ("doublet",),
 ) -> DoubletRecords:
     """Cut a record around every doublet of the flights.

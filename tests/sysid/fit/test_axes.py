@@ -21,7 +21,7 @@ from sysid.fit.axes import (
     structure_axes,
     unidentified_message,
 )
-from sysid.freqresp import gate_responses
+from sysid.freqresp import Gating, gate_responses
 from sysid.model import load_structure, structure_model
 
 
@@ -39,7 +39,7 @@ def _record() -> Record:
 
 
 FLIGHTS = [_flight("a.bin", ("lat", "sweep"), ("lon", "doublet")), _flight("b.bin"), _flight("c.bin")]
-GATING = {"min_coherence": 0.5, "min_decades": 0.3}
+GATING = {"gating": Gating()}
 
 
 def test_an_axis_with_no_maneuver_says_so_and_what_was_found() -> None:
@@ -71,7 +71,7 @@ def test_an_axis_with_no_maneuver_says_so_and_what_was_found() -> None:
 def test_an_axis_whose_responses_all_fail_gating_says_which_and_why() -> None:
     truth, _ = structure_model(load_structure("hover"), dict(CALM_HOVER))
     noisy = synthetic_responses(truth, ["q/delta_lon", "ax/delta_lon"], coherence=0.3)
-    gated = gate_responses(noisy, min_coherence=0.5, min_decades=0.3)
+    gated = gate_responses(noisy, Gating(min_coherence=0.5, min_decades=0.3))
     lon = diagnose_axis(
         "delta_lon",
         kind="sweep",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from importlib import resources
 
 import numpy as np
@@ -10,7 +11,15 @@ import pytest
 
 from flightlogs.errors import FitError
 from simulator.vehicle.identified import CALM_HOVER
-from sysid.fit import CostSummary, FitOptions, accuracy, fit_frequency_responses, synthetic_responses, worst_parameter
+from sysid.fit import (
+    DEFAULT_GUIDELINES,
+    CostSummary,
+    FitOptions,
+    accuracy,
+    fit_frequency_responses,
+    synthetic_responses,
+    worst_parameter,
+)
 from sysid.model import load_structure, parse_structure, structure_model
 
 PAIRS = [
@@ -164,7 +173,8 @@ def test_the_reduction_margin_is_the_guidelines() -> None:
     responses = synthetic_responses(
         _truth_model(), ["q/delta_lon", "ax/delta_lon", "u/delta_lon"], noise_db=0.5, noise_deg=3.0, fit_range=RANGES
     )
-    tight = FitOptions(max_insensitivity_percent=1.0, max_cr_percent=1.0)
+    limits = replace(DEFAULT_GUIDELINES, max_insensitivity_percent=1.0, max_cr_percent=1.0)
+    tight = FitOptions(guidelines=limits)
     fit = fit_frequency_responses(load_structure("hover"), responses, options=tight)
     kept = [s for s in fit.reduction if s.action == "kept"]
     assert kept and all(fit.status[s.parameter] == "estimated" for s in kept)
@@ -174,10 +184,7 @@ def test_the_reduction_margin_is_the_guidelines() -> None:
         after = CostSummary(average=step.cost_average_after, responses=step.cost_responses_after)
         assert bool(g.reduction_cost_rise(before, after)) == (step.action == "kept"), step
     loose = FitOptions(
-        max_insensitivity_percent=1.0,
-        max_cr_percent=1.0,
-        reduction_j_response_rise_percent=1e6,
-        reduction_j_average_rise_percent=1e6,
+        guidelines=replace(limits, reduction_j_response_rise_percent=1e6, reduction_j_average_rise_percent=1e6)
     )
     assert not [
         s

@@ -16,7 +16,9 @@ from typing import Any
 
 import pytest
 
+from flightlogs.writers.jsonio import jsonable
 from sysid.fit import DEFAULT_GUIDELINES, CostSummary, FitOptions, Guidelines, IdentifiedModel, model_verdict
+from sysid.freqresp import Gating
 from sysid.verify import OutputSummary, Verification
 
 from builders import small_model, with_unidentified
@@ -80,11 +82,12 @@ def test_limits_must_be_positive_and_in_order(limits: dict[str, Any], message: s
 
 def test_the_fit_options_carry_their_limits_into_the_guidelines() -> None:
     assert FitOptions().guidelines == DEFAULT_GUIDELINES
-    guidelines = FitOptions(max_cr_percent=30.0, max_insensitivity_percent=12.5).guidelines
+    limits = dataclasses.replace(DEFAULT_GUIDELINES, max_cr_percent=30.0, max_insensitivity_percent=12.5)
+    guidelines = FitOptions(guidelines=limits).guidelines
     assert (guidelines.max_cr_percent, guidelines.max_insensitivity_percent) == (30.0, 12.5)
     assert guidelines.j_average_good == 100.0  # the rest stays Tischler's
     with pytest.raises(ValueError, match="max_cr_percent=0"):
-        FitOptions(max_cr_percent=0.0)
+        dataclasses.replace(DEFAULT_GUIDELINES, max_cr_percent=0.0)
 
 
 def test_guidelines_are_read_from_the_options_a_model_records() -> None:
@@ -92,6 +95,10 @@ def test_guidelines_are_read_from_the_options_a_model_records() -> None:
     assert (recorded.max_cr_percent, recorded.max_insensitivity_percent) == (30.0, 12.5)
     assert Guidelines.from_options({"fit": {"starts": 1}}) == DEFAULT_GUIDELINES  # older files: no limits recorded
     assert Guidelines.from_options({"min_coherence": 0.5}) == DEFAULT_GUIDELINES
+    limits = dataclasses.replace(DEFAULT_GUIDELINES, max_cr_percent=30.0, tic_good=0.2)  # as FitOptions records them
+    assert Guidelines.from_options({"fit": jsonable(FitOptions(guidelines=limits))}) == limits
+    with pytest.raises(ValueError, match="fit.guidelines.tic_good is 'x', not a number"):
+        Guidelines.from_options({"fit": {"guidelines": {"tic_good": "x"}}})
     with pytest.raises(ValueError, match="fit.max_cr_percent is '30', not a number"):
         Guidelines.from_options({"fit": {"max_cr_percent": "30"}})
     with pytest.raises(ValueError, match="max_insensitivity_percent=-2.0"):
@@ -298,3 +305,17 @@ def test_a_broadband_input_found_in_a_flight_never_makes_a_model_on_its_own(
     assert verdict.grade == grade
     check = next(c for c in verdict.checks if c.guideline == "maneuvers designed for identification")
     assert check.problem.startswith(problem) and (not problem or problem in verdict.sentence)
+
+
+def test_a_model_says_which_gating_its_responses_passed() -> None:
+    """The rule as identify_flights records it (``options.gating``), as older files did (top level), or not at all."""
+    model = small_model()
+    recorded = dataclasses.replace(
+        model.provenance, options={"gating": jsonable(Gating(min_coherence=0.6, min_decades=0.5))}
+    )
+    assert dataclasses.replace(model, provenance=recorded).gating == Gating(min_coherence=0.6, min_decades=0.5)
+    older = dataclasses.replace(model.provenance, options={"min_coherence": 0.55})
+    assert dataclasses.replace(model, provenance=older).gating == Gating(min_coherence=0.55)
+    for options in ({}, {"gating": {"min_coherence": 1.5}}, {"gating": "0.5"}):
+        unsaid = dataclasses.replace(model.provenance, options=options)
+        assert dataclasses.replace(model, provenance=unsaid).gating is None, options
