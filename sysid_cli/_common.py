@@ -19,6 +19,7 @@ import click
 from flightlogs.errors import DataError
 from flightlogs.writers.jsonio import json_text, write_json
 
+from ._flags import RUNNING
 from ._warnings import QUIET
 
 __all__ = [
@@ -177,6 +178,7 @@ class SysidCommand(click.Command):
                     raise DataError(
                         f"{out}: exists, and --no-clobber leaves it as it is; give another {param.opts[-1]}"
                     )
+        ctx.meta[RUNNING] = ctx  # library messages then name its flags (sysid_cli._flags)
         if ctx.params.get("quiet"):
             ctx.meta[QUIET] = True  # its warnings counted, not listed (sysid_cli._warnings)
         if ctx.params.get("json_path") == "-":

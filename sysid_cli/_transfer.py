@@ -10,6 +10,7 @@ from typing import Any
 import click
 
 from ._common import emit_json
+from ._flags import as_flags
 
 __all__ = ["parse_band", "fit_transfer", "print_transfer"]
 
@@ -124,7 +125,7 @@ def print_transfer(summary: dict[str, Any]) -> None:
             say(f"  {name:<10} {p['value']:>12.5g} {p['cr_percent']:>8.3g} {p['insensitivity_percent']:>8.3g}")
         say("  poles (rad/s): " + ", ".join(f"{complex(*p):.4g}" for p in tf["poles"]))
         for note in tf["notes"]:
-            say(f"  note: {note}")
+            say(f"  note: {as_flags(note)}")
     for key in ("output", "report"):
         if summary.get(key):
             say(f"wrote {summary[key]}")

@@ -31,6 +31,8 @@ import click
 
 from flightlogs.errors import SysidWarning
 
+from ._flags import as_flags
+
 __all__ = ["QUIET", "grouped", "mark_reported", "warnings_printed_once"]
 
 _REPORTED = "sysid.reported_warnings"
@@ -135,4 +137,4 @@ def warnings_printed_once(meta: MutableMapping[str, Any]) -> Iterator[None]:
         if meta.get(QUIET) and len(ours) > 1:
             lines = [f"{len(ours)} warnings of {len(lines)} kinds; without -q they are listed"]
         for line in lines:
-            click.secho(f"warning: {line}", fg="yellow", err=True)
+            click.secho(f"warning: {as_flags(line)}", fg="yellow", err=True)

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option, staged_progress
+from ._flags import as_flags
 from ._flights import check_sources, conditioned_flights, dataset_flights, reading_from, reading_options
 from ._response_options import gating_options, windows_option
 from ._transfer import fit_transfer, parse_band
@@ -347,7 +348,7 @@ def _print_fit(summary: dict[str, Any], guidelines: Guidelines) -> None:
         )
     print_modes(summary["eigenvalues"], say)
     for note in summary["notes"]:
-        say(f"  note: {note}")
+        say(f"  note: {as_flags(note)}")
     say(f"verdict: {summary['verdict']['sentence']}")
     for key in ("output", "mat", "report"):
         if summary.get(key):

@@ -8,6 +8,7 @@ from typing import Any
 import click
 
 from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option
+from ._flags import as_flags
 from ._flights import conditioned_flights, reading_from, reading_options
 from ._response_options import gating_options, windows_option
 from ._wind_options import segments_from, segments_option, wind_distance_option, wind_offset_option, wind_option
@@ -270,7 +271,7 @@ def _print_summary(summary: dict[str, Any]) -> None:
     for axis, count in summary["pieces"].items():
         say(f"{axis}: {count} maneuver piece(s)")
     for note in summary["notes"]:
-        say(f"  {note}")
+        say(f"  {as_flags(note)}")
     for entry in summary["responses"]:
         if entry["kept"]:
             lo, hi = entry["fit_range_rad_s"]

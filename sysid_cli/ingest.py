@@ -9,6 +9,7 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
+from ._flags import as_flags
 from ._flights import reading_from, reading_options
 from ._warnings import grouped, mark_reported
 from ._wind_options import (
@@ -228,7 +229,7 @@ def _print_summary(summary: dict[str, Any]) -> None:
                 + (f"; {hovers} hover stretch{'es' if hovers > 1 else ''}" if hovers else "")
             )
         for warning in grouped(entry["warnings"]):
-            say(f"  warning: {warning}")
+            say(f"  warning: {as_flags(warning)}")
         mark_reported(entry["warnings"])
     if summary["output"]:
         say(f"wrote {summary['output']}")

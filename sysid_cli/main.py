@@ -13,6 +13,7 @@ import click
 
 from flightlogs.errors import SysidError, SysidWarning
 
+from ._flags import as_flags
 from ._warnings import warnings_printed_once
 
 __all__ = ["cli"]
@@ -109,7 +110,11 @@ class _SysidGroup(click.Group):
 
 
 def _failed(ctx: click.Context, message: str) -> NoReturn:
-    """End the command with `message` on stderr and exit 1; with ``--json -`` also ``{"error": message}`` on stdout."""
+    """End the command with `message` on stderr and exit 1; with ``--json -`` also ``{"error": message}`` on stdout.
+
+    The fields a library message names are the running command's flags (:func:`~sysid_cli._flags.as_flags`).
+    """
+    message = as_flags(message, ctx)
     click.secho(f"error: {message}", fg="red", err=True)
     from ._common import JSON_ON_STDOUT  # numpy and the writers: only once a command ran
 

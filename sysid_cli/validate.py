@@ -8,6 +8,7 @@ from typing import Any
 import click
 
 from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option
+from ._flags import as_flags
 from ._flights import conditioned_flights, is_dataset, reading_from, reading_options
 from ._wind_options import (
     segments_from,
@@ -322,9 +323,9 @@ def _print(summary: dict[str, Any]) -> None:
         )
     for record in summary["records"]:
         if record["notice"] and (len(unstable) < 2 or not record["unstable"]):
-            say(f"  note: {record['label']}: {record['notice']}")
+            say(f"  note: {record['label']}: {as_flags(record['notice'])}")
     for note in summary["notes"]:
-        say(f"  note: {note}")
+        say(f"  note: {as_flags(note)}")
     if summary["off_axis"]:
         say(
             "  off-axis (not judged): "

@@ -139,7 +139,7 @@ def pair_winds(
         if log.utc_offset_s is None and clock_offset_s is None:
             raise DataError(
                 f"{log.path}: the log has no GPS time, so the anemometer cannot be aligned by UTC; "
-                "give --wind-offset (anemometer time minus log time, s)"
+                "give `wind_offset_s` (anemometer time minus log time, s)"
             )
         offset, span = clock_offset_s or 0.0, _span(log)  # the span once: every record is tried against it
         overlaps = [_overlap(span, wind, offset) for wind in winds]
@@ -162,7 +162,7 @@ def _no_overlap_message(log: FlightLog, winds: Sequence[Any], offset: float) -> 
         where = f"{_iso(start)} to {_iso(end)}"
     return (
         f"{log.path}: no anemometer record overlaps the flight ({where}; {spans}); "
-        "if the anemometer clock is off, give --wind-offset"
+        "if the anemometer clock is off, give `wind_offset_s`"
     )
 
 

@@ -284,7 +284,7 @@ def _say_wind_cut(log: FlightLog, core: dict[str, Signal], time_base: np.ndarray
             f"{log.path}: records cut to the anemometer's overlap, {time_base[0]:.2f}-{time_base[-1]:.2f} s of the "
             f"log's {first:.2f}-{last:.2f} s ({lost:.1f} s lost; transport delay {alignment.transport.delay_s:.2f} s, "
             f"clock offset {alignment.clock_offset_s:+.3f} s from {alignment.clock_offset_source}): maneuvers "
-            "outside it are not used; if the anemometer's clock is off, give --estimate-wind-offset or --wind-offset"
+            "outside it are not used; if the anemometer's clock is off, give `estimate_wind_offset` or `wind_offset_s`"
         )
         warnings.warn(DataQualityWarning(message), stacklevel=3)
 
@@ -324,7 +324,7 @@ def _wind_signals(log: FlightLog, wind: Any, options: ConditioningOptions) -> tu
     if log.utc_offset_s is None and options.wind_offset_s is None:
         raise DataError(
             f"{log.path}: the log has no GPS time, so the anemometer cannot be aligned by UTC; "
-            "give --wind-offset (anemometer time minus log time, s)"
+            "give `wind_offset_s` (anemometer time minus log time, s)"
         )
     clock_offset = options.wind_offset_s or 0.0
     source: Literal["gps", "user"] = "user" if options.wind_offset_s is not None else "gps"
@@ -378,13 +378,13 @@ def _transport_delay(
         )
     if options.wind_distance_m is not None:
         message = (
-            "the anemometer-to-vehicle distance was given (--wind-distance): the anemometer's position is not used"
+            "the anemometer-to-vehicle distance was given (`wind_distance_m`): the anemometer's position is not used"
         )
         warnings.warn(SysidWarning(message), stacklevel=2)
         return transport_delay(wind_ne, distance_m=options.wind_distance_m, bearing_rad=options.wind_bearing_rad)
     if options.wind_bearing_rad is not None:
         message = (
-            "the bearing from the anemometer to the vehicle comes from their positions; --wind-bearing is not used"
+            "the bearing from the anemometer to the vehicle comes from their positions; `wind_bearing_rad` is not used"
         )
         warnings.warn(SysidWarning(message), stacklevel=2)
     bearing, distance = _gps_geometry(log, options.anemometer_position_rad, wind_time_s)
@@ -396,7 +396,7 @@ def _gps_geometry(log: FlightLog, anemometer_rad: tuple[float, float], wind_time
     if not set(_POSITION) <= log.signals.keys():
         raise DataError(
             f"{log.path}: the log holds no GNSS position (latitude, longitude), so the anemometer-to-vehicle "
-            "distance cannot be found from the anemometer's position; give --wind-distance"
+            "distance cannot be found from the anemometer's position; give `wind_distance_m`"
         )
     lat_signal, lon_signal = log.signals["latitude"], log.signals["longitude"]
     time_s = lat_signal.time_s
@@ -413,7 +413,7 @@ def _gps_geometry(log: FlightLog, anemometer_rad: tuple[float, float], wind_time
             f"{log.path}: the anemometer ({np.degrees(anemometer_rad[0]):.6f}, {np.degrees(anemometer_rad[1]):.6f}) "
             f"is {distance / 1000:.1f} km from the vehicle's mean GPS position ({np.degrees(mean_lat):.6f}, "
             f"{np.degrees(mean_lon):.6f}), too far for its wind to stand for the vehicle's; check the "
-            "anemometer's position (latitude first, degrees) or give --wind-distance"
+            "anemometer's position (latitude first, degrees) or give `wind_distance_m`"
         )
     north, east = local_north_east(lat, lon, mean_lat, mean_lon)
     spread = float(np.hypot(north, east).max())
@@ -487,13 +487,13 @@ def _with_estimated_delay(log: FlightLog, wind: Any, options: ConditioningOption
     if first.wind.residual is None:
         raise DataError(
             f"{log.path}: the transport delay cannot be estimated: the log has neither an autopilot wind "
-            "estimate nor attitude to correlate the wind with; give --wind-distance or --transport-delay"
+            "estimate nor attitude to correlate the wind with; give `wind_distance_m` or `transport_delay_s`"
         )
     delay = first.wind.residual.lag_s
     if delay < 0:
         raise DataError(
             f"{log.path}: the vehicle sees the wind {-delay:.2f} s before the anemometer: it is not upstream "
-            "(or its clock is off); give --wind-distance or --transport-delay"
+            "(or its clock is off); give `wind_distance_m` or `transport_delay_s`"
         )
     again = condition_flight(log, wind, replace(options, transport_delay_s=delay, estimate_transport_delay=False))
     assert again.wind is not None

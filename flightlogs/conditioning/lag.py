@@ -229,7 +229,9 @@ def transport_delay(
             speed_std_m_s=speed_std,
         )
     if distance_m is None:
-        raise DataError("the transport delay needs the anemometer-to-vehicle distance (--wind-distance) or a delay")
+        raise DataError(
+            "the transport delay needs the anemometer-to-vehicle distance (`wind_distance_m`) or a delay (`transport_delay_s`)"
+        )
     mean_vector = wind_ne.mean(axis=0)
     if bearing_rad is None:
         along = float(np.hypot(*mean_vector))

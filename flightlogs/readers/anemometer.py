@@ -335,7 +335,7 @@ def _resolve_columns(path: Path, header: list[str], explicit: Mapping[str, str])
             hits = [h for h, k in zip(header, keys) if k == synonym and h not in used.values()]
             if len(hits) > 1:
                 raise LogFormatError(
-                    f"{path}: columns {hits} all look like {quantity}; name one with --columns {quantity}=COL"
+                    f"{path}: columns {hits} all look like {quantity}; name one in `columns` ({quantity}=COL)"
                 )
             if hits:
                 used[quantity] = hits[0]
@@ -349,11 +349,11 @@ def _resolve_columns(path: Path, header: list[str], explicit: Mapping[str, str])
         used.pop(key, None)
     found = ", ".join(repr(h) for h in header)
     if "time" not in used:
-        raise LogFormatError(f"{path}: no time column recognised among {found}; name it with --columns time=COL")
+        raise LogFormatError(f"{path}: no time column recognised among {found}; name it in `columns` (time=COL)")
     if not ({"speed", "direction"} <= used.keys() or {"u", "v"} <= used.keys()):
         raise LogFormatError(
             f"{path}: no wind columns recognised (need speed and direction, or u and v) among "
-            f"{found}; name them with --columns speed=COL,direction=COL (or u=COL,v=COL)"
+            f"{found}; name them in `columns` (speed=COL,direction=COL or u=COL,v=COL)"
         )
     return used
 

@@ -80,7 +80,7 @@ def read_log(
     if not reading.force_multirotor:
         raise DataError(
             f"{log.path}: a {log.vehicle_type}, not a multirotor; the models here are a multirotor's "
-            "(read it as one with force_multirotor, --vehicle multirotor on the command line)"
+            "(read it as one with `force_multirotor`)"
         )
     forced = f"{log.path.name}: a {log.vehicle_type}, read as a multirotor as asked"
     warnings.warn(DataQualityWarning(forced), stacklevel=2)

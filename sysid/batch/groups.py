@@ -86,7 +86,7 @@ def check_keys(by: Sequence[str], mapping: LogMapping | None = None) -> None:
     known = (*BUILTIN_KEYS, *(mapping.columns if mapping is not None else ()))
     unknown = [key for key in by if key not in known]
     if unknown or not by:
-        where = f"a column of {mapping.source}" if mapping is not None else "given by a mapping file (--mapping)"
+        where = f"a column of {mapping.source}" if mapping is not None else "given by a mapping file (`mapping`)"
         raise DataError(
             f"cannot group by {', '.join(unknown) or 'nothing'}: a key is one of {', '.join(BUILTIN_KEYS)} or {where}"
         )

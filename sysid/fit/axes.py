@@ -112,7 +112,7 @@ def diagnose_axis(
     responses: Sequence[FrequencyResponse],
     dropped: Sequence[DroppedResponse],
     gating: Gating,
-    segments_hint: str = "give the maneuvers with --segments",
+    segments_hint: str = "give the maneuvers with `segments`",
 ) -> AxisStatus:
     """The status of one axis from what the identification found for it, before the fit.
 
@@ -180,7 +180,7 @@ def diagnose_axis(
         status="unidentified",
         reason=f"{_plural(len(records), kind)} {in_logs}, but no response passed the coherence gating "
         f"(γ² ≥ {gating.min_coherence:g} over ≥ {gating.min_decades:g} decade): {why}",
-        remedy=f"fly a longer or stronger {kind} on this axis, or lower --min-coherence",
+        remedy=f"fly a longer or stronger {kind} on this axis, or lower `min_coherence`",
     )
 
 
@@ -300,20 +300,20 @@ def unidentified_message(axes: Sequence[AxisStatus], *, model: str, partial: boo
     Examples
     --------
     >>> lon = AxisStatus(axis="lon", input="delta_lon", status="unidentified", reason="no sweep found in 3 logs",
-    ...                  remedy="give the maneuvers with --segments")
+    ...                  remedy="give the maneuvers with `segments`")
     >>> print(unidentified_message([lon], model="hover"))
     model hover: 1 of its 1 axes cannot be identified.
-    lon: no sweep found in 3 logs; give the maneuvers with --segments, or --partial to write a model of the other axes.
+    lon: no sweep found in 3 logs; give the maneuvers with `segments`, or `partial` to write a model of the other axes.
     >>> print(unidentified_message([lon], model="hover", partial=True))
     model hover: 1 of its 1 axes cannot be identified, so a partial model has no axis to write.
-    lon: no sweep found in 3 logs; give the maneuvers with --segments.
+    lon: no sweep found in 3 logs; give the maneuvers with `segments`.
     """
     missing = [a for a in axes if not a.identified]
     head = f"model {model}: {len(missing)} of its {len(axes)} axes cannot be identified."
     if partial:  # asked for, and there is no axis to write
         head = head[:-1] + ", so a partial model has no axis to write."
         return "\n".join([head] + [a.sentence + "." for a in missing])
-    advice = "--partial to write a model of the other axes"
+    advice = "`partial` to write a model of the other axes"
     return "\n".join([head] + [a.sentence + (", or " if a.remedy else "; ") + advice + "." for a in missing])
 
 

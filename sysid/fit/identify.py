@@ -350,7 +350,9 @@ def _identified(
                 trace = wind_trace(structure, identified, constants, records, flights)
                 wind = dataclasses.replace(wind, fit=dataclasses.replace(wind.fit, clock_offset=clock, trace=trace))
         else:
-            notes.append(f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give --wind)")
+            notes.append(
+                f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give `wind_paths`)"
+            )
     _report(progress, "done", len(_AXES) + 2, len(_AXES) + 2)
     maneuvers = sorted({f"{s.kind} {s.axis} {s.source}" for f in flights for s in f.segments if s.kind == options.kind})
     provenance = dataclasses.replace(_provenance(files, options), maneuvers=tuple(maneuvers))

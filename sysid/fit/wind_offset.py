@@ -396,7 +396,7 @@ def _unclaimed(scan: WindClockOffset, half_width_s: float) -> str:
     if _at_edge(scan, half_width_s):
         return (
             f"the residual is least at the edge of the ±{half_width_s:g} s scanned "
-            f"({scan.best_shift_s:+.2f} s): no minimum inside it; give --wind-offset"
+            f"({scan.best_shift_s:+.2f} s): no minimum inside it; give `wind_offset_s`"
         )
     if scan.contrast < MIN_CONTRAST:
         return (
@@ -477,7 +477,7 @@ def timed_wind(
             f"the anemometer clock offset given, {used:+.2f} s, is {apart:.2f} s from the {measured} where the wind "
             f"best explains the accelerations (the residual of eq. 3.14 is {more:.0f} % larger at the offset given, "
             f"over {scan.samples} samples); the wind terms are fitted at the offset given: check it, "
-            f"or leave --wind-offset out to use the one measured"
+            f"or leave `wind_offset_s` out to use the one measured"
         )
         warnings.warn(FitWarning(message), stacklevel=2)
         return moved_wind(records, flights, 0.0), scan, [message]

@@ -253,7 +253,7 @@ def _weight(log: FlightLog, steps: list[HoverStep], config: GroundEffectDataConf
     if not high:
         raise DataError(
             f"{log.path.name}: no hover step above Z/R = {config.reference_height_ratio:g} to give "
-            "the weight; give the mass (--mass)"
+            "the weight; give the mass (`mass_kg`)"
         )
     return float(
         np.mean(high)

@@ -73,7 +73,7 @@ def verify_logs(
     """
     if wind_model is not None and not wind_paths:
         raise DataError(
-            "the model has wind terms but no anemometer file was given (--wind); "
+            "the model has wind terms but no anemometer file was given (`wind_paths`); "
             "without wind only the model without G_w can be verified"
         )
     campaign = ingest_campaign(
@@ -100,7 +100,7 @@ def verify_flights(
     options: VerificationOptions = VerificationOptions(),
     before_s: float = BEFORE_S,
     after_s: float = AFTER_S,
-    hint: str = "give their times with --segments if they were not detected",
+    hint: str = "give their times with `segments` if they were not detected",
     unidentified: Mapping[str, str] | None = None,
 ) -> Verification:
     """Verify `model` (and `wind_model`) on every doublet of conditioned flights (see :func:`verify_logs`).

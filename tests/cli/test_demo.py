@@ -106,8 +106,9 @@ def test_demo_ends_with_the_report_and_sysid_report_rebuilds_it(demo_run: tuple[
 @pytest.mark.parametrize(
     ("extra", "fragment"),
     [
-        (["--wind-distance", "4.6", "--wind-offset", "10800"], "no anemometer record overlaps"),
-        ([], "distance"),
+        (["--wind-distance", "4.6", "--wind-offset", "10800"], "if the anemometer clock is off, give --wind-offset"),
+        ([], "the anemometer-to-vehicle distance (--wind-distance) or a delay (--transport-delay)"),  # the library
+        # names ConditioningOptions' fields (`wind_distance_m`): the command line its flags (issue 33)
     ],
 )
 def test_wind_that_cannot_be_aligned_is_exit_1(demo_dir: Path, tmp_path: Path, extra: list[str], fragment: str) -> None:
@@ -117,8 +118,17 @@ def test_wind_that_cannot_be_aligned_is_exit_1(demo_dir: Path, tmp_path: Path, e
         ["ingest", str(demo_dir / "flight.bin"), "--wind", str(demo_dir / "anemometer.csv"), "-o", str(out), *extra],
     )
     assert result.exit_code == 1
-    assert "Traceback" not in result.output and fragment in result.stderr
+    assert "Traceback" not in result.output and fragment in result.stderr and "`" not in result.stderr
     assert not out.exists()
+
+
+def test_a_field_the_command_has_no_flag_for_stays_named(demo_dir: Path) -> None:
+    """``sysid discrepancy`` reads wind but has no --transport-delay: the advice says so, in the JSON error too."""
+    args = ["discrepancy", str(demo_dir / "flight.bin"), str(demo_dir / "flight.bin")]
+    result = CliRunner().invoke(cli, [*args, "--wind", str(demo_dir / "anemometer.csv"), "--json", "-"])
+    assert result.exit_code == 1, result.output
+    expected = "(--wind-distance) or a delay (`transport_delay_s`, not an option of sysid discrepancy)"
+    assert expected in result.stderr and expected in json.loads(result.stdout)["error"]
 
 
 def test_a_wind_folder_pairs_each_log_by_utc(demo_dir: Path, tmp_path: Path) -> None:

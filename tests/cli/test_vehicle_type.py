@@ -53,7 +53,7 @@ def test_a_px4_fixed_wing_is_refused_and_can_be_forced(flight, tmp_path: Path) -
     assert refused.exit_code == 1 and not out.exists()
     assert refused.stderr == (
         f"error: {plane}: a fixed-wing (CA_AIRFRAME 1), not a multirotor; the models here are a multirotor's "
-        "(read it as one with force_multirotor, --vehicle multirotor on the command line)\n"
+        "(read it as one with --vehicle multirotor)\n"  # the library names `force_multirotor`: the CLI its flag
     )
     forced = CliRunner().invoke(cli, ["ingest", str(plane), "--vehicle", "multirotor", "--json", "-", "-q"])
     assert forced.exit_code == 0, forced.output

@@ -182,7 +182,7 @@ def test_a_gap_splits_the_record_and_is_reported(demo: dict) -> None:
 
 def test_no_gps_time_asks_for_the_wind_offset(demo: dict) -> None:
     log = replace(demo["log"], utc_offset_s=None)
-    with pytest.raises(DataError, match="--wind-offset"):
+    with pytest.raises(DataError, match="`wind_offset_s`"):
         condition_flight(log, demo["wind"], ConditioningOptions(wind_distance_m=4.6))
 
 
@@ -254,7 +254,9 @@ def test_a_given_distance_wins_over_the_anemometer_position(demo: dict) -> None:
     options = ConditioningOptions(
         anemometer_position_rad=_anemometer_rad(demo["truth"]), wind_distance_m=5.0, wind_offset_s=1.5
     )
-    with pytest.warns(SysidWarning, match=r"distance was given \(--wind-distance\): the anemometer's position is not"):
+    with pytest.warns(
+        SysidWarning, match=r"distance was given \(`wind_distance_m`\): the anemometer's position is not"
+    ):
         flight = condition_flight(demo["log"], demo["wind"], options)
     assert flight.wind is not None and flight.wind.transport.source == "geometry"
     assert flight.wind.transport.distance_m == 5.0
@@ -265,7 +267,7 @@ def test_anemometer_position_without_gps_in_the_log_asks_for_the_distance(demo: 
     log = demo["log"]
     no_gps = replace(log, signals={n: s for n, s in log.signals.items() if n not in ("latitude", "longitude")})
     options = ConditioningOptions(anemometer_position_rad=_anemometer_rad(demo["truth"]), wind_offset_s=1.5)
-    with pytest.raises(DataError, match=r"no GNSS position.*--wind-distance"):
+    with pytest.raises(DataError, match=r"no GNSS position.*`wind_distance_m`"):
         condition_flight(no_gps, demo["wind"], options)
 
 

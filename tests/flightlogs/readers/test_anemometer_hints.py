@@ -15,12 +15,12 @@ _ROWS = "2024-05-01T10:00:00.000Z,2.3,1.0,90\n2024-05-01T10:00:00.050Z,2.4,1.1,9
 @pytest.mark.parametrize(
     ("header", "hint"),
     [
-        ("utc,speed_m_s,temp,rh", "name them with --columns speed=COL,direction=COL (or u=COL,v=COL)"),
-        ("when,speed,direction,rh", "name it with --columns time=COL"),
-        ("time,speed [m/s],speed [km/h],direction", "name one with --columns speed=COL"),
+        ("utc,speed_m_s,temp,rh", "name them in `columns` (speed=COL,direction=COL or u=COL,v=COL)"),
+        ("when,speed,direction,rh", "name it in `columns` (time=COL)"),
+        ("time,speed [m/s],speed [km/h],direction", "name one in `columns` (speed=COL)"),
     ],
 )
-def test_a_missing_or_ambiguous_column_names_the_file_and_the_cli_option(
+def test_a_missing_or_ambiguous_column_names_the_file_and_the_columns_argument(
     tmp_path: Path, header: str, hint: str
 ) -> None:
     path = tmp_path / "w_missingcol.csv"

@@ -48,7 +48,7 @@ def test_an_axis_with_no_maneuver_says_so_and_what_was_found() -> None:
     assert lon.reason == (
         "no sweep found in 3 logs; the delta_lon input never passed the sweep test (a doublet of this axis was found)"
     )
-    assert lon.remedy == "give the maneuvers with --segments"
+    assert lon.remedy == "give the maneuvers with `segments`"
     yaw = diagnose_axis("delta_yaw", kind="sweep", flights=FLIGHTS, records=(), responses=(), dropped=(), **GATING)
     assert yaw.reason == "no sweep found in 3 logs; the delta_yaw input never passed the sweep test"
     given = [
@@ -85,7 +85,7 @@ def test_an_axis_whose_responses_all_fail_gating_says_which_and_why() -> None:
         "1 sweep in 3 logs, but no response passed the coherence gating (γ² ≥ 0.5 over ≥ 0.3 decade): "
         "q/delta_lon: coherence never reaches 0.5 (at most 0.30). ax/delta_lon: coherence never reaches 0.5 (at most 0.30)"
     )
-    assert "lower --min-coherence" in lon.remedy
+    assert "lower `min_coherence`" in lon.remedy
     fine = synthetic_responses(truth, ["q/delta_lon"])
     ok = diagnose_axis(
         "delta_lon", kind="sweep", flights=FLIGHTS, records=[_record()], responses=fine, dropped=(), **GATING
@@ -109,7 +109,7 @@ def test_every_control_input_of_the_structure_gets_a_status_and_the_message_one_
     assert lines[0] == "model hover: 3 of its 4 axes cannot be identified."
     assert lines[1] == (
         "lon: no sweep found in 3 logs; the delta_lon input never passed the sweep test (a doublet of this axis was "
-        "found); give the maneuvers with --segments, or --partial to write a model of the other axes."
+        "found); give the maneuvers with `segments`, or `partial` to write a model of the other axes."
     )
     assert partial_warning(axes, model="hover").startswith("model hover is partial: it covers lat only;")
 
