@@ -269,21 +269,8 @@ def _summary(
             }
             for r in verification.records
         ],
-        "summary": {
-            s.name: {
-                "unit": s.unit,
-                "rmse": s.rmse,
-                "tic": s.tic,
-                "records": s.n_records,
-                "one_step_rmse": s.prediction_rmse,
-                "one_step_tic": s.prediction_tic,
-            }
-            for s in verification.summary
-        },
-        "off_axis": {
-            s.name: {"unit": s.unit, "rmse": s.rmse, "tic": s.tic, "records": s.n_records}
-            for s in verification.off_axis
-        },
+        "summary": {s.name: s.to_dict() for s in verification.summary},  # the verification file's entries
+        "off_axis": {s.name: s.to_dict() for s in verification.off_axis},
         "overall": {"rmse": verification.rmse, "tic": verification.tic},
         "unstable": verification.unstable,
         "report": str(report) if report is not None else None,
@@ -319,7 +306,7 @@ def _print(summary: dict[str, Any]) -> None:
             f"  note: the model is unstable open loop in its {names} and grows up to {growth:.0f}-fold over "
             f"{len(unstable)} records "
             f"({'; '.join(r['label'] for r in unstable)}): small input or initial-state errors diverge there, so "
-            "judge them also by the one-step-ahead prediction error (one_step_* in --json)"
+            "judge them also by the one-step-ahead prediction error (prediction_rmse, prediction_tic in --json)"
         )
     for record in summary["records"]:
         if record["notice"] and (len(unstable) < 2 or not record["unstable"]):

@@ -138,21 +138,6 @@ def verification_to_dict(
     """
     v = verification
 
-    def summaries(rows: tuple[OutputSummary, ...]) -> list[dict[str, Any]]:
-        return [
-            {
-                "name": s.name,
-                "unit": s.unit,
-                "rmse": _num(s.rmse),
-                "tic": _num(s.tic),
-                "n_records": s.n_records,
-                "n_samples": s.n_samples,
-                "prediction_rmse": _num(s.prediction_rmse),
-                "prediction_tic": _num(s.prediction_tic),
-            }
-            for s in rows
-        ]
-
     return {
         "schema": VERIFICATION_SCHEMA,
         "schema_version": VERIFICATION_SCHEMA_VERSION,
@@ -162,8 +147,8 @@ def verification_to_dict(
         "created_utc": created_utc,
         "rmse": _num(v.rmse),
         "tic": _num(v.tic),
-        "summary": summaries(v.summary),
-        "off_axis": summaries(v.off_axis),
+        "summary": [s.to_dict() for s in v.summary],
+        "off_axis": [s.to_dict() for s in v.off_axis],
         "records": [_record_to_dict(r) for r in v.records],
         "without_wind": [_record_to_dict(r) for r in v.without_wind],
         "wind_correction": [c.to_dict() for c in v.wind_correction],
@@ -206,19 +191,6 @@ def _record_from_dict(d: Mapping[str, Any]) -> RecordVerification:
     )
 
 
-def _summary_from_dict(s: Mapping[str, Any]) -> OutputSummary:
-    return OutputSummary(
-        name=s["name"],
-        unit=s["unit"],
-        rmse=_float(s["rmse"]),
-        tic=_float(s["tic"]),
-        n_records=int(s["n_records"]),
-        n_samples=int(s["n_samples"]),
-        prediction_rmse=_optional(s.get("prediction_rmse")),
-        prediction_tic=_optional(s.get("prediction_tic")),
-    )
-
-
 def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> SavedVerification:
     """Rebuild a saved verification from its JSON document.
 
@@ -254,12 +226,12 @@ def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") ->
     try:
         verification = Verification(
             records=tuple(_record_from_dict(r) for r in doc["records"]),
-            summary=tuple(_summary_from_dict(s) for s in doc["summary"]),
+            summary=tuple(OutputSummary.from_dict(s) for s in doc["summary"]),
             rmse=_float(doc["rmse"]),
             tic=_float(doc["tic"]),
             without_wind=tuple(_record_from_dict(r) for r in doc.get("without_wind", [])),
             wind_correction=tuple(WindCorrection.from_dict(c) for c in doc.get("wind_correction", [])),
-            off_axis=tuple(_summary_from_dict(s) for s in doc.get("off_axis", [])),
+            off_axis=tuple(OutputSummary.from_dict(s) for s in doc.get("off_axis", [])),
             unverified=tuple(str(text) for text in doc.get("unverified", [])),
         )
         return SavedVerification(

@@ -11,6 +11,8 @@ from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
+from sysid._json import finite_or_none, float_or_nan
+
 __all__ = [
     "rms_error",
     "theil_inequality",
@@ -303,6 +305,33 @@ class OutputSummary:
     prediction_rmse: float | None = None
     prediction_tic: float | None = None
 
+    def to_dict(self) -> dict[str, str | int | float | None]:
+        """Its JSON form, the same in the verification file and in ``sysid validate --json`` (NaN as null)."""
+        return {
+            "name": self.name,
+            "unit": self.unit,
+            "rmse": finite_or_none(self.rmse),
+            "tic": finite_or_none(self.tic),
+            "n_records": self.n_records,
+            "n_samples": self.n_samples,
+            "prediction_rmse": finite_or_none(self.prediction_rmse),
+            "prediction_tic": finite_or_none(self.prediction_tic),
+        }
+
+    @classmethod
+    def from_dict(cls, doc: Mapping[str, Any]) -> OutputSummary:
+        """Read :meth:`to_dict`'s form."""
+        return cls(
+            name=str(doc["name"]),
+            unit=str(doc["unit"]),
+            rmse=float_or_nan(doc["rmse"]),
+            tic=float_or_nan(doc["tic"]),
+            n_records=int(doc["n_records"]),
+            n_samples=int(doc["n_samples"]),
+            prediction_rmse=None if doc.get("prediction_rmse") is None else float(doc["prediction_rmse"]),
+            prediction_tic=None if doc.get("prediction_tic") is None else float(doc["prediction_tic"]),
+        )
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class WindCorrection:
@@ -369,15 +398,14 @@ class WindCorrection:
             "rmse_with_in_band": self.rmse_with_in_band,
             "reduction_in_band_percent": self.reduction_in_band_percent,
         }
-        return {"name": self.name, "unit": self.unit} | {k: v if math.isfinite(v) else None for k, v in numbers.items()}
+        return {"name": self.name, "unit": self.unit} | {k: finite_or_none(v) for k, v in numbers.items()}
 
     @classmethod
     def from_dict(cls, doc: Mapping[str, Any]) -> WindCorrection:
         """Read :meth:`to_dict`'s form (the band's fields may be missing: files written before them)."""
 
         def number(key: str) -> float:
-            value = doc.get(key)
-            return math.nan if value is None else float(value)
+            return float_or_nan(doc.get(key))
 
         return cls(
             name=str(doc["name"]),

@@ -101,6 +101,8 @@ def test_validate_reports_the_wind_correction(flights: tuple[Path, list[Path], l
         "1.5",
         "--report",
         str(report),
+        "-o",
+        str(tmp_path / "validation.json"),
         "--json",
         "-",
         "-q",
@@ -108,6 +110,9 @@ def test_validate_reports_the_wind_correction(flights: tuple[Path, list[Path], l
     result = CliRunner().invoke(cli, args)
     assert result.exit_code == 0, result.output
     summary = json.loads(result.stdout)
+    saved = json.loads((tmp_path / "validation.json").read_text())  # one vocabulary: the file's entries are --json's
+    assert {s["name"]: s for s in saved["summary"]} == summary["summary"]
+    assert {c["name"]: c for c in saved["wind_correction"]} == summary["wind_correction"]
     assert len(summary["records"]) == 2
     assert set(summary["summary"]) == {"u", "q", "theta", "ax"}  # lon doublets: judged on the lon outputs
     assert {"w", "az", "v", "p"} <= set(summary["off_axis"])  # the others, for information
@@ -115,9 +120,9 @@ def test_validate_reports_the_wind_correction(flights: tuple[Path, list[Path], l
         assert summary["summary"][name]["tic"] <= 0.25
     assert summary["wind_correction"]["ax"]["reduction_percent"] >= 13.0  # Table 3.6, strong wind
     assert summary["wind_correction"]["ax"]["rmse_with"] < summary["wind_correction"]["ax"]["rmse_without"]
-    ax = summary["wind_correction"]["ax"]  # the same entry as the verification file's (one vocabulary)
+    ax = summary["wind_correction"]["ax"]
     assert ax["band_hz"] == 2.0 and ax["reduction_in_band_percent"] >= ax["reduction_percent"]
-    assert summary["unstable"] is True and summary["summary"]["q"]["one_step_tic"] is not None
+    assert summary["unstable"] is True and summary["summary"]["q"]["prediction_tic"] is not None
     page = report.read_text()  # the model report, with the verification
     assert 'id="verification"' in page and "With and without the wind term" in page
     assert "change in the wind's band" in page and f"{-ax['reduction_in_band_percent']:+.1f} %" in page
