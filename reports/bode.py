@@ -110,7 +110,7 @@ def bode_figure(
     return figure
 
 
-def write_bode_svg(path: str | Path, responses: Sequence[FrequencyResponse], **options: Any) -> None:
+def write_bode_svg(path: str | Path, responses: Sequence[FrequencyResponse], **options: Any) -> Path:
     """Write :func:`bode_figure` as a standalone SVG file, atomically.
 
     Parameters
@@ -121,11 +121,17 @@ def write_bode_svg(path: str | Path, responses: Sequence[FrequencyResponse], **o
         Responses to draw.
     **options
         Passed to :func:`bode_figure` (``models``, ``n_cols``, ``min_coherence``).
+
+    Returns
+    -------
+    Path
+        The file written.
     """
     svg = figure_svg(bode_figure(responses, **options))
     text = '<?xml version="1.0" encoding="utf-8" standalone="no"?>\n' + svg + "\n"
     with atomic_output(path) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")
+    return Path(path)
 
 
 _PANEL_IN = (1.15, 0.95, 0.7)  # magnitude, phase, coherence heights, inch

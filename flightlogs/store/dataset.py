@@ -101,7 +101,7 @@ def file_sha256(path: str | Path) -> str:
 
 def write_dataset(
     path: str | Path, logs: Sequence[FlightLog], winds: Sequence[Any] = (), conditioned: Sequence[Any] = ()
-) -> None:
+) -> Path:
     """Write logs, wind measurements and conditioned flights to an HDF5 dataset, atomically.
 
     Parameters
@@ -114,6 +114,11 @@ def write_dataset(
         Anemometer measurements to store.
     conditioned : sequence of ConditionedFlight, optional
         Aligned records, segments and alignment of each flight.
+
+    Returns
+    -------
+    Path
+        The file written.
     """
     with atomic_output(path) as tmp, create_schema_file(tmp) as h5:
         stamp_schema(h5, SCHEMA, SCHEMA_VERSION)
@@ -126,6 +131,7 @@ def write_dataset(
         flights = h5.create_group("conditioned")
         for flight in conditioned:
             _write_conditioned(flights.create_group(_unique_key(flights, flight.source)), flight)
+    return Path(path)
 
 
 def read_dataset(path: str | Path) -> Dataset:

@@ -50,7 +50,7 @@ _ARRAYS = (
 )
 
 
-def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) -> None:
+def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) -> Path:
     """Write responses to an HDF5 file, atomically (the file appears only once complete).
 
     Parameters
@@ -59,6 +59,11 @@ def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) ->
         Destination ``.h5``; its folder must exist.
     responses : sequence of FrequencyResponse
         Responses to store, gated (``fit_range`` set) or not.
+
+    Returns
+    -------
+    Path
+        The file written.
 
     Examples
     --------
@@ -70,7 +75,8 @@ def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) ->
     ...                       cross_spectrum=np.ones(2, complex), windows_s=(4.0,),
     ...                       input_unit="%", output_unit="rad/s")
     >>> target = Path(tempfile.mkdtemp()) / "fr.h5"
-    >>> write_responses(target, [h])
+    >>> write_responses(target, [h]) == target
+    True
     >>> (back,) = read_responses(target)
     >>> back.pair, back.input_unit, bool(np.array_equal(back.response, h.response))
     ('q/delta_lon', '%', True)
@@ -81,6 +87,7 @@ def write_responses(path: str | Path, responses: Sequence[FrequencyResponse]) ->
         width = max(3, len(str(len(responses))))
         for k, response in enumerate(responses):
             _write_one(group.create_group(f"{k:0{width}d}"), response)
+    return Path(path)
 
 
 def read_responses(path: str | Path) -> tuple[FrequencyResponse, ...]:
