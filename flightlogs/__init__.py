@@ -40,7 +40,7 @@ from flightlogs.signals import (
 )
 
 if _TYPE_CHECKING:
-    from flightlogs.flightlog import Autopilot, FlightLog, LogFormat, Signal, SystemIdRun
+    from flightlogs.flightlog import Autopilot, FlightLog, LogFormat, Signal, SystemIdRun, WindMeasurement
     from flightlogs.frames import air_velocity_body, earth_to_body, quaternion_to_euler, wind_to_body_axes
     from flightlogs.record import Record
 
@@ -50,6 +50,7 @@ _LAZY = {
     "Signal": "flightlog",
     "SystemIdRun": "flightlog",
     "FlightLog": "flightlog",
+    "WindMeasurement": "flightlog",
     "Autopilot": "flightlog",
     "LogFormat": "flightlog",
     "Record": "record",
@@ -80,6 +81,7 @@ __all__ = [
     "Signal",
     "SystemIdRun",
     "FlightLog",
+    "WindMeasurement",
     "Autopilot",
     "LogFormat",
     "Record",

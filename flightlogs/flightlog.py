@@ -13,7 +13,7 @@ import numpy as np
 
 from flightlogs.signals import LOGGED_SIGNALS, STATE_SIGNALS, is_canonical
 
-__all__ = ["Signal", "SystemIdRun", "FlightLog", "Autopilot", "LogFormat", "logged_rate_hz"]
+__all__ = ["Signal", "SystemIdRun", "FlightLog", "WindMeasurement", "Autopilot", "LogFormat", "logged_rate_hz"]
 
 
 def _held_dtype(dtype: np.dtype) -> type[np.floating]:
@@ -299,3 +299,84 @@ class FlightLog:
         if self.utc_offset_s is None or not self.signals:
             return None
         return datetime.fromtimestamp(self.time_range_s[0] + self.utc_offset_s, tz=UTC)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class WindMeasurement:
+    """Horizontal wind recorded by a ground anemometer, in NED earth axes (:func:`~flightlogs.readers.read_anemometer_csv`).
+
+    Parameters
+    ----------
+    path : Path
+        The file read.
+    utc_s : ndarray, shape (n_samples,)
+        Sample times, UNIX seconds UTC, strictly increasing.
+    wind_n, wind_e : ndarray, shape (n_samples,)
+        North and east components of the velocity the air moves WITH
+        (towards), m/s: ``wind_n = -speed cos(dir_from)``,
+        ``wind_e = -speed sin(dir_from)``.
+    speed_m_s : ndarray, shape (n_samples,)
+        Horizontal wind speed, m/s, ≥ 0.
+    direction_from_rad : ndarray, shape (n_samples,)
+        Meteorological direction the wind comes FROM, rad, in [0, 2π),
+        clockwise from north.
+    wind_d : ndarray, shape (n_samples,), optional
+        Down component of the air velocity, m/s (``-w``), when the file has
+        a vertical component.
+    columns : Mapping[str, str]
+        Which CSV column fed which quantity (``"time"``, ``"speed"``, ...).
+    unit : str
+        Speed unit found in the file (key of :data:`flightlogs.readers.anemometer.SPEED_UNITS`).
+    layout : {"columns", "responseone"}
+        The layout recognised.
+    warnings : tuple of str
+        Assumptions made and lines dropped (the messages of the warnings
+        raised while reading).
+    """
+
+    path: Path
+    utc_s: np.ndarray
+    wind_n: np.ndarray
+    wind_e: np.ndarray
+    speed_m_s: np.ndarray
+    direction_from_rad: np.ndarray
+    wind_d: np.ndarray | None = None
+    columns: Mapping[str, str] = field(default_factory=dict)
+    unit: str = "m/s"
+    layout: str = "columns"
+    warnings: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        n_samples = np.shape(self.utc_s)[0] if np.ndim(self.utc_s) == 1 else -1
+        for name in ("utc_s", "wind_n", "wind_e", "speed_m_s", "direction_from_rad", "wind_d"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            array = np.array(value, dtype=np.float64)
+            if array.shape != (n_samples,):
+                raise ValueError(f"{name} has shape {array.shape}; expected ({n_samples},) like utc_s (1-D)")
+            array.setflags(write=False)
+            object.__setattr__(self, name, array)
+        object.__setattr__(self, "columns", MappingProxyType(dict(self.columns)))
+        object.__setattr__(self, "warnings", tuple(self.warnings))
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples."""
+        return int(self.utc_s.size)
+
+    @property
+    def duration_s(self) -> float:
+        """Time between the first and last sample, s."""
+        return float(self.utc_s[-1] - self.utc_s[0]) if self.n_samples > 1 else 0.0
+
+    @property
+    def rate_hz(self) -> float:
+        """Mean sample rate, Hz (0 for fewer than two samples)."""
+        span = self.duration_s
+        return (self.n_samples - 1) / span if span > 0 else 0.0
+
+    @property
+    def utc_start(self) -> datetime:
+        """UTC of the first sample."""
+        return datetime.fromtimestamp(float(self.utc_s[0]), tz=UTC)

@@ -15,13 +15,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 
 from flightlogs.conditioning.lag import LagEstimate, TransportDelay, estimate_lag
 from flightlogs.errors import DataError
-from flightlogs.flightlog import FlightLog
+from flightlogs.flightlog import FlightLog, WindMeasurement
 
 __all__ = [
     "ESTIMATOR_LAGS_S",
@@ -77,7 +77,7 @@ def _log_span_utc(log: FlightLog) -> tuple[float, float]:
     return start + log.utc_offset_s, end + log.utc_offset_s
 
 
-def overlap_s(log: FlightLog, wind: Any, *, clock_offset_s: float = 0.0) -> float:
+def overlap_s(log: FlightLog, wind: WindMeasurement, *, clock_offset_s: float = 0.0) -> float:
     """Seconds during which `wind` covers `log` (0 if they do not meet).
 
     Parameters
@@ -97,7 +97,7 @@ def _span(log: FlightLog) -> tuple[float, float]:
     return log.time_range_s if log.utc_offset_s is None else _log_span_utc(log)
 
 
-def _overlap(span: tuple[float, float], wind: Any, clock_offset_s: float) -> float:
+def _overlap(span: tuple[float, float], wind: WindMeasurement, clock_offset_s: float) -> float:
     w_start = float(wind.utc_s[0]) - clock_offset_s
     w_end = float(wind.utc_s[-1]) - clock_offset_s
     return max(0.0, min(span[1], w_end) - max(span[0], w_start))
@@ -108,8 +108,8 @@ def _iso(seconds: float) -> str:
 
 
 def pair_winds(
-    logs: Sequence[FlightLog], winds: Sequence[Any], *, clock_offset_s: float | None = None
-) -> list[Any | None]:
+    logs: Sequence[FlightLog], winds: Sequence[WindMeasurement], *, clock_offset_s: float | None = None
+) -> list[WindMeasurement | None]:
     """Pair each log with the anemometer record that overlaps it most in time.
 
     Parameters
@@ -134,7 +134,7 @@ def pair_winds(
     """
     if not winds:
         return [None] * len(logs)
-    paired: list[Any | None] = []
+    paired: list[WindMeasurement | None] = []
     for log in logs:
         if log.utc_offset_s is None and clock_offset_s is None:
             raise DataError(
@@ -150,7 +150,7 @@ def pair_winds(
     return paired
 
 
-def _no_overlap_message(log: FlightLog, winds: Sequence[Any], offset: float) -> str:
+def _no_overlap_message(log: FlightLog, winds: Sequence[WindMeasurement], offset: float) -> str:
     spans = "; ".join(
         f"{Path(w.path).name} {_iso(float(w.utc_s[0]) - offset)} to {_iso(float(w.utc_s[-1]) - offset)}" for w in winds
     )
@@ -166,7 +166,9 @@ def _no_overlap_message(log: FlightLog, winds: Sequence[Any], offset: float) -> 
     )
 
 
-def wind_log_time(log: FlightLog, wind: Any, *, clock_offset_s: float, transport_delay_s: float) -> np.ndarray:
+def wind_log_time(
+    log: FlightLog, wind: WindMeasurement, *, clock_offset_s: float, transport_delay_s: float
+) -> np.ndarray:
     """Times of the wind samples on the log's clock, as felt at the vehicle.
 
     Parameters

@@ -22,7 +22,7 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 
@@ -32,7 +32,7 @@ from flightlogs.conditioning.align import WindAlignment, estimate_residual_offse
 from flightlogs.conditioning.lag import TransportDelay, transport_delay
 from flightlogs.conditioning.resample import contiguous_spans, resample_signals, uniform_time_base
 from flightlogs.errors import DataError, DataQualityWarning, SysidWarning, collected_warnings
-from flightlogs.flightlog import FlightLog, Signal
+from flightlogs.flightlog import FlightLog, Signal, WindMeasurement
 from flightlogs.frames import air_velocity_body, wind_to_body_axes
 from flightlogs.geo import bearing_and_distance, local_north_east
 from flightlogs.maneuvers.excitation_recovery import ExcitationRecovery
@@ -174,7 +174,7 @@ class ConditionedFlight:
 
 def condition_flight(
     log: FlightLog,
-    wind: Any | None = None,
+    wind: WindMeasurement | None = None,
     options: ConditioningOptions = ConditioningOptions(),
 ) -> ConditionedFlight:
     """Align, resample, rotate, segment and de-trim one flight.
@@ -212,10 +212,13 @@ def condition_flight(
         if isinstance(first, ConditionedFlight):
             return replace(first, warnings=caught.messages)
         caught.discard()  # this pass only measured the clock offset: the passes with it corrected say what holds
+    assert wind is not None, "only a flight with wind has its clock offset measured"
     return _with_estimated_offset(log, wind, options, first)
 
 
-def _one_pass(log: FlightLog, wind: Any | None, options: ConditioningOptions) -> ConditionedFlight | WindAlignment:
+def _one_pass(
+    log: FlightLog, wind: WindMeasurement | None, options: ConditioningOptions
+) -> ConditionedFlight | WindAlignment:
     """One conditioning; or, when the clock offset is to be estimated, the alignment whose residual measures it."""
     core = {name: _unwrapped(log.signals[name]) for name in CORE_SIGNALS if name in log.signals}
     if not core:
@@ -320,7 +323,9 @@ def _unwrapped(signal: Signal) -> Signal:
     )
 
 
-def _wind_signals(log: FlightLog, wind: Any, options: ConditioningOptions) -> tuple[WindAlignment, dict[str, Signal]]:
+def _wind_signals(
+    log: FlightLog, wind: WindMeasurement, options: ConditioningOptions
+) -> tuple[WindAlignment, dict[str, Signal]]:
     if log.utc_offset_s is None and options.wind_offset_s is None:
         raise DataError(
             f"{log.path}: the log has no GPS time, so the anemometer cannot be aligned by UTC; "
@@ -455,7 +460,7 @@ _MAX_OFFSET_ITERATIONS = 6
 
 
 def _with_estimated_offset(
-    log: FlightLog, wind: Any, options: ConditioningOptions, first: WindAlignment
+    log: FlightLog, wind: WindMeasurement, options: ConditioningOptions, first: WindAlignment
 ) -> ConditionedFlight:
     """Condition again with the clock offset corrected by the residual found (vehicle lags by +lag).
 
@@ -478,7 +483,7 @@ def _with_estimated_offset(
     return replace(again, wind=replace(again.wind, clock_offset_source="estimated"))
 
 
-def _with_estimated_delay(log: FlightLog, wind: Any, options: ConditioningOptions) -> ConditionedFlight:
+def _with_estimated_delay(log: FlightLog, wind: WindMeasurement, options: ConditioningOptions) -> ConditionedFlight:
     """Condition without a delay, take the vehicle's lag behind the wind as the delay, condition again."""
     with collected_warnings() as caught:
         first = condition_flight(log, wind, replace(options, transport_delay_s=0.0, estimate_transport_delay=False))

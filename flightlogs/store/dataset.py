@@ -36,16 +36,19 @@ import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import h5py
 import numpy as np
 
 from flightlogs._arrays import ByContents
-from flightlogs.flightlog import FlightLog, Signal, SystemIdRun
+from flightlogs.flightlog import FlightLog, Signal, SystemIdRun, WindMeasurement
 from flightlogs.store.schema import create_schema_file, open_schema, put_text, stamp_schema, text, text_dtype
 from flightlogs.writers.atomic import atomic_output
 from flightlogs.writers.jsonio import jsonable
+
+if TYPE_CHECKING:  # conditioning loads when a dataset holds conditioned flights
+    from flightlogs.conditioning.condition import ConditionedFlight
 
 #: Time arrays' filter: LZF (in every h5py build) after byte shuffling; steady steps shrink well. Signal
 #: values are stored plain: measured on a 113 MB log's signals and records, LZF took 1.2 s of a 1.5 s
@@ -67,10 +70,10 @@ class Dataset:
     ----------
     logs : tuple of FlightLog
         Ingested flight logs, in the order they were written.
-    winds : tuple
-        Wind measurements (:class:`flightlogs.readers.anemometer.WindMeasurement`).
-    conditioned : tuple
-        Conditioned flights (:class:`flightlogs.conditioning.condition.ConditionedFlight`).
+    winds : tuple of WindMeasurement
+        Wind measurements.
+    conditioned : tuple of ConditionedFlight
+        Conditioned flights.
     sha256 : dict
         Hash of each source file as it was at ingest, by path string.
     schema_version : int
@@ -78,8 +81,8 @@ class Dataset:
     """
 
     logs: tuple[FlightLog, ...]
-    winds: tuple[Any, ...] = ()
-    conditioned: tuple[Any, ...] = ()
+    winds: tuple[WindMeasurement, ...] = ()
+    conditioned: tuple[ConditionedFlight, ...] = ()
     sha256: dict[str, str] = dataclasses.field(default_factory=dict)
     schema_version: int = SCHEMA_VERSION
 
@@ -100,7 +103,10 @@ def file_sha256(path: str | Path) -> str:
 
 
 def write_dataset(
-    path: str | Path, logs: Sequence[FlightLog], winds: Sequence[Any] = (), conditioned: Sequence[Any] = ()
+    path: str | Path,
+    logs: Sequence[FlightLog],
+    winds: Sequence[WindMeasurement] = (),
+    conditioned: Sequence[ConditionedFlight] = (),
 ) -> Path:
     """Write logs, wind measurements and conditioned flights to an HDF5 dataset, atomically.
 
@@ -320,9 +326,7 @@ def _write_dataclass(group: h5py.Group, item: Any) -> None:
             group.attrs[f"{field.name}.json"] = True
 
 
-def _read_wind(group: h5py.Group) -> Any:
-    from flightlogs.readers.anemometer import WindMeasurement
-
+def _read_wind(group: h5py.Group) -> WindMeasurement:
     kwargs: dict[str, Any] = {}
     for field in dataclasses.fields(WindMeasurement):
         if field.name in group:

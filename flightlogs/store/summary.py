@@ -5,7 +5,7 @@ from __future__ import annotations
 from datetime import UTC
 from typing import Any
 
-from flightlogs.flightlog import FlightLog
+from flightlogs.flightlog import FlightLog, WindMeasurement
 
 __all__ = ["log_summary", "wind_summary", "conditioned_summary"]
 
@@ -48,7 +48,7 @@ def log_summary(log: FlightLog) -> dict[str, Any]:
     }
 
 
-def wind_summary(wind: Any) -> dict[str, Any]:
+def wind_summary(wind: WindMeasurement) -> dict[str, Any]:
     """Summarise an anemometer measurement as JSON-ready data.
 
     Parameters
