@@ -34,6 +34,7 @@ __all__ = [
     "AXES",
     "SID_AXES",
     "Segment",
+    "DetectionOptions",
     "detect_segments",
     "SegmentDetector",
     "segments_from_sid",
@@ -155,17 +156,54 @@ class Segment:
         return self.end_s - self.start_s
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DetectionOptions:
+    """Thresholds and durations of maneuver detection (:func:`detect_segments`).
+
+    Parameters
+    ----------
+    min_hover_s : float
+        Shortest stretch, quiet on every axis, reported as hover, s. Default 3.
+    threshold : float
+        Activity threshold in noise-floor units. Default 4.
+    trend_window_s : float
+        Window of the robust trend that removes trim and slow pilot inputs,
+        s; about one period of the lowest sweep frequency. Default 10.
+    merge_gap_s : float
+        Active stretches on one axis closer than this are one maneuver, s.
+        Default 2.
+    min_active_s : float
+        Bursts active for less than this in total are ignored, s. Default 0.3.
+    hover_margin_s : float
+        Hover keeps this far from any activity, s. Default 0.5.
+
+    Raises
+    ------
+    ValueError
+        If a value is not a positive number (the hover margin may be zero).
+    """
+
+    min_hover_s: float = 3.0
+    threshold: float = 4.0
+    trend_window_s: float = 10.0
+    merge_gap_s: float = 2.0
+    min_active_s: float = 0.3
+    hover_margin_s: float = 0.5
+
+    def __post_init__(self) -> None:
+        for name in ("min_hover_s", "threshold", "trend_window_s", "merge_gap_s", "min_active_s"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name}={getattr(self, name)!r} must be > 0")
+        if not self.hover_margin_s >= 0:
+            raise ValueError(f"hover_margin_s={self.hover_margin_s!r} must be >= 0")
+
+
 def detect_segments(
     time_s: np.ndarray,
     inputs: Mapping[str, np.ndarray],
     *,
     responses: Mapping[str, Mapping[str, np.ndarray]] | None = None,
-    min_hover_s: float = 3.0,
-    threshold: float = 4.0,
-    trend_window_s: float = 10.0,
-    merge_gap_s: float = 2.0,
-    min_active_s: float = 0.3,
-    hover_margin_s: float = 0.5,
+    options: DetectionOptions = DetectionOptions(),
 ) -> tuple[Segment, ...]:
     """Find sweeps, doublets, 3211s, multisines and hover in mixer inputs.
 
@@ -184,20 +222,8 @@ def detect_segments(
         time-frequency signature in these traces together, and the
         segment's `detail` names the traces that carried it; `inputs` then
         serve the doublets and 3211s only.
-    min_hover_s : float, optional
-        Shortest stretch, quiet on every axis, reported as hover, s. Default 3.
-    threshold : float, optional
-        Activity threshold in noise-floor units. Default 4.
-    trend_window_s : float, optional
-        Window of the robust trend that removes trim and slow pilot inputs,
-        s; about one period of the lowest sweep frequency. Default 10.
-    merge_gap_s : float, optional
-        Active stretches on one axis closer than this are one maneuver, s.
-        Default 2.
-    min_active_s : float, optional
-        Bursts active for less than this in total are ignored, s. Default 0.3.
-    hover_margin_s : float, optional
-        Hover keeps this far from any activity, s. Default 0.5.
+    options : DetectionOptions, optional
+        Thresholds and durations of the detection.
 
     Returns
     -------
@@ -216,14 +242,14 @@ def detect_segments(
     Per axis, a robust (bisquare) moving quadratic removes trim and drift;
     a 0.2 s moving mean (which sees the slow start of a faded-in sweep) and
     moving RMS (which sees its fast end) are normalised by noise floors of
-    the quiet stretches. A burst is a run above `threshold`; overlapping
+    the quiet stretches. A burst is a run above ``options.threshold``; overlapping
     bursts on several axes are one maneuver, owned by the axis with the
     largest normalised activity, the others being the closed loop's
     reaction. Each edge is where the owner's trace leaves a baseline fitted
     to the 10 s of trace before it (after it, for the end), within 3 σ or
     1.5 % of the peak; for clean inputs they fall within about 0.1-0.3 s of
     the excitation (a fade-in is found once it rises out of the noise). The
-    trace is cut into half-waves at zero crossings (hysteresis `threshold`
+    trace is cut into half-waves at zero crossings (hysteresis ``options.threshold``
     σ): two large ones of similar area make a doublet, four of durations
     3:2:1:1 (the outer two timed from the first and to the last loud
     sample) a 3211, both bounded by those samples since their edges are
@@ -234,17 +260,7 @@ def detect_segments(
     by a poorly fitted feedback can show an adjacent pair of pulses that
     passes for a doublet).
     """
-    detector = SegmentDetector(
-        time_s,
-        responses=responses,
-        min_hover_s=min_hover_s,
-        threshold=threshold,
-        trend_window_s=trend_window_s,
-        merge_gap_s=merge_gap_s,
-        min_active_s=min_active_s,
-        hover_margin_s=hover_margin_s,
-    )
-    return detector.detect(inputs)
+    return SegmentDetector(time_s, responses=responses, options=options).detect(inputs)
 
 
 class SegmentDetector:
@@ -263,17 +279,12 @@ class SegmentDetector:
         time_s: np.ndarray,
         *,
         responses: Mapping[str, Mapping[str, np.ndarray]] | None = None,
-        min_hover_s: float = 3.0,
-        threshold: float = 4.0,
-        trend_window_s: float = 10.0,
-        merge_gap_s: float = 2.0,
-        min_active_s: float = 0.3,
-        hover_margin_s: float = 0.5,
+        options: DetectionOptions = DetectionOptions(),
     ) -> None:
         self._t, self._dt = _uniform(time_s)
         self._responses = None if responses is None else _check_responses(responses, self._t.size)
         self._found_sweeps: list[FoundSweep] | None = None
-        self._options = (min_hover_s, threshold, trend_window_s, merge_gap_s, min_active_s, hover_margin_s)
+        self._options = options
 
     def _sweeps(self) -> list[FoundSweep]:
         if self._found_sweeps is None:
@@ -284,12 +295,14 @@ class SegmentDetector:
     def detect(self, inputs: Mapping[str, np.ndarray]) -> tuple[Segment, ...]:
         """The segments, with `inputs` the mixer input by axis (as :func:`detect_segments`'), in time order."""
         t, dt = self._t, self._dt
-        min_hover_s, threshold, trend_window_s, merge_gap_s, min_active_s, hover_margin_s = self._options
+        o = self._options
         if not inputs and self._responses is None:
             raise DataError("no mixer input given")
         traces = _check_inputs(inputs, t.size) if inputs else {}
         maneuvers, busy = (
-            find_maneuvers(t, dt, traces, threshold, trend_window_s, merge_gap_s, min_active_s) if traces else ([], [])
+            find_maneuvers(t, dt, traces, o.threshold, o.trend_window_s, o.merge_gap_s, o.min_active_s)
+            if traces
+            else ([], [])
         )
         segments: list[Segment] = []
         if self._responses is not None:
@@ -341,7 +354,7 @@ class SegmentDetector:
         ]
         segments += [
             Segment(axis=None, kind="hover", start_s=a, end_s=b, source="detected")
-            for a, b in hover_spans(t, busy, min_hover_s, hover_margin_s)
+            for a, b in hover_spans(t, busy, o.min_hover_s, o.hover_margin_s)
         ]
         return tuple(sorted(segments, key=lambda s: s.start_s))
 

@@ -12,6 +12,7 @@ from flightlogs.errors import DataError
 from flightlogs.flightlog import SystemIdRun
 from flightlogs.maneuvers.segments import (
     SID_AXES,
+    DetectionOptions,
     Segment,
     SegmentDetector,
     detect_segments,
@@ -369,3 +370,19 @@ def test_a_detector_run_twice_gives_what_detect_segments_gives_each_time() -> No
         assert detector.detect(inputs) == detect_segments(t, inputs, responses=responses)
     kinds = [[(s.axis, s.kind) for s in detector.detect(i) if s.kind != "hover"] for i in ({"lon": delta_lon}, {})]
     assert kinds == [[("lat", "sweep"), ("lon", "doublet")], [("lat", "sweep")]]
+
+
+@pytest.mark.parametrize(
+    "bad", [{"threshold": 0.0}, {"min_hover_s": -1.0}, {"trend_window_s": float("nan")}, {"hover_margin_s": -0.1}]
+)
+def test_detection_options_are_checked(bad: dict[str, float]) -> None:
+    with pytest.raises(ValueError, match=next(iter(bad))):
+        DetectionOptions(**bad)
+
+
+def test_a_longer_least_hover_finds_less_hover() -> None:
+    """The options reach the detection: hover shorter than ``min_hover_s`` is not hover."""
+    t = np.arange(0.0, 60.0, 0.01)
+    quiet = {"lon": np.random.default_rng(3).normal(0.0, 1e-3, t.size)}
+    assert [s.kind for s in detect_segments(t, quiet)] == ["hover"]
+    assert detect_segments(t, quiet, options=DetectionOptions(min_hover_s=61.0)) == ()

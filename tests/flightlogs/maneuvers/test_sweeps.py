@@ -7,10 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from flightlogs.maneuvers import detect_segments
+from flightlogs.maneuvers import DetectionOptions, detect_segments
 
 DT = 0.01
 T = np.arange(0.0, 120.0, DT)
+NO_HOVER = DetectionOptions(min_hover_s=1e9)  # the maneuvers alone
 
 
 def _chirp(start_s: float, duration_s: float, f0: float, f1: float) -> np.ndarray:
@@ -37,7 +38,7 @@ def test_a_chirp_is_found_from_input_and_response_together(f0: float, f1: float,
     chirp = _chirp(30.0, 40.0, f0, f1)
     delta = 0.06 * _high_passed(chirp, 1.0) + rng.normal(0, 0.003, T.size)
     theta = 0.05 * (chirp - _high_passed(chirp, 1.0)) + rng.normal(0, 0.002, T.size)
-    (found,) = detect_segments(T, {}, responses={"lon": {"delta_lon": delta, "theta": theta}}, min_hover_s=1e9)
+    (found,) = detect_segments(T, {}, responses={"lon": {"delta_lon": delta, "theta": theta}}, options=NO_HOVER)
     assert (found.axis, found.kind) == ("lon", "sweep")
     assert found.detail.startswith(f"{direction} ridge in")
     assert 28.0 <= found.start_s <= 31.5 and 68.5 <= found.end_s <= 72.0  # truth 30-70 s with 1 s fades
@@ -54,7 +55,7 @@ def test_a_schroeder_multisine_is_a_multisine() -> None:
     signal = np.cos(2 * np.pi * np.outer(T, harmonics) / 10.0 + phases).sum(axis=1)
     signal *= (T >= 40.0) & (T < 70.0)
     x = 0.06 * signal / np.abs(signal).max() + rng.normal(0, 0.002, T.size)
-    (found,) = detect_segments(T, {}, responses={"thr": {"delta_thr": x}}, min_hover_s=1e9)
+    (found,) = detect_segments(T, {}, responses={"thr": {"delta_thr": x}}, options=NO_HOVER)
     assert (found.axis, found.kind) == ("thr", "multisine")
     assert 39.0 <= found.start_s <= 41.0 and 69.0 <= found.end_s <= 71.0
 
@@ -62,7 +63,7 @@ def test_a_schroeder_multisine_is_a_multisine() -> None:
 def test_noise_alone_is_no_maneuver() -> None:
     rng = np.random.default_rng(5)
     traces = {"lat": {"delta_lat": rng.normal(0, 0.003, T.size), "p": rng.normal(0, 0.01, T.size)}}
-    assert detect_segments(T, {}, responses=traces, min_hover_s=1e9) == ()
+    assert detect_segments(T, {}, responses=traces, options=NO_HOVER) == ()
 
 
 def _band_noise(rng: np.random.Generator, lo_hz: float, hi_hz: float) -> np.ndarray:
@@ -85,7 +86,7 @@ def test_a_pilot_shaking_two_sticks_at_once_is_found_on_both_axes() -> None:
     for axis, rate in (("lat", "p"), ("lon", "q")):
         command = np.where(flown, 0.3 * _band_noise(rng, 0.7, 5.0), 0.0)
         responses[axis] = {f"{rate}_ref": command, rate: command + rng.normal(0, 0.01, T.size)}
-    found = detect_segments(T, {}, responses=responses, min_hover_s=1e9)
+    found = detect_segments(T, {}, responses=responses, options=NO_HOVER)
     assert sorted(s.axis for s in found) == ["lat", "lon"]
     for segment in found:
         assert segment.kind == "broadband" and segment.detail.startswith("piloted, without a frequency trend")
@@ -98,5 +99,5 @@ def test_broadband_motion_that_no_command_carries_is_no_maneuver() -> None:
     flown = (T >= 30.0) & (T < 80.0)
     p = np.where(flown, 0.3 * _band_noise(rng, 0.7, 5.0), 0.0) + rng.normal(0, 0.01, T.size)
     stick = rng.normal(0, 1e-3, T.size)
-    found = detect_segments(T, {}, responses={"lat": {"stick_lat": stick, "p": p}}, min_hover_s=1e9)
+    found = detect_segments(T, {}, responses={"lat": {"stick_lat": stick, "p": p}}, options=NO_HOVER)
     assert found == ()
