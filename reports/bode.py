@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter, NullLocator
+from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter, NullLocator
 
 from flightlogs.writers.atomic import atomic_output
 from sysid.freqresp import FrequencyResponse
@@ -236,10 +236,15 @@ def _draw(
     conditioned = f" | {', '.join(response.conditioned_on)}" if response.conditioned_on else ""
     units = f" ({response.output_unit}/{response.input_unit})" if response.input_unit or response.output_unit else ""
     magnitude.set_title(f"{response.pair}{conditioned}", fontsize=9)
-    magnitude.set_ylabel(f"magnitude, dB{units}" if len(units) < 18 else "magnitude, dB")
+    if units:  # inside the panel: along a panel an inch tall it ran into the labels of the panels around it
+        magnitude.text(0.99, 0.96, units.strip(), transform=magnitude.transAxes, ha="right", va="top", fontsize=6.5)
+    magnitude.set_ylabel("magnitude, dB")
     phase.set_ylabel("phase, deg")
-    coherence.set_ylabel("coherence γ²")
+    coherence.set_ylabel("γ²")  # "coherence γ²" is taller than its panel
     coherence.set_ylim(0.0, 1.05)
+    coherence.set_yticks([0.0, 0.5, 1.0])
+    for ax in (magnitude, phase):  # their lowest tick label met the top one of the panel below
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=4, prune="lower"))
     coherence.set_xlabel("frequency, rad/s")
     for ax in panels:
         ax.set_xlim(omega[0], omega[-1])

@@ -137,3 +137,29 @@ def test_frequency_ticks_are_plain_numbers_labelled_once_per_column() -> None:
     assert sum(ax.get_legend() is not None for ax in shown) == 1  # one legend per figure
     left, right = sorted(labelled, key=lambda ax: ax.get_position().x0)
     assert left.get_position().y0 < right.get_position().y0  # left column: 3 blocks, right: 2
+
+
+def _text_overlaps(figure: Any) -> list[tuple[str, str]]:
+    """Pairs of the figure's visible titles, axis labels and tick labels whose boxes overlap, as drawn."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(figure)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    boxes = []
+    for ax in figure.axes:
+        if not ax.get_visible():
+            continue
+        texts = [ax.title, ax.yaxis.label, ax.xaxis.label, *ax.get_yticklabels(), *ax.get_xticklabels(), *ax.texts]
+        boxes += [(t.get_text(), t.get_window_extent(renderer)) for t in texts if t.get_text() and t.get_visible()]
+    return [(a, b) for k, (a, box) in enumerate(boxes) for b, other in boxes[k + 1 :] if box.overlaps(other)]
+
+
+@pytest.mark.parametrize("n", [1, 2, 5])
+def test_no_label_runs_into_another(n: int) -> None:
+    """Issue 33: the y-labels overlapped (a magnitude label with its units ran an inch and a half along a panel an
+    inch tall; each panel's lowest tick label met the top one of the panel below). Units, long as they are,
+    now sit inside the magnitude panel."""
+    long_units = [dataclasses.replace(_lag(o), input_unit="normalised (-1..1)", output_unit="m/s^2") for o in "qwu"]
+    responses = [*long_units, _lag("theta"), _lag("ax")][:n]
+    assert _text_overlaps(bode_figure(responses)) == []
