@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -80,19 +79,7 @@ def discrepancy(
     from flightlogs.conditioning.condition import ConditioningOptions
     from flightlogs.errors import DataError
     from flightlogs.writers.jsonio import write_json
-    from sysid.discrepancy import (
-        DiscrepancyOptions,
-        ResponseComparison,
-        compare_model_responses,
-        compare_responses,
-        discover,
-        flights_series,
-        read_simulation_model,
-        simulated_flight,
-        simulation_misfit,
-        write_corrected_model,
-    )
-    from sysid.model.statespace import DelayedStateSpace
+    from sysid.discrepancy import DiscrepancyOptions, discover_simulation, write_corrected_model
 
     sim_logs: tuple[Path, ...] = logs
     if not real_logs:
@@ -102,37 +89,26 @@ def discrepancy(
     models = [p for p in sim_logs if p.suffix.lower() == ".json"]
     if models and len(sim_logs) > 1:
         raise DataError(f"{models[0]}: a fitted model is the whole simulation; give it alone, or only flight logs")
-    model = read_simulation_model(models[0]) if models else None
     # the search needs no maneuvers; the report's frequency responses need the sweeps (2 s a log to find)
     maneuvers = None if report is not None else ()
+    reading = reading_from(table_map, vehicle)
     windy = ConditioningOptions(wind_offset_s=wind_offset, wind_distance_m=wind_distance, segments=maneuvers)
     log_only = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset}
     flown = conditioned_flights(
-        list(real_logs),
-        list(wind_paths),
-        windy,
-        log_only=log_only,
-        quiet=quiet,
-        reading=reading_from(table_map, vehicle),
+        list(real_logs), list(wind_paths), windy, log_only=log_only, quiet=quiet, reading=reading
     )
-    if model is None:
-        simulated = conditioned_flights(
-            list(sim_logs),
-            [],
-            ConditioningOptions(segments=maneuvers),
-            log_only={},
-            quiet=quiet,
-            reading=reading_from(table_map, vehicle),
+    simulation = (
+        models[0]
+        if models
+        else conditioned_flights(
+            list(sim_logs), [], ConditioningOptions(segments=maneuvers), log_only={}, quiet=quiet, reading=reading
         )
-        real_series = flights_series(flown, like=simulated)  # like with like: a table's rate, its derived forces
-        sim_series = flights_series(simulated, like=flown)
-    else:
-        real_series = flights_series(flown)
-        sim_series = [simulated_flight(model, s, source=models[0].name) for s in real_series]
+    )
     with staged_progress("discrepancy", quiet=quiet) as progress:
-        misfit = simulation_misfit(models[0]) if models else None
-        options = DiscrepancyOptions(rotor_radius_m=rotor_radius, simulation_misfit=misfit)
-        result = discover(sim_series, real_series, options, progress=progress)
+        found = discover_simulation(
+            simulation, flown, options=DiscrepancyOptions(rotor_radius_m=rotor_radius), progress=progress
+        )
+    result = found.result
     summary = result.to_dict()
     if out is not None:
         write_json(out, summary)
@@ -141,12 +117,7 @@ def discrepancy(
     if report is not None:
         from reports.discrepancy_report import write_discrepancy_report  # matplotlib: only for a report
 
-        comparisons: Sequence[ResponseComparison]
-        if model is None:
-            comparisons = compare_responses(simulated, flown)
-        else:  # a corrected simulation has no frequency response of its own to draw
-            comparisons = compare_model_responses(model, flown) if isinstance(model, DelayedStateSpace) else []
-        write_discrepancy_report(report, result, comparisons, model=models[0].name if models else None)
+        write_discrepancy_report(report, result, found.comparisons(flown), model=found.model_name)
     if not quiet:
         click.echo(f"verdict: {result.verdict}")
         for finding in result.findings:

@@ -10,6 +10,7 @@ from sysid.discrepancy.catalogue import CATALOGUE, EFFECTS, Term
 from sysid.discrepancy.corrected import CorrectedModel
 from sysid.discrepancy.describe import FAR_FROM_FLOOR
 from sysid.discrepancy.fitted_model import model_flight, model_outputs, simulated_flight
+from sysid.discrepancy.flights import SimulationDiscrepancy, discover_simulation
 from sysid.discrepancy.model_files import (
     SimulationModel,
     read_corrected_model,
@@ -23,6 +24,8 @@ from sysid.discrepancy.search import DiscrepancyOptions, discover
 from sysid.discrepancy.series import FlightSeries, flight_series, flights_series
 
 __all__ = [
+    "SimulationDiscrepancy",
+    "discover_simulation",
     "Alternative",
     "CorrectedModel",
     "SimulationModel",
