@@ -19,7 +19,7 @@ import click
 from flightlogs.errors import DataError
 from flightlogs.writers.jsonio import json_text, write_json
 
-from ._flags import RUNNING
+from ._flags import RUNNING, as_flags
 from ._warnings import QUIET
 
 __all__ = [
@@ -264,9 +264,14 @@ def json_owns_stdout(json_path: str | None) -> Iterator[None]:
 
 
 def emit_json(summary: dict[str, Any], json_path: str | None) -> None:
-    """Write `summary` as JSON (NaN as null) to a file (atomically) or, for ``-``, to the real stdout."""
+    """Write `summary` as JSON (NaN as null) to a file (atomically) or, for ``-``, to the real stdout.
+
+    Its ``notes``, library sentences, name the command's flags as the printed lines do (:func:`as_flags`).
+    """
     if json_path is None:
         return
+    if isinstance(summary.get("notes"), list):
+        summary = summary | {"notes": [as_flags(n) if isinstance(n, str) else n for n in summary["notes"]]}
     if json_path == "-":
         stdout = _JSON_STDOUT.get() or sys.stdout
         stdout.write(json_text(summary, indent=2))

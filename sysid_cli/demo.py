@@ -27,31 +27,14 @@ def _verify_doublets(model_path: Path, dataset: Path, out: Path) -> str:
     """
     from flightlogs.store.dataset import read_dataset
     from sysid.fit import read_model
-    from sysid.verify import VerificationOptions, axis_outputs, doublet_records, verify
+    from sysid.verify import VerificationOptions, verification_provenance, verify_identified
     from sysid.verify.io import write_verification
-    from sysid.verify.records import AFTER_S, BEFORE_S
 
-    identified = read_model(model_path)
-    model, with_wind = identified.linear_model(include_wind=False), identified.linear_model(include_wind=True)
-    flights = list(read_dataset(dataset).conditioned)
-    cut = doublet_records(flights)
-    verification = verify(
-        model,
-        cut.records,
-        excited=cut.excited,
-        axes=axis_outputs(identified),
-        wind_model=with_wind if with_wind.inputs != model.inputs else None,
-        options=VerificationOptions(initial_state="estimated"),
-    )
-    options = {
-        "initial_state": "estimated",
-        "before_s": BEFORE_S,
-        "after_s": AFTER_S,
-        "inputs": "all measured",
-        "judged": "on-axis outputs of each doublet's axis",
-        "dataset": dataset.name,
-    }
-    write_verification(out, verification, model=model_path, options=options)
+    options = VerificationOptions(initial_state="estimated")
+    flights = read_dataset(dataset).conditioned
+    verification, _ = verify_identified(read_model(model_path), flights, options=options)
+    saved = verification_provenance(options, sources=[dataset.name])
+    write_verification(out, verification, model=model_path, options=saved)
     worst = max(verification.summary, key=lambda s: s.tic)
     text = (
         f"  {len(verification.records)} doublets, each judged on its axis' outputs: overall TIC "

@@ -99,6 +99,7 @@ def validate(
     from flightlogs.conditioning.condition import ConditioningOptions
     from reports.model_report import write_model_report
     from sysid.fit import read_model
+    from sysid.verify import VerificationOptions, verification_provenance, verify_identified
     from sysid.verify.io import write_verification
 
     identified = read_model(model_path)
@@ -124,87 +125,33 @@ def validate(
     )
     if segments_file is not None and segments is not None:
         _check_segments(segments_file, segments, flights)
-    verification, notes = _verify(
-        identified,
-        flights,
-        dataset=is_dataset(logs[0]),
-        with_wind_files=bool(wind_paths),
-        segments_given=segments_file is not None,
-        before_s=before_s,
-        after_s=after_s,
-        initial_state=initial_state,
+    hint = (
+        ""
+        if segments_file is not None
+        else "give their times to `sysid ingest --segments`"
+        if is_dataset(logs[0])
+        else "give their times with `segments` if they were not detected"
     )
-    saved = {
-        "initial_state": initial_state,
-        "before_s": before_s,
-        "after_s": after_s,
-        "inputs": "all measured",
-        "judged": "on-axis outputs of each doublet's axis",
-        "logs": [p.name for p in logs],
-        "wind": [p.name for p in wind_paths],
-    }
+    options = VerificationOptions(initial_state=initial_state)  # type: ignore[arg-type]
+    verification, said = verify_identified(
+        identified, flights, options=options, before_s=before_s, after_s=after_s, hint=hint
+    )
+    notes = list(said)
+    names = {"sources": [p.name for p in logs], "winds": [p.name for p in wind_paths]}
+    saved = verification_provenance(options, before_s=before_s, after_s=after_s, **names)
     if out is not None:
         write_verification(out, verification, model=model_path, options=saved)
     if report is not None:
         write_model_report(report, identified, verification=verification, verification_options=saved)
     if measured is not None:
         notes.insert(
-            0, f"anemometer clock offset {measured:+.2f} s, as the model's fit measured it (--wind-offset to override)"
+            0,
+            f"anemometer clock offset {measured:+.2f} s, as the model's fit measured it (`wind_offset_s` to override)",
         )
     summary = _summary(verification, model_path, logs, report, notes) | {"output": str(out) if out else None}
     if not quiet:
         _print(summary)
     emit_json(summary, json_path)
-
-
-def _verify(
-    identified: Any,
-    flights: list[Any],
-    *,
-    dataset: bool,
-    with_wind_files: bool,
-    segments_given: bool,
-    before_s: float,
-    after_s: float,
-    initial_state: str,
-) -> tuple[Any, list[str]]:
-    """Verify the model on the flights' doublets, with its wind term where the flights carry the wind."""
-    from sysid.verify import VerificationOptions, axis_outputs, verify_flights
-
-    model = identified.linear_model(include_wind=False)
-    with_wind = identified.linear_model(include_wind=True)
-    wind_inputs = {name for name in with_wind.inputs if name not in model.inputs}
-    signals = {name for flight in flights for record in flight.records for name in record.signals}
-    use_wind = bool(wind_inputs) and (wind_inputs <= signals if dataset else with_wind_files)
-    notes = []
-    if wind_inputs and not use_wind:
-        notes.append(
-            "the model's wind term is not verified: "
-            + (
-                "the dataset holds no aligned wind (ingest it with --wind)"
-                if dataset
-                else "no anemometer file was given (--wind)"
-            )
-        )
-    hint = (
-        ""
-        if segments_given
-        else "give their times to `sysid ingest --segments`"
-        if dataset
-        else "give their times with --segments if they were not detected"
-    )
-    verification = verify_flights(
-        model,
-        flights,
-        wind_model=with_wind if use_wind else None,
-        axes=axis_outputs(identified),
-        before_s=before_s,
-        after_s=after_s,
-        hint=hint,
-        options=VerificationOptions(initial_state=initial_state),  # type: ignore[arg-type]
-        unidentified={a.input: a.reason for a in identified.unidentified_axes},
-    )
-    return verification, notes + list(verification.unverified)
 
 
 def _check_segments(path: Path, segments: Any, flights: list[Any]) -> None:

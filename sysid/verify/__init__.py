@@ -18,7 +18,7 @@ from sysid.verify.io import (
     verification_to_dict,
     write_verification,
 )
-from sysid.verify.logs import verify_flights, verify_logs
+from sysid.verify.logs import verification_provenance, verify_flights, verify_identified, verify_logs
 from sysid.verify.records import DoubletRecords, doublet_records
 from sysid.verify.results import (
     OutputSummary,
@@ -38,6 +38,8 @@ __all__ = [
     "verify",
     "verify_logs",
     "verify_flights",
+    "verify_identified",
+    "verification_provenance",
     "driven_part",
     "axis_outputs",
     "doublet_records",

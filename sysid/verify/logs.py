@@ -5,17 +5,20 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import DataError
 from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.store.campaign import ingest_campaign
+from sysid.fit.result import IdentifiedModel
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify.engine import VerificationOptions, verify
 from sysid.verify.records import AFTER_S, BEFORE_S, MIXER_INPUTS, DoubletRecords, doublet_records
 from sysid.verify.results import Verification
+from sysid.verify.submodel import axis_outputs
 
-__all__ = ["verify_logs", "verify_flights"]
+__all__ = ["verify_logs", "verify_flights", "verify_identified", "verification_provenance"]
 
 
 def verify_logs(
@@ -156,6 +159,103 @@ def verify_flights(
         options=options,
     )
     return replace(verification, unverified=tuple(unverified))
+
+
+def verify_identified(
+    identified: IdentifiedModel,
+    flights: Sequence[ConditionedFlight],
+    *,
+    options: VerificationOptions = VerificationOptions(),
+    before_s: float = BEFORE_S,
+    after_s: float = AFTER_S,
+    hint: str = "give their times with `segments` if they were not detected",
+) -> tuple[Verification, tuple[str, ...]]:
+    """Verify an identified model on the flights' doublets: ``sysid validate``, and the demo's verification.
+
+    Each doublet is judged on the outputs of its axis (:func:`~sysid.verify.axis_outputs`); the model's wind
+    term G_w is verified too where every record carries the wind it reads, and said not to be otherwise.
+
+    Parameters
+    ----------
+    identified : IdentifiedModel
+        The model, as :func:`sysid.fit.read_model` reads it.
+    flights : sequence of ConditionedFlight
+        Flights with doublets not used in the fit.
+    options : VerificationOptions, optional
+        Bias, reference shift, initial state and instability choices.
+    before_s, after_s : float, optional
+        Quiet stretch kept before and response after each doublet, s.
+    hint : str, optional
+        What the message says to do when no doublet is found.
+
+    Returns
+    -------
+    Verification
+        With the wind term, where the flights carry the wind.
+    tuple of str
+        Notes: the wind term not verified, and the axes without a doublet.
+
+    Raises
+    ------
+    DataError
+        If no flight holds a doublet on an axis of the model.
+    """
+    model, with_wind = identified.linear_model(include_wind=False), identified.linear_model(include_wind=True)
+    wind_inputs = sorted(name for name in with_wind.inputs if name not in model.inputs)
+    carried = {name for flight in flights for record in flight.records for name in record.signals}
+    use_wind = bool(wind_inputs) and set(wind_inputs) <= carried
+    notes = []
+    if wind_inputs and not use_wind:
+        notes.append(
+            f"the model's wind term is not verified: the records carry no {', '.join(wind_inputs)} "
+            "(the flights conditioned with an anemometer, `wind_paths`)"
+        )
+    verification = verify_flights(
+        model,
+        flights,
+        wind_model=with_wind if use_wind else None,
+        axes=axis_outputs(identified),
+        options=options,
+        before_s=before_s,
+        after_s=after_s,
+        hint=hint,
+        unidentified={a.input: a.reason for a in identified.unidentified_axes},
+    )
+    return verification, (*notes, *verification.unverified)
+
+
+def verification_provenance(
+    options: VerificationOptions,
+    *,
+    before_s: float = BEFORE_S,
+    after_s: float = AFTER_S,
+    sources: Sequence[str] = (),
+    winds: Sequence[str] = (),
+) -> dict[str, Any]:
+    """How a verification was made, as its file and the report record it.
+
+    Parameters
+    ----------
+    options : VerificationOptions
+        The options it was made with.
+    before_s, after_s : float, optional
+        The doublet cut, s.
+    sources, winds : sequence of str, optional
+        Names of the logs (or dataset) and anemometer files.
+
+    Returns
+    -------
+    dict
+    """
+    return {
+        "initial_state": options.initial_state,
+        "before_s": before_s,
+        "after_s": after_s,
+        "inputs": "all measured",
+        "judged": "on-axis outputs of each doublet's axis",
+        "logs": list(sources),
+        "wind": list(winds),
+    }
 
 
 def _axis_names(model: DelayedStateSpace) -> set[str]:
