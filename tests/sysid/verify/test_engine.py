@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -517,25 +518,30 @@ def test_axes_come_from_the_structure_not_from_the_trim_coupling(calm_flights: l
     assert {s.name for s in result.summary} == {n for names in axes.values() for n in names}
 
 
+def _verified(time_s: np.ndarray, excited: str, output: Any, *, off_axis: tuple[str, ...] = ()) -> RecordVerification:
+    """A record's verification made by hand: one output, nothing else measured."""
+    return RecordVerification(
+        label="r",
+        source=Path("f.bin"),
+        time_s=time_s,
+        inputs=(excited,),
+        outputs=(output,),
+        reference_shifts={},
+        rmse=0.0,
+        tic=0.0,
+        growth=1.0,
+        unstable=False,
+        off_axis=off_axis,
+    )
+
+
 def test_off_axis_names_some_outputs_of_the_record() -> None:
     from sysid.verify import OutputVerification
 
     out = OutputVerification(
         name="q", unit="rad/s", measured=np.zeros(3), simulated=np.zeros(3), bias=0.0, rmse=0.0, tic=0.0
     )
-    make = lambda off: RecordVerification(
-        label="r",
-        source=Path("f.bin"),
-        time_s=np.arange(3.0),
-        inputs=("delta_lon",),
-        outputs=(out,),
-        reference_shifts={},
-        rmse=0.0,
-        tic=0.0,
-        growth=1.0,
-        unstable=False,
-        off_axis=off,
-    )
+    make = lambda off: _verified(np.arange(3.0), "delta_lon", out, off_axis=off)
     with pytest.raises(ValueError, match="some, not all"):
         make(("q",))
     with pytest.raises(ValueError, match="some, not all"):
@@ -654,18 +660,7 @@ def test_the_error_in_the_winds_band_is_the_error_low_passed_as_the_wind_is() ->
         out = OutputVerification(
             name="az", unit="m/s^2", measured=error, simulated=np.zeros(t.size), bias=0.0, rmse=0.0, tic=0.0
         )
-        return RecordVerification(
-            label="r",
-            source=Path("f.bin"),
-            time_s=t,
-            inputs=("delta_thr",),
-            outputs=(out,),
-            reference_shifts={},
-            rmse=0.0,
-            tic=0.0,
-            growth=1.0,
-            unstable=False,
-        )
+        return _verified(t, "delta_thr", out)
 
     (rms,) = _pooled_in_wind_band([record(100.0, 0.4, 0.3)]).values()
     assert rms == pytest.approx(0.4 / np.sqrt(2), rel=2e-3)
