@@ -99,7 +99,7 @@ def validate(
     from flightlogs.conditioning.condition import ConditioningOptions
     from reports.model_report import write_model_report
     from sysid.fit import read_model
-    from sysid.verify import VerificationOptions, verification_provenance, verify_identified
+    from sysid.verify import VerificationOptions, check_given_doublets, verification_provenance, verify_identified
     from sysid.verify.io import write_verification
 
     identified = read_model(model_path)
@@ -124,7 +124,7 @@ def validate(
         logs, wind_paths, conditioning, log_only=log_only, quiet=quiet, reading=reading_from(table_map, vehicle)
     )
     if segments_file is not None and segments is not None:
-        _check_segments(segments_file, segments, flights)
+        check_given_doublets(segments_file, segments, flights)
     hint = (
         ""
         if segments_file is not None
@@ -148,84 +148,11 @@ def validate(
             0,
             f"anemometer clock offset {measured:+.2f} s, as the model's fit measured it (`wind_offset_s` to override)",
         )
-    summary = _summary(verification, model_path, logs, report, notes) | {"output": str(out) if out else None}
+    summary = {"model": str(model_path), "logs": [str(p) for p in logs]} | verification.digest()
+    summary |= {"report": str(report) if report else None, "notes": notes, "output": str(out) if out else None}
     if not quiet:
         _print(summary)
     emit_json(summary, json_path)
-
-
-def _check_segments(path: Path, segments: Any, flights: list[Any]) -> None:
-    """DataError naming the first doublet of `path` that starts outside every flight's records."""
-    from flightlogs.errors import DataError
-
-    for segment in segments:
-        if segment.kind != "doublet" or segment.axis is None:
-            continue
-        if any(r.start_s <= segment.start_s <= r.end_s for f in flights for r in f.records):
-            continue
-        spans = "; ".join(
-            f"{f.source.name} {min(r.start_s for r in f.records):.1f}-{max(r.end_s for r in f.records):.1f} s"
-            for f in flights
-            if f.records
-        )
-        line = _line_of(path, segment.start_s, segment.end_s)
-        where = f"{path}" + (f" line {line}" if line else "")
-        raise DataError(
-            f"{where}: the {segment.axis} doublet at {segment.start_s:g}-{segment.end_s:g} s starts "
-            f"outside every log's records ({spans})"
-        )
-
-
-def _line_of(path: Path, start_s: float, end_s: float) -> int | None:
-    """The CSV line (from 1) whose first two fields are `start_s`, `end_s`, if there is one."""
-    if path.suffix.lower() != ".csv":
-        return None
-    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
-        fields = line.split(",")
-        try:
-            if len(fields) >= 2 and (float(fields[0]), float(fields[1])) == (start_s, end_s):
-                return number
-        except ValueError:
-            continue
-    return None
-
-
-def _summary(
-    verification: Any, model_path: Path, logs: tuple[Path, ...], report: Path | None, notes: list[str]
-) -> dict[str, Any]:
-    summary: dict[str, Any] = {
-        "model": str(model_path),
-        "logs": [str(p) for p in logs],
-        "records": [
-            {
-                "label": r.label,
-                "source": str(r.source),
-                "start_s": float(r.time_s[0]),
-                "end_s": float(r.time_s[-1]),
-                "rmse": r.rmse,
-                "tic": r.tic,
-                "unstable": r.unstable,
-                "growth": r.growth,
-                "unstable_modes": list(r.unstable_modes),
-                "notice": r.notice,
-                "reference_shifts": dict(r.reference_shifts),
-                "bias": {o.name: o.bias for o in r.outputs},
-                "excited": r.excited,
-                "on_axis": [o.name for o in r.judged],
-                "off_axis": list(r.off_axis),
-            }
-            for r in verification.records
-        ],
-        "summary": {s.name: s.to_dict() for s in verification.summary},  # the verification file's entries
-        "off_axis": {s.name: s.to_dict() for s in verification.off_axis},
-        "overall": {"rmse": verification.rmse, "tic": verification.tic},
-        "unstable": verification.unstable,
-        "report": str(report) if report is not None else None,
-        "notes": notes,
-    }
-    if verification.wind_correction:
-        summary["wind_correction"] = {c.name: c.to_dict() for c in verification.wind_correction}
-    return summary
 
 
 def _print(summary: dict[str, Any]) -> None:

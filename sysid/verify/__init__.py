@@ -19,7 +19,7 @@ from sysid.verify.io import (
     write_verification,
 )
 from sysid.verify.logs import verification_provenance, verify_flights, verify_identified, verify_logs
-from sysid.verify.records import DoubletRecords, doublet_records
+from sysid.verify.records import DoubletRecords, check_given_doublets, doublet_records
 from sysid.verify.results import (
     OutputSummary,
     OutputVerification,
@@ -43,6 +43,7 @@ __all__ = [
     "driven_part",
     "axis_outputs",
     "doublet_records",
+    "check_given_doublets",
     "DoubletRecords",
     "OutputVerification",
     "RecordVerification",

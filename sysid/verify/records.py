@@ -4,11 +4,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from flightlogs.conditioning.condition import ConditionedFlight
+from flightlogs.errors import DataError
+from flightlogs.maneuvers.segments import Segment
 from flightlogs.record import Record
 
-__all__ = ["AFTER_S", "BEFORE_S", "DoubletRecords", "doublet_records", "MIXER_INPUTS"]
+__all__ = ["AFTER_S", "BEFORE_S", "DoubletRecords", "check_given_doublets", "doublet_records", "MIXER_INPUTS"]
 
 #: Mixer input excited by a maneuver on each axis.
 #: Quiet stretch kept before each doublet, and response after it, s (an unstable model diverges over long records).
@@ -77,3 +80,53 @@ def doublet_records(
                     excited.append(MIXER_INPUTS[segment.axis])
                     break
     return DoubletRecords(records=tuple(records), excited=tuple(excited))
+
+
+def check_given_doublets(path: Path, segments: Sequence[Segment], flights: Sequence[ConditionedFlight]) -> None:
+    """Check that every doublet a segments file gives starts inside some flight's records.
+
+    Parameters
+    ----------
+    path : Path
+        The segments file (its CSV line is named).
+    segments : sequence of Segment
+        The maneuvers it gives.
+    flights : sequence of ConditionedFlight
+        The flights they should lie in.
+
+    Raises
+    ------
+    DataError
+        Naming the first doublet of `path` that starts outside every flight's records, its line and the
+        records' spans.
+    """
+    for segment in segments:
+        if segment.kind != "doublet" or segment.axis is None:
+            continue
+        if any(r.start_s <= segment.start_s <= r.end_s for f in flights for r in f.records):
+            continue
+        spans = "; ".join(
+            f"{f.source.name} {min(r.start_s for r in f.records):.1f}-{max(r.end_s for r in f.records):.1f} s"
+            for f in flights
+            if f.records
+        )
+        line = _line_of(path, segment.start_s, segment.end_s)
+        where = f"{path}" + (f" line {line}" if line else "")
+        raise DataError(
+            f"{where}: the {segment.axis} doublet at {segment.start_s:g}-{segment.end_s:g} s starts "
+            f"outside every log's records ({spans})"
+        )
+
+
+def _line_of(path: Path, start_s: float, end_s: float) -> int | None:
+    """The CSV line (from 1) whose first two fields are `start_s`, `end_s`, if there is one."""
+    if path.suffix.lower() != ".csv":
+        return None
+    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+        fields = line.split(",")
+        try:
+            if len(fields) >= 2 and (float(fields[0]), float(fields[1])) == (start_s, end_s):
+                return number
+        except ValueError:
+            continue
+    return None

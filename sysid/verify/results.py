@@ -495,3 +495,43 @@ class Verification:
             If there is no wind model or it does not share that output.
         """
         return _named(self.wind_correction, name, f"no wind correction for output {name!r}")
+
+    def digest(self) -> dict[str, Any]:
+        """What ``sysid validate --json`` gives of it: each record without its time histories, each output's
+        entry as the verification file's (:meth:`OutputSummary.to_dict`), by name.
+
+        Returns
+        -------
+        dict
+            ``records``, ``summary``, ``off_axis``, ``overall``, ``unstable`` and, with a wind model,
+            ``wind_correction``.
+        """
+        digest: dict[str, Any] = {
+            "records": [
+                {
+                    "label": r.label,
+                    "source": str(r.source),
+                    "start_s": float(r.time_s[0]),
+                    "end_s": float(r.time_s[-1]),
+                    "rmse": r.rmse,
+                    "tic": r.tic,
+                    "unstable": r.unstable,
+                    "growth": r.growth,
+                    "unstable_modes": list(r.unstable_modes),
+                    "notice": r.notice,
+                    "reference_shifts": dict(r.reference_shifts),
+                    "bias": {o.name: o.bias for o in r.outputs},
+                    "excited": r.excited,
+                    "on_axis": [o.name for o in r.judged],
+                    "off_axis": list(r.off_axis),
+                }
+                for r in self.records
+            ],
+            "summary": {s.name: s.to_dict() for s in self.summary},
+            "off_axis": {s.name: s.to_dict() for s in self.off_axis},
+            "overall": {"rmse": self.rmse, "tic": self.tic},
+            "unstable": self.unstable,
+        }
+        if self.wind_correction:
+            digest["wind_correction"] = {c.name: c.to_dict() for c in self.wind_correction}
+        return digest

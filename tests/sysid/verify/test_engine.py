@@ -685,3 +685,17 @@ def test_the_wind_correction_round_trips_with_its_band() -> None:
     older = {"name": "az", "unit": "m/s^2", "rmse_without": 0.29, "rmse_with": 0.243}  # a file from before the band
     assert np.isnan(WindCorrection.from_dict(older).reduction_in_band_percent)
     assert WindCorrection.from_dict(older).to_dict()["reduction_in_band_percent"] is None
+
+
+def test_a_given_doublet_outside_every_record_names_its_line(calm_flights: list[ConditionedFlight], tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """``sysid validate --segments``: a doublet no record reaches is one sentence with the file's line."""
+    from flightlogs.maneuvers.segments import read_segments_file
+    from sysid.verify import check_given_doublets
+
+    inside = calm_flights[0].segments[0]
+    path = tmp_path / "doublets.csv"
+    path.write_text(f"start_s,end_s,axis,kind\n{inside.start_s},{inside.end_s},lon,doublet\n500,503,lon,doublet\n")
+    given = read_segments_file(path)
+    check_given_doublets(path, given[:1], calm_flights)  # inside: nothing said
+    with pytest.raises(DataError, match=rf"^{path} line 3: the lon doublet at 500-503 s starts outside every log's "):
+        check_given_doublets(path, given, calm_flights)
