@@ -18,9 +18,8 @@ from flightlogs.readers.dispatch import ReadOptions, read_log
 
 __all__ = ["Campaign", "ingest_campaign", "expand_wind_paths"]
 
-_MAX_FORKED_BYTES = (
-    256 * 2**20
-)  # logs conditioned in worker processes up to this much in all: each sends its result back
+#: Logs conditioned in worker processes up to this much in all: each worker sends its result back.
+_MAX_FORKED_BYTES = 256 * 2**20
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
