@@ -101,6 +101,7 @@ def validate(
     from sysid.fit import read_model
     from sysid.verify import VerificationOptions, check_given_doublets, verification_provenance, verify_identified
     from sysid.verify.io import write_verification
+    from sysid.verify.logs import SEGMENTS_HINT
 
     identified = read_model(model_path)
     segments = segments_from(segments_file)
@@ -130,7 +131,7 @@ def validate(
         if segments_file is not None
         else "give their times to `sysid ingest --segments`"
         if is_dataset(logs[0])
-        else "give their times with `segments` if they were not detected"
+        else SEGMENTS_HINT
     )
     options = VerificationOptions(initial_state=initial_state)  # type: ignore[arg-type]
     verification, said = verify_identified(

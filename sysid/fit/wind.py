@@ -256,7 +256,6 @@ class _Problem:
         self.columns = [j for j, c in enumerate(self.assembler.channels) if c.wind]
         self.start = np.array([values[n] for n in self.free])
         self._cache: dict[tuple[int, float], list[np.ndarray]] = {}
-        self._stacked: dict[tuple[int, float], np.ndarray] = {}
 
     def shifted(self, k: int, tau: float) -> list[np.ndarray]:
         """Wind channel `k` delayed by `tau`, per record."""
@@ -267,15 +266,6 @@ class _Problem:
             shifted = [np.interp(t - tau, t, w[:, k]) for t, w in zip(self.data.times, self.data.winds)]
             self._cache[key] = [x - x.mean() for x in shifted]  # as the residual: each record's bias taken out
         return self._cache[key]
-
-    def stacked(self, k: int, tau: float) -> np.ndarray:
-        """:meth:`shifted`, the records end to end, shape (n_samples,)."""
-        key = (k, round(float(tau), 12))
-        if key not in self._stacked:
-            if len(self._stacked) > 64:
-                self._stacked.clear()
-            self._stacked[key] = np.concatenate(self.shifted(k, tau))
-        return self._stacked[key]
 
     def parts(self, theta: np.ndarray) -> tuple[SystemMatrices, list[np.ndarray]]:
         m = self.assembler.matrices(theta)
@@ -314,7 +304,7 @@ class _Normal:
     def solve(self, theta: np.ndarray) -> tuple[np.ndarray, float]:
         """Least-squares gains at the delays of `theta` (entries linear in their gains) and the cost."""
         delays = self.problem.assembler.matrices(theta).delays[self.problem.columns]
-        winds = np.column_stack([self.problem.stacked(k, tau) for k, tau in enumerate(delays)])
+        winds = np.column_stack([np.concatenate(self.problem.shifted(k, tau)) for k, tau in enumerate(delays)])
         return self.solve_for(theta, winds, self.residual)
 
     def solve_for(self, theta: np.ndarray, winds: np.ndarray, residual: np.ndarray) -> tuple[np.ndarray, float]:

@@ -18,7 +18,10 @@ from sysid.verify.records import AFTER_S, BEFORE_S, MIXER_INPUTS, DoubletRecords
 from sysid.verify.results import Verification
 from sysid.verify.submodel import axis_outputs
 
-__all__ = ["verify_logs", "verify_flights", "verify_identified", "verification_provenance"]
+__all__ = ["SEGMENTS_HINT", "verify_logs", "verify_flights", "verify_identified", "verification_provenance"]
+
+#: What a message says to do when no doublet is found in logs (a caller with a dataset says otherwise).
+SEGMENTS_HINT = "give their times with `segments` if they were not detected"
 
 
 def verify_logs(
@@ -103,7 +106,7 @@ def verify_flights(
     options: VerificationOptions = VerificationOptions(),
     before_s: float = BEFORE_S,
     after_s: float = AFTER_S,
-    hint: str = "give their times with `segments` if they were not detected",
+    hint: str = SEGMENTS_HINT,
     unidentified: Mapping[str, str] | None = None,
 ) -> Verification:
     """Verify `model` (and `wind_model`) on every doublet of conditioned flights (see :func:`verify_logs`).
@@ -168,7 +171,7 @@ def verify_identified(
     options: VerificationOptions = VerificationOptions(),
     before_s: float = BEFORE_S,
     after_s: float = AFTER_S,
-    hint: str = "give their times with `segments` if they were not detected",
+    hint: str = SEGMENTS_HINT,
 ) -> tuple[Verification, tuple[str, ...]]:
     """Verify an identified model on the flights' doublets: ``sysid validate``, and the demo's verification.
 
