@@ -12,7 +12,6 @@ import numpy as np
 from sysid.batch import BatchResult, Drift, GroupFit, parameter_series
 from sysid.batch.drift import DriftOptions
 
-from .fleet_table import drift_text
 from .html import render_html, write_html
 from .svg import figure_svg, new_figure
 
@@ -118,7 +117,7 @@ def render_fleet_report(
             {
                 "name": vehicle,
                 "groups": len(groups),
-                "drifts": [drift_text(d) for d in drifts.values()],
+                "drifts": [d.sentence for d in drifts.values()],
                 "figure": trend_figure(result.groups, vehicle, names, drifts, drift.max_cost_average),
             }
         )

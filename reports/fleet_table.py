@@ -15,9 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from flightlogs.writers.atomic import atomic_output
-from sysid.batch import BatchResult, Drift
+from sysid.batch import BatchResult
 
-__all__ = ["COLUMNS", "results_table", "drift_text", "failures_table", "write_tables"]
+__all__ = ["COLUMNS", "results_table", "failures_table", "write_tables"]
 
 COLUMNS = (
     "group",
@@ -87,26 +87,11 @@ def results_table(result: BatchResult) -> Any:
                     "insensitivity_percent": p.insensitivity_percent,
                     "status": p.status,
                     "unit": p.unit,
-                    "drift": "" if drift is None else drift_text(drift),
+                    "drift": "" if drift is None else drift.sentence,
                 }
             )
     frame = pd.DataFrame(rows, columns=list(COLUMNS))
     return frame.astype({"value": float, "cramer_rao_percent": float, "insensitivity_percent": float})
-
-
-def drift_text(drift: Drift) -> str:
-    """One line: ``"Z_thr -89.9 -> -68.4, magnitude -24.0 % (5.1 combined bounds) at V03 2024-06-07, after V03 2024-06-06"``.
-
-    Parameters
-    ----------
-    drift : Drift
-        The drift.
-    """
-    return (
-        f"{drift.parameter} {drift.baseline:.4g} -> {drift.value:.4g}, magnitude {drift.change_percent:+.1f} % "
-        f"({abs(drift.sigmas):.1f} combined bounds) at {drift.after}, after {drift.before}"
-        + ("" if drift.confirmed else "; last flight, not yet confirmed")
-    )
 
 
 def failures_table(result: BatchResult) -> Any:

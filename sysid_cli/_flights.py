@@ -10,7 +10,7 @@ import click
 
 from ._common import progress_bar
 
-__all__ = ["is_dataset", "check_sources", "dataset_flights", "conditioned_flights", "reading_options", "reading_from"]
+__all__ = ["check_sources", "conditioned_flights", "reading_options", "reading_from"]
 
 _MAP_HELP = (
     "Column map of CSV / Parquet tables among the inputs: time=0,delta_lat=1,p=2:deg/s (canonical name = "
@@ -57,17 +57,6 @@ def reading_from(table_map: Any, vehicle: str | None) -> Any:
     return ReadOptions(table_map=table_map, force_multirotor=vehicle == "multirotor")
 
 
-def is_dataset(path: Path) -> bool:
-    """Whether `path` names an HDF5 dataset (by its suffix) rather than a flight log.
-
-    Parameters
-    ----------
-    path : Path
-        A file given on the command line.
-    """
-    return Path(path).suffix.lower() in (".h5", ".hdf5")
-
-
 def check_sources(sources: Sequence[Path], log_only: Mapping[str, Any]) -> bool:
     """True when `sources` are datasets, False when they are logs; a usage error when they are mixed.
 
@@ -85,11 +74,14 @@ def check_sources(sources: Sequence[Path], log_only: Mapping[str, Any]) -> bool:
     click.UsageError
         If datasets and logs are mixed, or a log-only option is given with datasets.
     """
-    datasets = [p for p in sources if is_dataset(p)]
-    if datasets and len(datasets) != len(sources):
-        raise click.UsageError("give either datasets (.h5 from `sysid ingest -o`) or logs, not both")
-    if not datasets:
-        return False
+    from flightlogs.errors import DataError
+    from flightlogs.store.sources import are_datasets
+
+    try:
+        if not are_datasets(sources):
+            return False
+    except DataError as err:
+        raise click.UsageError(str(err)) from None
     given = [name for name, value in log_only.items() if _is_set(value)]
     if given:
         raise click.UsageError(
@@ -101,28 +93,6 @@ def check_sources(sources: Sequence[Path], log_only: Mapping[str, Any]) -> bool:
 
 def _is_set(value: Any) -> bool:
     return not (value is None or value is False or (isinstance(value, (tuple, list)) and not value))
-
-
-def dataset_flights(datasets: Sequence[Path]) -> list[Any]:
-    """The conditioned flights held in HDF5 datasets (``sysid ingest -o``), in order.
-
-    Parameters
-    ----------
-    datasets : sequence of Path
-        Dataset files.
-
-    Raises
-    ------
-    flightlogs.errors.DataError
-        If the datasets hold no conditioned flight.
-    """
-    from flightlogs.errors import DataError
-    from flightlogs.store.dataset import read_dataset
-
-    flights = [flight for path in datasets for flight in read_dataset(path).conditioned]
-    if not flights:
-        raise DataError(f"{', '.join(p.name for p in datasets)}: no conditioned flight in the dataset")
-    return flights
 
 
 def conditioned_flights(
@@ -162,16 +132,15 @@ def conditioned_flights(
     flightlogs.errors.DataError
         If no flight could be conditioned (or a dataset holds none).
     """
-    if check_sources(sources, log_only):
-        return dataset_flights(sources)
-    from flightlogs.store.campaign import ingest_campaign
+    from flightlogs.store.sources import conditioned_sources
 
+    if check_sources(sources, log_only):
+        return conditioned_sources(sources)
     with progress_bar("reading", unit="bytes", quiet=quiet) as bar:
-        campaign = ingest_campaign(
-            list(sources),
-            list(wind_paths),
+        return conditioned_sources(
+            sources,
+            wind_paths,
             options=conditioning,
             progress=lambda _name, done, total: bar(done, total),
             **({} if reading is None else {"reading": reading}),
         )
-    return list(campaign.require_flights())

@@ -120,9 +120,12 @@ def print_transfer(summary: dict[str, Any]) -> None:
     for tf in summary["tf"]:
         low, high = tf["band_rad_s"]
         say(f"{tf['expression']}: J = {tf['J']:.2f} over {low:.3g}-{high:.3g} rad/s")
-        say(f"  {'parameter':<10} {'value':>12} {'CR%':>8} {'I%':>8}")
+        say(f"  {'parameter':<10} {'value':>12} {'CR%':>8} {'I%':>8}  unit")
         for name, p in tf["parameters"].items():
-            say(f"  {name:<10} {p['value']:>12.5g} {p['cr_percent']:>8.3g} {p['insensitivity_percent']:>8.3g}")
+            say(
+                f"  {name:<10} {p['value']:>12.5g} {p['cr_percent']:>8.3g} {p['insensitivity_percent']:>8.3g}  "
+                f"{p['unit']}"
+            )
         say("  poles (rad/s): " + ", ".join(f"{complex(*p):.4g}" for p in tf["poles"]))
         for note in tf["notes"]:
             say(f"  note: {as_flags(note)}")

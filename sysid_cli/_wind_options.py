@@ -81,7 +81,7 @@ def segments_option(help: str) -> _Decorator:
 
 
 def segments_from(segments_file: Path | None) -> tuple[Segment, ...] | None:
-    """The maneuvers of ``--segments`` (:func:`flightlogs.maneuvers.segments.read_segments_file`), or None without it."""
-    from flightlogs.maneuvers.segments import read_segments_file
+    """The maneuvers of ``--segments`` (:func:`flightlogs.readers.segments_file.read_segments_file`), or None without it."""
+    from flightlogs.readers.segments_file import read_segments_file
 
     return read_segments_file(segments_file) if segments_file is not None else None

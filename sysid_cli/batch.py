@@ -203,34 +203,9 @@ def batch(
 def _summary(
     result: Any, tables: tuple[Path, ...], report: Path | None, seconds: float, workers: int
 ) -> dict[str, Any]:
-    from reports.fleet_table import drift_text
-
-    return {
-        "logs": len(result.surveys),
-        "groups": len(result.groups),
-        "fitted": sum(g.error is None for g in result.groups),
-        "cached": result.cached,
-        "workers": workers,
-        "seconds": seconds,
-        "drifts": [
-            {
-                "vehicle": d.vehicle,
-                "parameter": d.parameter,
-                "before": d.before,
-                "after": d.after,
-                "change_percent": d.change_percent,
-                "sigmas": d.sigmas,
-                "confirmed": d.confirmed,
-                "text": drift_text(d),
-            }
-            for d in result.drifts
-        ],
-        "failures": [{"what": f.what, "stage": f.stage, "reason": f.reason} for f in result.failures],
-        "results": str(tables[0]),
-        "csv": str(tables[1]),
-        "failures_csv": str(tables[2]),
-        "report": None if report is None else str(report),
-    }
+    summary: dict[str, Any] = result.digest() | {"workers": workers, "seconds": seconds}
+    summary |= {"results": str(tables[0]), "csv": str(tables[1]), "failures_csv": str(tables[2])}
+    return summary | {"report": None if report is None else str(report)}
 
 
 def _print(summary: dict[str, Any]) -> None:

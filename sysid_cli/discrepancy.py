@@ -9,6 +9,7 @@ import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, staged_progress
 from ._flights import conditioned_flights, reading_from, reading_options
+from ._tables import print_discrepancy
 from ._wind_options import wind_distance_option, wind_offset_option, wind_option
 
 __all__ = ["discrepancy"]
@@ -119,12 +120,7 @@ def discrepancy(
 
         write_discrepancy_report(report, result, found.comparisons(flown), model=found.model_name)
     if not quiet:
-        click.echo(f"verdict: {result.verdict}")
-        for finding in result.findings:
-            cut = f"{finding.improvement_percent:5.1f} % held-out" if finding.modelled else "located only    "
-            click.echo(f"  {finding.effect:14s} {cut}  {finding.evidence}")
-        if not result.findings:
-            click.echo(f"  {result.summary}")
+        print_discrepancy(result)
         for written in (out, report, model_out):
             if written is not None:
                 click.echo(f"wrote {written}")

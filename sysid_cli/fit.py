@@ -10,9 +10,9 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option, staged_progress
-from ._flags import as_flags
-from ._flights import check_sources, conditioned_flights, dataset_flights, reading_from, reading_options
+from ._flights import check_sources, conditioned_flights, reading_from, reading_options
 from ._response_options import gating_options, windows_option
+from ._tables import print_fit
 from ._transfer import fit_transfer, parse_band
 from ._wind_options import (
     anemometer_at_option,
@@ -25,9 +25,9 @@ from ._wind_options import (
 )
 
 if TYPE_CHECKING:
-    from sysid.fit import Guidelines
+    pass
 
-__all__ = ["fit", "parse_assignments", "print_modes"]
+__all__ = ["fit", "parse_assignments"]
 
 _EPILOG = """\b
 Examples:
@@ -268,6 +268,8 @@ def fit(
     dataset = check_sources(logs, log_only)
     with staged_progress("identifying", quiet=quiet) as progress:
         if dataset:
+            from flightlogs.store.sources import dataset_flights
+
             flights = dataset_flights(logs)
             model = identify_flights(flights, structure, options=options, files=list(logs), progress=progress)
         else:
@@ -294,62 +296,5 @@ def fit(
         "report": str(report) if report else None,
     }
     if not quiet:
-        _print_fit(summary, model.guidelines)
+        print_fit(summary, model.guidelines)
     emit_json(summary, json_path)
-
-
-def _fmt(value: float | None, spec: str = ".3g") -> str:
-    return "-" if value is None else format(value, spec)
-
-
-def _value(value: float | None) -> str:
-    """A parameter value for the table: "—" when it has none (unidentified)."""
-    return "—" if value is None or not math.isfinite(value) else format(value, ".5g")
-
-
-def print_modes(rows: list[dict[str, Any]], say: Any) -> None:
-    """Print a modes table (rows as from :func:`sysid.fit.mode_summary`) through `say`."""
-    say(f"  {'mode':<9} {'eigenvalue':>22} {'damping':>8} {'omega_n rad/s':>13} {'t2 / t1/2 s':>11}  stability")
-    for m in rows:
-        pair = f"{m['real']:.4g} ± {m['imag']:.4g}i" if m["imag"] > 0 else f"{m['real']:.4g}"
-        time = m["time_to_double_s"] if m["time_to_double_s"] is not None else m["time_to_half_s"]
-        say(
-            f"  {m['mode']:<9} {pair:>22} {_fmt(m['damping']):>8} {m['natural_frequency_rad_s']:>13.4g} "
-            f"{_fmt(time):>11}  {m['stability']}"
-        )
-
-
-def _print_fit(summary: dict[str, Any], guidelines: Guidelines) -> None:
-    say = click.echo
-    say(
-        f"model {summary['model']}: J_ave = {summary['cost']['average']:.2f} (guideline <= {guidelines.j_average_good:g})"
-    )
-    say(f"  {'parameter':<11} {'value':>11} {'CR%':>7} {'I%':>7}  {'status':<12} unit")
-    for name, p in summary["parameters"].items():
-        misses = guidelines.misses_cr(p["cr_percent"] or 0) or guidelines.misses_insensitivity(
-            p["insensitivity_percent"] or 0
-        )
-        flag = " !" if misses else ""
-        say(
-            f"  {name:<11} {_value(p['value']):>11} {_fmt(p['cr_percent'], '.2f'):>7} "
-            f"{_fmt(p['insensitivity_percent'], '.2f'):>7}  {p['status'] + flag:<12} {p['unit']}"
-        )
-    for axis in summary["axes"]:
-        if axis["status"] != "identified":
-            say(f"  axis {axis['axis']} unidentified: {axis['reason']}; its parameters have no value")
-    say("  response costs: " + ", ".join(f"{k} {v:.1f}" for k, v in summary["cost"]["responses"].items()))
-    for step in summary["reduction"]:
-        say(f"  reduction {step['step']}: {step['parameter']} {step['action']} ({step['reason']})")
-    if summary["wind"]:
-        w = summary["wind"]
-        say(
-            "  wind step residual RMS: "
-            + ", ".join(f"{o} {b:.3g} -> {a:.3g}" for o, b, a in zip(w["outputs"], w["rms_before"], w["rms_after"]))
-        )
-    print_modes(summary["eigenvalues"], say)
-    for note in summary["notes"]:
-        say(f"  note: {as_flags(note)}")
-    say(f"verdict: {summary['verdict']['sentence']}")
-    for key in ("output", "mat", "report"):
-        if summary.get(key):
-            say(f"wrote {summary[key]}")

@@ -309,14 +309,14 @@ def _print_fit(summary: dict[str, Any]) -> None:
     say = click.echo
     say(f"{summary['source']}: {summary['n_points']} points, F0 {summary['f0_source']}")
     criterion = {"aicc": "AICc", "bic": "BIC"}[summary["criterion"]]
-    say(f"  {'model':<18} {'RMSE':>8} {'R2':>8} {'d' + criterion:>8}  parameters")
+    say(f"  {'model':<18} {'RMSE T/T∞':>9} {'R2':>8} {'d' + criterion:>8}  parameters (of z/R, T/T∞: unitless)")
     for name, model in summary["models"].items():
         params = ", ".join(
             f"{n} {v:.5g} [{lo:.4g}, {hi:.4g}]"
             for (n, v), (lo, hi) in zip(model["params"].items(), model["ci"].values())
         )
         mark = "*" if name == summary["best"] else " "
-        say(f"{mark} {name:<18} {model['rmse']:>8.4f} {model['r2']:>8.4f} {model['delta']:>8.2f}  {params or '-'}")
+        say(f"{mark} {name:<18} {model['rmse']:>9.4f} {model['r2']:>8.4f} {model['delta']:>8.2f}  {params or '-'}")
     say(f"chosen: {summary['best']} (lowest {criterion})")
     for key, path in summary["outputs"].items():
         if path:

@@ -9,9 +9,8 @@ from typing import Any
 import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option, progress_bar
-from ._flags import as_flags
 from ._flights import reading_from, reading_options
-from ._warnings import grouped, mark_reported
+from ._tables import print_ingest
 from ._wind_options import (
     anemometer_at_option,
     parse_position,
@@ -132,6 +131,7 @@ def ingest(
     canonical signal with its rate, unit and source, align the anemometer wind, and find the maneuvers."""
     from flightlogs.conditioning.condition import ConditioningOptions
     from flightlogs.store.campaign import ingest_campaign
+    from flightlogs.store.summary import campaign_summary
 
     if estimate_wind_offset and estimate_transport_delay:
         raise click.UsageError("--estimate-wind-offset and --estimate-transport-delay shift the wind alike; pick one")
@@ -160,76 +160,7 @@ def ingest(
 
         campaign.require_flights()  # no dataset without a flight in it; some not conditioned: warned below
         write_dataset(out, campaign.logs, campaign.winds, list(campaign.flights))
-    summary = _summary(campaign, out)
+    summary = campaign_summary(campaign, out)
     if not quiet:
-        _print_summary(summary)
+        print_ingest(summary)
     emit_json(summary, json_path)
-
-
-def _summary(campaign: Any, out: Path | None) -> dict[str, Any]:
-    from flightlogs.store.summary import conditioned_summary, log_summary, wind_summary
-
-    entries = []
-    for log, flight, notes in zip(campaign.logs, campaign.conditioned, campaign.notes):
-        entry = log_summary(log)
-        if flight is not None:
-            entry.update({k: v for k, v in conditioned_summary(flight).items() if k != "warnings"})
-            entry["warnings"] += conditioned_summary(flight)["warnings"]
-        entry["warnings"] += list(notes)
-        entries.append(entry)
-    summary: dict[str, Any] = dict(entries[0]) if len(entries) == 1 else {}
-    summary["logs"] = entries
-    summary["wind"] = [wind_summary(wind) for wind in campaign.winds]
-    summary["output"] = str(out) if out is not None else None
-    return summary
-
-
-def _print_summary(summary: dict[str, Any]) -> None:
-    say = click.echo
-    for entry in summary["logs"]:
-        say(
-            f"{entry['path']}: {entry['autopilot']} {entry['log_format']}, "
-            f"{entry['vehicle'] or 'vehicle unknown'}, {entry['duration_s']:.1f} s"
-            + (f", starts {entry['utc_start']}" if entry["utc_start"] else ", no GPS time")
-        )
-        say(f"  {'signal':<11} {'samples':>8} {'rate Hz':>8}  {'unit':<20} source")
-        for name, info in entry["signals"].items():
-            say(f"  {name:<11} {info['samples']:>8} {info['rate_hz']:>8.1f}  {info['unit']:<20} {info['source']}")
-        if entry["missing"]:
-            say(f"  missing: {', '.join(entry['missing'])}")
-        alignment = entry.get("wind_alignment")
-        if alignment:
-            say(
-                f"  wind {alignment['wind_file']}: clock offset {alignment['clock_offset_s']:+.3f} s "
-                f"({alignment['clock_offset_source']}), transport delay {alignment['transport_delay_s']:.3f} s "
-                f"({alignment['transport_delay_source']}"
-                + (f", {alignment['distance_m']:.2f} m" if alignment["distance_m"] is not None else "")
-                + f"), mean {alignment['mean_speed_m_s']:.2f} m/s"
-            )
-            if alignment["residual_offset_s"] is not None:
-                say(
-                    f"    residual clock offset {alignment['residual_offset_s']:+.3f} s against "
-                    f"{alignment['residual_against']}, modelled as lagging the air by a first-order "
-                    f"{alignment['residual_lag_modelled_s']:g} s (correlation {alignment['residual_correlation']:.2f})"
-                )
-        for record in entry.get("records", []):
-            say(
-                f"  record {record['label']}: {record['start_s']:.2f}-{record['end_s']:.2f} s, "
-                f"{record['samples']} samples at {entry['rate_hz']:.0f} Hz"
-            )
-        for segment in entry.get("segments", []):
-            axis = segment["axis"] or "-"
-            say(
-                f"  {segment['kind']:<8} {axis:<4} {segment['start_s']:8.2f}-{segment['end_s']:8.2f} s  ({segment['source']})"
-            )
-        if "segments" in entry and all(s["kind"] == "hover" for s in entry["segments"]):
-            hovers = len(entry["segments"])
-            say(
-                "  no maneuver found (no sweep, doublet, 3-2-1-1, multisine or pilot's broadband input)"
-                + (f"; {hovers} hover stretch{'es' if hovers > 1 else ''}" if hovers else "")
-            )
-        for warning in grouped(entry["warnings"]):
-            say(f"  warning: {as_flags(warning)}")
-        mark_reported(entry["warnings"])
-    if summary["output"]:
-        say(f"wrote {summary['output']}")

@@ -8,7 +8,8 @@ from typing import Any
 import click
 
 from ._common import SysidCommand, emit_json, json_option
-from .fit import parse_assignments, print_modes
+from ._tables import print_modes
+from .fit import parse_assignments
 
 __all__ = ["modes"]
 

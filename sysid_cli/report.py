@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -11,7 +10,7 @@ import click
 
 from ._common import OutputPath, SysidCommand, emit_json, json_option
 
-__all__ = ["report", "ingest_card"]
+__all__ = ["report"]
 
 _EPILOG = """\b
 Examples:
@@ -19,58 +18,6 @@ Examples:
   sysid report model.json validation.json -o report.html
   sysid report model.json validation.json --ingest-summary ingest.json -o report.html --json -
 """
-
-
-def ingest_card(doc: Any, *, source: str = "ingest summary") -> dict[str, str]:
-    """Summary-card lines (vehicle, flight, wind alignment) from what ``sysid ingest --json`` wrote.
-
-    Parameters
-    ----------
-    doc : Mapping[str, Any]
-        The ingest summary (anything else is refused).
-    source : str, optional
-        Its file name, for the error message.
-
-    Returns
-    -------
-    dict of str to str
-        Label to text.
-
-    Raises
-    ------
-    DataError
-        If `doc` is not an ingest summary.
-    """
-    from flightlogs.errors import DataError
-
-    if not isinstance(doc, Mapping):
-        raise DataError(f"{source}: not a summary written by 'sysid ingest --json' (not a JSON object)")
-    logs = doc.get("logs") if isinstance(doc.get("logs"), list) else [doc] if "vehicle" in doc else None
-    if not logs or not all(isinstance(log, Mapping) for log in logs):
-        raise DataError(f"{source}: not a summary written by 'sysid ingest --json' (no 'logs' or 'vehicle')")
-    card = {"vehicle": "; ".join(dict.fromkeys(str(log.get("vehicle") or "not named in the log") for log in logs))}
-    card["flight"] = "; ".join(
-        f"{Path(str(log.get('path', '?'))).name}: {log.get('autopilot', '?')} {log.get('log_format', '')} log, "
-        f"{float(log.get('duration_s') or 0.0):.0f} s from {log.get('utc_start') or 'unknown UTC'}"
-        for log in logs
-    )
-    alignment = doc.get("wind_alignment")
-    if isinstance(alignment, Mapping) and alignment:
-        parts = [
-            f"anemometer clock offset {float(alignment['clock_offset_s']):+.2f} s "
-            f"({alignment.get('clock_offset_source', '?')})"
-            if "clock_offset_s" in alignment
-            else "",
-            f"transport delay {float(alignment['transport_delay_s']):.2f} s "
-            f"({alignment.get('transport_delay_source', '?')})"
-            if "transport_delay_s" in alignment
-            else "",
-            f"turbulence {100 * float(alignment['turbulence_ratio']):.0f} %"
-            if alignment.get("turbulence_ratio") is not None
-            else "",
-        ]
-        card["wind alignment"] = ", ".join(p for p in parts if p)
-    return card
 
 
 def _read_json(path: Path) -> Any:
@@ -113,6 +60,7 @@ def report(
     parameters, costs, correlations, modes; with VALIDATION.json (a saved verification, as 'sysid validate -o'
     and 'sysid demo' write), also the doublets predicted with and without the wind term. One self-contained file."""
     from reports.html import write_html
+    from reports.ingest_card import ingest_card
     from reports.model_report import model_report_html
     from sysid.fit import model_verdict, read_model
     from sysid.verify.io import read_verification, require_verified_model

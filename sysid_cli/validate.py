@@ -7,9 +7,9 @@ from typing import Any
 
 import click
 
-from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option
-from ._flags import as_flags
-from ._flights import conditioned_flights, is_dataset, reading_from, reading_options
+from ._common import LibraryDefault, OutputPath, SysidCommand, emit_json, json_option, progress_bar
+from ._flights import check_sources, reading_from, reading_options
+from ._tables import print_validation
 from ._wind_options import (
     segments_from,
     segments_option,
@@ -99,100 +99,40 @@ def validate(
     from flightlogs.conditioning.condition import ConditioningOptions
     from reports.model_report import write_model_report
     from sysid.fit import read_model
-    from sysid.verify import VerificationOptions, check_given_doublets, verification_provenance, verify_identified
+    from sysid.verify import VerificationOptions, verify_logs
     from sysid.verify.io import write_verification
-    from sysid.verify.logs import SEGMENTS_HINT
 
+    log_only: dict[str, Any] = {"--wind": wind_paths, "--wind-distance": wind_distance, "--wind-offset": wind_offset}
+    log_only |= {"--transport-delay": transport_delay, "--segments": segments_file, "--map": table_map}
+    check_sources(logs, log_only | {"--vehicle": vehicle})
     identified = read_model(model_path)
-    segments = segments_from(segments_file)
-    measured = identified.measured_clock_offset_s if wind_paths and wind_offset is None else None
     conditioning = ConditioningOptions(
-        wind_offset_s=wind_offset if measured is None else measured,
+        wind_offset_s=wind_offset,
         wind_distance_m=wind_distance,
         transport_delay_s=transport_delay,
-        segments=segments,
+        segments=segments_from(segments_file),
     )
-    log_only = {
-        "--wind": wind_paths,
-        "--wind-distance": wind_distance,
-        "--wind-offset": wind_offset,
-        "--transport-delay": transport_delay,
-        "--segments": segments_file,
-        "--map": table_map,
-        "--vehicle": vehicle,
-    }
-    flights = conditioned_flights(
-        logs, wind_paths, conditioning, log_only=log_only, quiet=quiet, reading=reading_from(table_map, vehicle)
-    )
-    if segments_file is not None and segments is not None:
-        check_given_doublets(segments_file, segments, flights)
-    hint = (
-        ""
-        if segments_file is not None
-        else "give their times to `sysid ingest --segments`"
-        if is_dataset(logs[0])
-        else SEGMENTS_HINT
-    )
-    options = VerificationOptions(initial_state=initial_state)  # type: ignore[arg-type]
-    verification, said = verify_identified(
-        identified, flights, options=options, before_s=before_s, after_s=after_s, hint=hint
-    )
-    notes = list(said)
-    names = {"sources": [p.name for p in logs], "winds": [p.name for p in wind_paths]}
-    saved = verification_provenance(options, before_s=before_s, after_s=after_s, **names)
+    with progress_bar("reading", unit="bytes", quiet=quiet) as bar:
+        validation = verify_logs(
+            identified,
+            logs,
+            wind_paths=wind_paths,
+            conditioning=conditioning,
+            segments_path=segments_file,
+            options=VerificationOptions(initial_state=initial_state),  # type: ignore[arg-type]
+            before_s=before_s,
+            after_s=after_s,
+            progress=lambda _name, done, total: bar(done, total),
+            reading=reading_from(table_map, vehicle),
+        )
+    verification, saved = validation.verification, validation.provenance
     if out is not None:
         write_verification(out, verification, model=model_path, options=saved)
     if report is not None:
         write_model_report(report, identified, verification=verification, verification_options=saved)
-    if measured is not None:
-        notes.insert(
-            0,
-            f"anemometer clock offset {measured:+.2f} s, as the model's fit measured it (`wind_offset_s` to override)",
-        )
     summary = {"model": str(model_path), "logs": [str(p) for p in logs]} | verification.digest()
+    notes = [*verification.record_notes(), *validation.notes]
     summary |= {"report": str(report) if report else None, "notes": notes, "output": str(out) if out else None}
     if not quiet:
-        _print(summary)
+        print_validation(summary)
     emit_json(summary, json_path)
-
-
-def _print(summary: dict[str, Any]) -> None:
-    say = click.echo
-    say(f"{summary['model']}: {len(summary['records'])} records, each judged on the outputs of its axis")
-    wind = summary.get("wind_correction", {})
-    header = f"  {'output':<8} {'unit':<8} {'RMS error':>10} {'TIC':>6}"
-    band = next((c["band_hz"] for c in wind.values() if c["band_hz"] is not None), None)
-    in_band = f"< {band:g} Hz" if band is not None else ""
-    say(header + (f" {'without G_w':>12} {'reduction':>9}" + (f" {in_band:>9}" if in_band else "") if wind else ""))
-    for name, row in summary["summary"].items():
-        line = f"  {name:<8} {row['unit']:<8} {row['rmse']:>10.4g} {row['tic']:>6.2f}"
-        if name in wind and wind[name]["reduction_percent"] is not None:
-            line += f" {wind[name]['rmse_without']:>12.4g} {wind[name]['reduction_percent']:>8.1f}%"
-            if in_band and wind[name]["reduction_in_band_percent"] is not None:
-                line += f" {wind[name]['reduction_in_band_percent']:>8.1f}%"
-        say(line)
-    from sysid.verify import mode_names
-
-    unstable = [r for r in summary["records"] if r["unstable"]]
-    if len(unstable) > 1:  # one note, not the same sentence per record
-        growth = max(r["growth"] for r in unstable)
-        names = mode_names([m for r in unstable for m in r["unstable_modes"]])
-        say(
-            f"  note: the model is unstable open loop in its {names} and grows up to {growth:.0f}-fold over "
-            f"{len(unstable)} records "
-            f"({'; '.join(r['label'] for r in unstable)}): small input or initial-state errors diverge there, so "
-            "judge them also by the one-step-ahead prediction error (prediction_rmse, prediction_tic in --json)"
-        )
-    for record in summary["records"]:
-        if record["notice"] and (len(unstable) < 2 or not record["unstable"]):
-            say(f"  note: {record['label']}: {as_flags(record['notice'])}")
-    for note in summary["notes"]:
-        say(f"  note: {as_flags(note)}")
-    if summary["off_axis"]:
-        say(
-            "  off-axis (not judged): "
-            + ", ".join(f"{name} TIC {row['tic']:.2f}" for name, row in summary["off_axis"].items())
-        )
-    for path in (summary["output"], summary["report"]):
-        if path:
-            say(f"wrote {path}")

@@ -69,7 +69,7 @@ FORBIDDEN_THIRD_PARTY = {
 # fit             3    core, model, freqresp
 # verify          4    core, model, fit
 # discrepancy     4    core, model, freqresp, fit   (a fitted model file in the simulation's place)
-# batch           5    model, fit, verify, discrepancy   (runs them all on a cluster)
+# batch           5    core, model, fit, verify, discrepancy   (runs them all on a cluster)
 SUBPACKAGE_LAYERS: dict[str, dict[str, tuple[int, frozenset[str]]]] = {
     "flightlogs": {
         "core": (0, frozenset()),
@@ -96,7 +96,7 @@ SUBPACKAGE_LAYERS: dict[str, dict[str, tuple[int, frozenset[str]]]] = {
         "fit": (3, frozenset({"core", "model", "freqresp"})),
         "verify": (4, frozenset({"core", "model", "fit"})),
         "discrepancy": (4, frozenset({"core", "model", "freqresp", "fit"})),  # series or a model file; responses
-        "batch": (5, frozenset({"model", "fit", "verify", "discrepancy"})),
+        "batch": (5, frozenset({"core", "model", "fit", "verify", "discrepancy"})),
     },
 }
 NAMESPACE = "__init__"  # a top package's own __init__: above all its units, imported by none of them

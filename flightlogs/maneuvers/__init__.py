@@ -16,7 +16,6 @@ from flightlogs.maneuvers.segments import (
     SegmentDetector,
     SegmentSource,
     detect_segments,
-    read_segments_file,
     segments_from_sid,
 )
 
@@ -34,5 +33,4 @@ __all__ = [
     "SegmentDetector",
     "detect_segments",
     "segments_from_sid",
-    "read_segments_file",
 ]

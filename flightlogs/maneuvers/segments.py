@@ -5,7 +5,7 @@ three places, in order of trust: ``"sids"``, the runs ArduPilot's System ID
 mode logs when it starts a sweep (SIDS messages, in
 :attr:`FlightLog.system_id_runs <flightlogs.flightlog.FlightLog>`;
 :func:`segments_from_sid`); ``"user"``, a TOML or CSV file the engineer
-writes (:func:`read_segments_file`);
+writes (:func:`flightlogs.readers.segments_file.read_segments_file`);
 ``"detected"``, found from the mixer inputs alone (:func:`detect_segments`).
 Axes are the mixer inputs: ``lat`` (delta_lat, roll), ``lon`` (delta_lon,
 pitch), ``yaw`` (delta_yaw) and ``thr`` (delta_thr).
@@ -13,12 +13,9 @@ pitch), ``yaw`` (delta_yaw) and ``thr`` (delta_thr).
 
 from __future__ import annotations
 
-import csv
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields, replace
-from pathlib import Path
-from typing import Any, Literal, cast, get_args
+from typing import Any, Literal, cast
 
 import numpy as np
 
@@ -26,6 +23,7 @@ from flightlogs.errors import DataError
 from flightlogs.flightlog import SystemIdRun
 from flightlogs.maneuvers._detection import FoundManeuver, find_maneuvers, hover_spans
 from flightlogs.maneuvers._sweeps import FoundSweep, find_sweeps
+from flightlogs.segment import AXES, Axis, Kind, Segment, SegmentSource
 
 __all__ = [
     "Axis",
@@ -38,15 +36,7 @@ __all__ = [
     "detect_segments",
     "SegmentDetector",
     "segments_from_sid",
-    "read_segments_file",
 ]
-
-Axis = Literal["lat", "lon", "yaw", "thr"]
-Kind = Literal["sweep", "doublet", "3211", "multisine", "broadband", "hover"]
-SegmentSource = Literal["sids", "detected", "user"]
-
-#: Mixer axes in canonical order (delta_lat, delta_lon, delta_yaw, delta_thr).
-AXES: tuple[str, ...] = get_args(Axis)
 
 #: ArduCopter ``SID_AXIS`` values: (mixer axis excited, ArduPilot's name).
 #: Source: ``@Values`` of ``SID_AXIS`` in ``ArduCopter/mode_systemid.cpp``.
@@ -85,7 +75,6 @@ _SID_FIELDS = {
     "TR": "record_s",
     "TFout": "fade_out_s",
 }
-_USER_KEYS = ("start_s", "end_s", "axis", "kind", "f_min_hz", "f_max_hz")
 _RING_S = 5.0  # the loop rings this long after a doublet or 3211
 _STEP_JUMP = 5.0  # a logged step: a sample-to-sample change this many times the input's typical one
 _STEP_LOOK_BACK_S = 0.5  # the first step is searched from this long before the fitted start
@@ -95,65 +84,6 @@ _MIN_TONE_S = 15.0  # a sweep runs at least this long besides any step it overla
 #: The rate (or, for thrust, the acceleration) a step on each axis moves.
 _RATE_OF = {"lat": "p", "lon": "q", "yaw": "r", "thr": "az"}
 _FOLLOWED = 2.0  # a step's rate: its RMS over the step and one second after, this many times the hover's before
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Segment:
-    """One maneuver, or one stretch of hover, in a flight.
-
-    Parameters
-    ----------
-    axis : {"lat", "lon", "yaw", "thr"} or None
-        Mixer axis excited; None exactly when `kind` is ``"hover"``.
-    kind : {"sweep", "doublet", "3211", "multisine", "broadband", "hover"}
-        What was flown. ``broadband`` is a pilot's frequency-rich input without
-        a frequency trend: not a sweep (a sweep's frequency rises or falls), used
-        for identification only when asked for.
-    start_s, end_s : float
-        Bounds on the log clock, s; a fade-in is inside.
-    source : {"sids", "detected", "user"}
-        Where the segment came from.
-    f_min_hz, f_max_hz : float or None, optional
-        Frequency range of a sweep (or multisine), Hz.
-    detail : str, optional
-        Free text, e.g. the ArduPilot axis that was excited.
-    """
-
-    axis: Axis | None
-    kind: Kind
-    start_s: float
-    end_s: float
-    source: SegmentSource
-    f_min_hz: float | None = None
-    f_max_hz: float | None = None
-    detail: str = ""
-
-    def __post_init__(self) -> None:
-        if self.kind not in get_args(Kind):
-            raise DataError(f"unknown kind {self.kind!r} (expected {', '.join(get_args(Kind))})")
-        if self.kind == "hover" and self.axis is not None:
-            raise DataError(f"a hover segment has no axis, got axis={self.axis!r}")
-        if self.kind != "hover" and self.axis not in AXES:
-            raise DataError(f"unknown axis {self.axis!r} for a {self.kind} (expected {', '.join(AXES)})")
-        if self.source not in get_args(SegmentSource):
-            raise DataError(f"unknown source {self.source!r}")
-        start, end = float(self.start_s), float(self.end_s)
-        if not (np.isfinite(start) and np.isfinite(end)) or end <= start:
-            raise DataError(f"end_s={end:g} must be after start_s={start:g}")
-        object.__setattr__(self, "start_s", start)
-        object.__setattr__(self, "end_s", end)
-        for name in ("f_min_hz", "f_max_hz"):
-            value = getattr(self, name)
-            if value is not None and not (np.isfinite(value) and value > 0):
-                raise DataError(f"{name}={value} must be a positive frequency in Hz")
-            object.__setattr__(self, name, None if value is None else float(value))
-        if self.f_min_hz is not None and self.f_max_hz is not None and self.f_max_hz < self.f_min_hz:
-            raise DataError(f"f_max_hz={self.f_max_hz:g} is below f_min_hz={self.f_min_hz:g}")
-
-    @property
-    def duration_s(self) -> float:
-        """Length of the segment, s."""
-        return self.end_s - self.start_s
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -453,59 +383,6 @@ def segments_from_sid(
     return tuple(out)
 
 
-def read_segments_file(path: str | Path) -> tuple[Segment, ...]:
-    """Read user-defined segments from a TOML or CSV file.
-
-    Parameters
-    ----------
-    path : str or Path
-        ``.toml`` with ``[[segment]]`` tables (keys ``start_s``, ``end_s``,
-        ``axis``, ``kind``, ``f_min_hz``, ``f_max_hz``), or ``.csv`` with rows
-        ``start_s,end_s,axis[,kind[,f_min_hz,f_max_hz]]`` (a header row naming
-        the columns is optional; ``#`` starts a comment line). `kind` defaults
-        to ``"sweep"``; hover rows leave `axis` empty.
-
-    Returns
-    -------
-    tuple of Segment
-        ``source="user"``, in time order.
-
-    Raises
-    ------
-    DataError
-        If the file cannot be read or parsed, holds no segment, or a row is
-        invalid (end before start, unknown axis or kind, not a number); the
-        message names the file and the line.
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     path = Path(tmp) / "segments.csv"
-    ...     _ = path.write_text("start_s,end_s,axis,kind\\n12.5,46.5,lon,sweep\\n")
-    ...     read_segments_file(path)[0].axis
-    'lon'
-    """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise DataError(f"{path}: cannot be read ({err}).") from err
-    suffix = path.suffix.lower()
-    if suffix not in (".toml", ".csv"):
-        raise DataError(f"{path}: a segments file is .toml or .csv, not {suffix or 'without extension'}.")
-    entries = _toml_entries(path, text) if suffix == ".toml" else _csv_entries(path, text)
-    if not entries:
-        raise DataError(f"{path}: no segment found.")
-    segments = []
-    for line, entry in entries:
-        try:
-            segments.append(_user_segment(entry))
-        except DataError as err:
-            raise DataError(f"{path}:{line}: {err}.") from None
-    return tuple(sorted(segments, key=lambda s: s.start_s))
-
-
 # ------------------------------------------------------------------ checks of detection inputs
 
 
@@ -649,68 +526,3 @@ def _checked_run(run: SystemIdRun) -> SystemIdRun:
     if int(run.axis) != run.axis:
         raise DataError(f"SIDS row at {run.start_s:.2f} s: axis={run.axis} is not an integer")
     return replace(run, axis=int(run.axis))
-
-
-def _toml_entries(path: Path, text: str) -> list[tuple[int, dict[str, Any]]]:
-    import tomllib  # here, not at import: only segment files need it
-
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise DataError(f"{path}: not valid TOML ({err}).") from err
-    unknown = [key for key in data if key != "segment"]
-    if unknown:
-        raise DataError(f"{path}: unknown top-level key {unknown[0]!r} (expected [[segment]] tables).")
-    tables = data.get("segment", [])
-    if not isinstance(tables, list) or not all(isinstance(item, dict) for item in tables):
-        raise DataError(f"{path}: 'segment' must be an array of tables, written [[segment]].")
-    lines = [n for n, row in enumerate(text.splitlines(), 1) if re.match(r"\s*\[\[\s*segment\s*\]\]", row)]
-    return list(zip(lines + [0] * (len(tables) - len(lines)), tables))
-
-
-def _csv_entries(path: Path, text: str) -> list[tuple[int, dict[str, Any]]]:
-    entries: list[tuple[int, dict[str, Any]]] = []
-    header = None
-    for line, row in enumerate(csv.reader(text.splitlines()), 1):
-        cells = [cell.strip() for cell in row]
-        if not any(cells) or cells[0].startswith("#"):
-            continue
-        if header is None and not entries and not _is_number(cells[0]):
-            header = [cell.lower() for cell in cells]
-            unknown = [name for name in header if name not in _USER_KEYS]
-            if unknown:
-                raise DataError(f"{path}:{line}: unknown column {unknown[0]!r} (expected {', '.join(_USER_KEYS)}).")
-            continue
-        names = header or list(_USER_KEYS)
-        if len(cells) > len(names):
-            raise DataError(f"{path}:{line}: {len(cells)} fields, expected at most {len(names)}.")
-        entries.append((line, {name: cell for name, cell in zip(names, cells) if cell != ""}))
-    return entries
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def _user_segment(entry: dict[str, Any]) -> Segment:
-    unknown = [key for key in entry if key not in _USER_KEYS]
-    if unknown:
-        raise DataError(f"unknown key {unknown[0]!r} (expected {', '.join(_USER_KEYS)})")
-    values: dict[str, Any] = {}
-    for key in ("start_s", "end_s", "f_min_hz", "f_max_hz"):
-        if key in entry:
-            try:
-                values[key] = float(entry[key])
-            except (TypeError, ValueError):
-                raise DataError(f"{key}={entry[key]!r} is not a number") from None
-        elif key in ("start_s", "end_s"):
-            raise DataError(f"{key} is missing")
-    if values["end_s"] <= values["start_s"]:
-        raise DataError(f"end_s={values['end_s']:g} is not after start_s={values['start_s']:g}")
-    axis = str(entry.get("axis", "")).strip().lower()
-    kind = str(entry.get("kind", "sweep")).strip().lower()
-    return Segment(axis=None if axis in ("", "none") else axis, kind=kind, source="user", **values)  # type: ignore[arg-type]

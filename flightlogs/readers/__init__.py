@@ -3,7 +3,7 @@
 The public names of :mod:`~flightlogs.readers.anemometer`, :mod:`~flightlogs.readers.ardupilot`,
 :mod:`~flightlogs.readers.dataflash`, :mod:`~flightlogs.readers.detect`,
 :mod:`~flightlogs.readers.dispatch`, :mod:`~flightlogs.readers.px4_topics`,
-:mod:`~flightlogs.readers.rig`, :mod:`~flightlogs.readers.table`, :mod:`~flightlogs.readers.tlog` and :mod:`~flightlogs.readers.ulog`
+:mod:`~flightlogs.readers.rig`, :mod:`~flightlogs.readers.segments_file`, :mod:`~flightlogs.readers.table`, :mod:`~flightlogs.readers.tlog` and :mod:`~flightlogs.readers.ulog`
 are re-exported here: write ``from flightlogs.readers import name``. Modules with a leading
 underscore are private. Each name loads its module on first use: ``import flightlogs.readers.ulog``
 loads neither pymavlink nor the other readers.
@@ -44,6 +44,7 @@ if TYPE_CHECKING:
         rotor_count,
     )
     from flightlogs.readers.rig import HEIGHT_UNITS, THRUST_UNITS, RigData, read_rig_csv
+    from flightlogs.readers.segments_file import read_segments_file, segment_line
     from flightlogs.readers.table import TableColumn, TableMap, is_table, parse_table_map, read_table
     from flightlogs.readers.tlog import read_tlog
     from flightlogs.readers.ulog import read_ulog
@@ -93,6 +94,8 @@ __all__ = [
     "is_table",
     "read_tlog",
     "read_ulog",
+    "read_segments_file",
+    "segment_line",
 ]
 
 _HOMES = {
@@ -125,6 +128,7 @@ _HOMES = {
         "px4_topics",
     ),
     **dict.fromkeys(("HEIGHT_UNITS", "THRUST_UNITS", "RigData", "read_rig_csv"), "rig"),
+    **dict.fromkeys(("read_segments_file", "segment_line"), "segments_file"),
     **dict.fromkeys(("TableColumn", "TableMap", "is_table", "parse_table_map", "read_table"), "table"),
     **dict.fromkeys(("read_tlog",), "tlog"),
     **dict.fromkeys(("read_ulog",), "ulog"),

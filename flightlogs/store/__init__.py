@@ -1,7 +1,8 @@
 """Storage: the versioned HDF5 dataset, campaigns of logs and anemometer files, and their summaries.
 
 The public names of :mod:`~flightlogs.store.campaign`, :mod:`~flightlogs.store.dataset`,
-:mod:`~flightlogs.store.schema` and :mod:`~flightlogs.store.summary` are re-exported here: write
+:mod:`~flightlogs.store.schema`, :mod:`~flightlogs.store.sources` and :mod:`~flightlogs.store.summary` are
+re-exported here: write
 ``from flightlogs.store import name``. Modules with a leading underscore are private. Each name loads
 its module on first use (the dataset loads h5py).
 """
@@ -14,7 +15,8 @@ if TYPE_CHECKING:
     from flightlogs.store.campaign import Campaign, expand_wind_paths, ingest_campaign
     from flightlogs.store.dataset import SCHEMA_VERSION, Dataset, file_sha256, read_dataset, write_dataset
     from flightlogs.store.schema import open_schema, software_version, stamp_schema
-    from flightlogs.store.summary import conditioned_summary, log_summary, wind_summary
+    from flightlogs.store.sources import conditioned_sources, dataset_flights, is_dataset
+    from flightlogs.store.summary import campaign_summary, conditioned_summary, log_summary, wind_summary
 
 __all__ = [
     "Campaign",
@@ -31,12 +33,17 @@ __all__ = [
     "log_summary",
     "wind_summary",
     "conditioned_summary",
+    "campaign_summary",
+    "is_dataset",
+    "dataset_flights",
+    "conditioned_sources",
 ]
 
 _HOMES = {
     **dict.fromkeys(("Campaign", "expand_wind_paths", "ingest_campaign"), "campaign"),
     **dict.fromkeys(("SCHEMA_VERSION", "Dataset", "file_sha256", "read_dataset", "write_dataset"), "dataset"),
     **dict.fromkeys(("open_schema", "software_version", "stamp_schema"), "schema"),
-    **dict.fromkeys(("conditioned_summary", "log_summary", "wind_summary"), "summary"),
+    **dict.fromkeys(("campaign_summary", "conditioned_summary", "log_summary", "wind_summary"), "summary"),
+    **dict.fromkeys(("conditioned_sources", "dataset_flights", "is_dataset"), "sources"),
 }
 __getattr__, __dir__ = lazy_names(__name__, _HOMES)

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 from datetime import UTC
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from flightlogs.flightlog import FlightLog, WindMeasurement
 
-__all__ = ["log_summary", "wind_summary", "conditioned_summary"]
+if TYPE_CHECKING:
+    from flightlogs.store.campaign import Campaign
+
+__all__ = ["log_summary", "wind_summary", "conditioned_summary", "campaign_summary"]
 
 
 def log_summary(log: FlightLog) -> dict[str, Any]:
@@ -139,3 +143,36 @@ def conditioned_summary(flight: Any) -> dict[str, Any]:
         "wind_alignment": alignment,
         "warnings": list(flight.warnings),
     }
+
+
+def campaign_summary(campaign: Campaign, out: str | Path | None = None) -> dict[str, Any]:
+    """What an ingest found, as ``sysid ingest --json`` gives it and ``sysid report --ingest-summary`` reads it.
+
+    Parameters
+    ----------
+    campaign : Campaign
+        The logs read and conditioned.
+    out : str or Path, optional
+        The dataset written, if any.
+
+    Returns
+    -------
+    dict
+        ``logs``: for each log its :func:`log_summary`, with its :func:`conditioned_summary` where it was
+        conditioned and every warning; ``wind``: each anemometer file's :func:`wind_summary`; ``output``.
+        With one log, its entry's keys also at the top level.
+    """
+    entries = []
+    for log, flight, notes in zip(campaign.logs, campaign.conditioned, campaign.notes):
+        entry = log_summary(log)
+        if flight is not None:
+            conditioned = conditioned_summary(flight)
+            entry.update({k: v for k, v in conditioned.items() if k != "warnings"})
+            entry["warnings"] += conditioned["warnings"]
+        entry["warnings"] += list(notes)
+        entries.append(entry)
+    summary: dict[str, Any] = dict(entries[0]) if len(entries) == 1 else {}
+    summary["logs"] = entries
+    summary["wind"] = [wind_summary(wind) for wind in campaign.winds]
+    summary["output"] = str(out) if out is not None else None
+    return summary

@@ -9,7 +9,6 @@ key (old entries are left, never wrongly reused). Entries are written whole
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 import math
@@ -20,7 +19,6 @@ from typing import Any
 from flightlogs.store.schema import software_version
 from flightlogs.writers.jsonio import write_json
 from sysid.batch.results import GroupFit, LogSurvey
-from sysid.fit.result import ParameterEstimate
 
 __all__ = ["CACHE_VERSION", "cache_key", "load_survey", "save_survey", "load_fit", "save_fit"]
 
@@ -63,7 +61,7 @@ def load_survey(cache: Path, sha256: str, path: str) -> LogSurvey | None:
     doc = _read(cache / "survey" / f"{sha256}.json")
     if doc is None:
         return None
-    return LogSurvey(**(doc | {"path": path, "cached": True}))
+    return LogSurvey.from_dict(doc | {"path": path, "cached": True})
 
 
 def save_survey(cache: Path, survey: LogSurvey) -> None:
@@ -76,7 +74,7 @@ def save_survey(cache: Path, survey: LogSurvey) -> None:
     survey : LogSurvey
         What to keep (its reason too, when the log cannot be read).
     """
-    _write(cache / "survey" / f"{survey.sha256}.json", dataclasses.asdict(survey) | {"cached": False})
+    _write(cache / "survey" / f"{survey.sha256}.json", survey.to_dict() | {"cached": False})
 
 
 def load_fit(cache: Path, key: str) -> GroupFit | None:
@@ -95,21 +93,7 @@ def load_fit(cache: Path, key: str) -> GroupFit | None:
     files = [doc[name] for name in ("model_file", "verification_file", "report_file") if doc[name]]
     if not all(Path(f).is_file() for f in files):
         return None
-    parameters = tuple(
-        ParameterEstimate(**(p | {k: _float(p[k]) for k in ("value", "cr_percent", "insensitivity_percent")}))
-        for p in doc["parameters"]
-    )
-    return GroupFit(
-        **(
-            doc
-            | {
-                "logs": tuple(doc["logs"]),
-                "parameters": parameters,
-                "cost_average": _float(doc["cost_average"]),
-                "cached": True,
-            }
-        )
-    )
+    return GroupFit.from_dict(doc | {"cached": True})
 
 
 def save_fit(cache: Path, key: str, fit: GroupFit) -> None:
@@ -124,7 +108,7 @@ def save_fit(cache: Path, key: str, fit: GroupFit) -> None:
     fit : GroupFit
         What to keep.
     """
-    _write(cache / "fit" / f"{key}.json", dataclasses.asdict(fit) | {"cached": False})
+    _write(cache / "fit" / f"{key}.json", fit.to_dict() | {"cached": False})
 
 
 def _read(path: Path) -> dict[str, Any] | None:

@@ -7,12 +7,17 @@ a worker; the logs' data never does.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
 from pathlib import Path
+from typing import Any
 
+from sysid._json import finite_or_none, float_or_nan
 from sysid.fit.result import ParameterEstimate
 
 __all__ = ["LogSurvey", "GroupFit", "LogComparison", "Drift", "Failure", "BatchResult"]
+
+_NUMBERS = ("value", "cr_percent", "insensitivity_percent")  # a parameter's numbers: NaN in, None in JSON
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -41,6 +46,15 @@ class LogSurvey:
     utc_start: str | None = None
     error: str | None = None
     cached: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        """Its JSON entry (the batch cache keeps it)."""
+        return {name: getattr(self, name) for name in _fields(self)}
+
+    @classmethod
+    def from_dict(cls, doc: Mapping[str, Any]) -> LogSurvey:
+        """Rebuild it from :meth:`to_dict`."""
+        return cls(**{name: doc[name] for name in _fields(cls) if name in doc})
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -86,6 +100,29 @@ class GroupFit:
     modes: str = ""
     error: str | None = None
     cached: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        """Its JSON entry (the batch cache keeps it); non-finite numbers as None."""
+        doc = {name: getattr(self, name) for name in _fields(self)}
+        doc["logs"] = list(self.logs)
+        doc["cost_average"] = finite_or_none(self.cost_average)
+        doc["parameters"] = [
+            {name: getattr(p, name) for name in _fields(p)} | {k: finite_or_none(getattr(p, k)) for k in _NUMBERS}
+            for p in self.parameters
+        ]
+        return doc
+
+    @classmethod
+    def from_dict(cls, doc: Mapping[str, Any]) -> GroupFit:
+        """Rebuild it from :meth:`to_dict` (None as NaN)."""
+        parameters = tuple(
+            ParameterEstimate(**(dict(p) | {k: float_or_nan(p[k]) for k in _NUMBERS})) for p in doc["parameters"]
+        )
+        fields = {name: doc[name] for name in _fields(cls) if name in doc}
+        return cls(
+            **fields
+            | {"logs": tuple(doc["logs"]), "parameters": parameters, "cost_average": float_or_nan(doc["cost_average"])}
+        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -154,6 +191,20 @@ class Drift:
     sigmas: float
     confirmed: bool
 
+    @property
+    def sentence(self) -> str:
+        """One line: ``"Z_thr -89.9 -> -68.4, magnitude -24.0 % (5.1 combined bounds) at V03 2024-06-07, after
+        V03 2024-06-06"``."""
+        return (
+            f"{self.parameter} {self.baseline:.4g} -> {self.value:.4g}, magnitude {self.change_percent:+.1f} % "
+            f"({abs(self.sigmas):.1f} combined bounds) at {self.after}, after {self.before}"
+            + ("" if self.confirmed else "; last flight, not yet confirmed")
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """Its JSON entry, with its :attr:`sentence` as ``text``."""
+        return {name: getattr(self, name) for name in _fields(self)} | {"text": self.sentence}
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Failure:
@@ -172,6 +223,10 @@ class Failure:
     what: str
     stage: str
     reason: str
+
+    def to_dict(self) -> dict[str, str]:
+        """Its JSON entry."""
+        return {"what": self.what, "stage": self.stage, "reason": self.reason}
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -209,9 +264,32 @@ class BatchResult:
         """Logs and groups taken from the cache."""
         return sum(s.cached for s in self.surveys) + sum(g.cached for g in self.groups)
 
+    def digest(self) -> dict[str, Any]:
+        """What ``sysid batch --json`` gives of it: counts, the drifts and the failures.
+
+        Returns
+        -------
+        dict
+            ``logs``, ``groups``, ``fitted``, ``cached`` (counts), ``drifts`` and ``failures`` (their
+            :meth:`Drift.to_dict` and :meth:`Failure.to_dict`).
+        """
+        return {
+            "logs": len(self.surveys),
+            "groups": len(self.groups),
+            "fitted": sum(g.error is None for g in self.groups),
+            "cached": self.cached,
+            "drifts": [d.to_dict() for d in self.drifts],
+            "failures": [f.to_dict() for f in self.failures],
+        }
+
 
 def _group_named(group: GroupFit, shown: int = 5) -> str:
     """``group KEY (a.ulg, b.ulg and 3 more)``: a group by its key and the files it holds."""
     names = [Path(path).name for path in group.logs]
     more = f" and {len(names) - shown} more" if len(names) > shown else ""
     return f"group {group.key} ({', '.join(names[:shown])}{more})" if names else f"group {group.key}"
+
+
+def _fields(item: Any) -> list[str]:
+    """The field names of a dataclass or of its instance."""
+    return [f.name for f in fields(item)]

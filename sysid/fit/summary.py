@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from flightlogs.signals import describe
 from sysid._json import finite_or_none as _num
 from sysid.fit._json import axis_entry, parameter_entry
 from sysid.fit.guidelines import model_verdict
@@ -95,6 +96,7 @@ def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
         if model.wind is None
         else {
             "outputs": list(model.wind.outputs),
+            "units": [_unit(o) for o in model.wind.outputs],
             "rms_before": list(model.wind.rms_before),
             "rms_after": list(model.wind.rms_after),
             "samples": model.wind.samples,
@@ -105,3 +107,11 @@ def fit_summary(model: IdentifiedModel) -> dict[str, Any]:
         "maneuvers": list(model.provenance.maneuvers),
         "verdict": {"grade": verdict.grade, "sentence": verdict.sentence},
     }
+
+
+def _unit(signal: str) -> str:
+    """The SI unit of a canonical signal ("" for a name that is not one)."""
+    try:
+        return describe(signal).unit
+    except KeyError:
+        return ""

@@ -93,12 +93,15 @@ class FittedCoefficient:
         Cramér–Rao bound, % of ``|value|`` (inf when the data do not inform it).
     insensitivity_percent : float
         Insensitivity, % of ``|value|``.
+    unit : str, optional
+        Its unit (:meth:`~sysid.model.transfer.TransferStructure.parameter_units`; s for the delay).
     """
 
     name: str
     value: float
     cr_percent: float
     insensitivity_percent: float
+    unit: str = ""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -178,7 +181,12 @@ class TransferFunctionFit:
             "denominator": list(self.denominator),
             "delay_s": self.delay_s,
             "parameters": {
-                c.name: {"value": c.value, "cr_percent": c.cr_percent, "insensitivity_percent": c.insensitivity_percent}
+                c.name: {
+                    "value": c.value,
+                    "cr_percent": c.cr_percent,
+                    "insensitivity_percent": c.insensitivity_percent,
+                    "unit": c.unit,
+                }
                 for c in self.coefficients
             },
             "J": self.cost,
@@ -274,8 +282,11 @@ def fit_transfer_function(
     )
     names = (*structure.parameters, *((_DELAY_NAME,) if options.delay else ()))
     spread = accuracy(model.jacobian(found.x), found.x, names)
+    units = structure.parameter_units(response.output_unit, response.input_unit) | {_DELAY_NAME: "s"}
     coefficients = tuple(
-        FittedCoefficient(name=name, value=float(v), cr_percent=float(cr), insensitivity_percent=float(i))
+        FittedCoefficient(
+            name=name, value=float(v), cr_percent=float(cr), insensitivity_percent=float(i), unit=units[name]
+        )
         for name, v, cr, i in zip(names, found.x, spread.cramer_rao_percent, spread.insensitivity_percent)
     )
     numerator, denominator = structure.coefficients(found.x[: len(structure.parameters)])

@@ -76,6 +76,47 @@ class TransferStructure:
         """``output/input``."""
         return f"{self.output}/{self.input}"
 
+    def parameter_units(self, output_unit: str, input_unit: str) -> dict[str, str]:
+        """Each parameter's unit, from the response's units and the power of s it multiplies.
+
+        The fixed term (the ``s^n`` of a monic denominator) sets the scale:
+        with it in the denominator, a denominator coefficient of ``s^k`` is in
+        s^(k-n) (``a0`` of ``s^2 + a1 s + a0`` in 1/s^2) and a numerator one in
+        output per input times s^(k-n); with it in the numerator, the other way round.
+
+        Parameters
+        ----------
+        output_unit, input_unit : str
+            The response's units ("rad/s", "normalised (-1..1)").
+
+        Returns
+        -------
+        dict of str to str
+            By parameter name; a parameter met at two powers is ``"mixed"``.
+
+        Examples
+        --------
+        >>> tf = parse_transfer_function("p/delta_lat = b0/(s^2 + a1*s + a0)")
+        >>> tf.parameter_units("rad/s", "normalised")
+        {'b0': 'rad/s per normalised, s^-2', 'a1': 's^-1', 'a0': 's^-2'}
+        """
+        fixed_in_denominator = any(t.parameter is None for t in self.denominator)
+        reference = max(
+            t.power for t in (self.denominator if fixed_in_denominator else self.numerator) if t.parameter is None
+        )
+        ratio = f"{output_unit or '1'} per {input_unit or '1'}"
+        inverse = f"{input_unit or '1'} per {output_unit or '1'}"
+        units: dict[str, str] = {}
+        for terms, scaled in ((self.numerator, fixed_in_denominator), (self.denominator, not fixed_in_denominator)):
+            for term in terms:
+                if term.parameter is None:
+                    continue
+                time = f"s^{term.power - reference}" if term.power != reference else ""
+                base = (ratio if fixed_in_denominator else inverse) if scaled else ""
+                unit = ", ".join(part for part in (base, time) if part) or "1"
+                units[term.parameter] = unit if units.get(term.parameter, unit) == unit else "mixed"
+        return {name: units[name] for name in self.parameters}
+
     def coefficients(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Numerator and denominator coefficients, highest power first (numpy.polyval order).
 

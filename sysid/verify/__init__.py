@@ -18,7 +18,7 @@ from sysid.verify.io import (
     verification_to_dict,
     write_verification,
 )
-from sysid.verify.logs import verification_provenance, verify_flights, verify_identified, verify_logs
+from sysid.verify.logs import Validation, verification_provenance, verify_flights, verify_identified, verify_logs
 from sysid.verify.records import DoubletRecords, check_given_doublets, doublet_records
 from sysid.verify.results import (
     OutputSummary,
@@ -37,6 +37,7 @@ __all__ = [
     "verify_record",
     "verify",
     "verify_logs",
+    "Validation",
     "verify_flights",
     "verify_identified",
     "verification_provenance",

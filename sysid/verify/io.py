@@ -19,11 +19,9 @@ from typing import Any
 
 from flightlogs.errors import DataError
 from sysid._json import finite_or_none as _num
-from sysid._json import float_array as _array
 from sysid._json import float_or_nan as _float
-from sysid._json import json_floats as _list
 from sysid._json import read_json_object, write_json
-from sysid.verify.results import OutputSummary, OutputVerification, RecordVerification, Verification, WindCorrection
+from sysid.verify.results import OutputSummary, RecordVerification, Verification, WindCorrection
 
 __all__ = [
     "VERIFICATION_SCHEMA",
@@ -70,44 +68,6 @@ class SavedVerification:
         object.__setattr__(self, "options", MappingProxyType(dict(self.options)))
 
 
-def _optional(value: Any) -> float | None:
-    return None if value is None else float(value)
-
-
-def _output_to_dict(o: OutputVerification) -> dict[str, Any]:
-    return {
-        "name": o.name,
-        "unit": o.unit,
-        "measured": _list(o.measured),
-        "simulated": _list(o.simulated),
-        "bias": _num(o.bias),
-        "rmse": _num(o.rmse),
-        "tic": _num(o.tic),
-        "predicted": None if o.predicted is None else _list(o.predicted),
-        "prediction_rmse": _num(o.prediction_rmse),
-        "prediction_tic": _num(o.prediction_tic),
-    }
-
-
-def _record_to_dict(r: RecordVerification) -> dict[str, Any]:
-    return {
-        "label": r.label,
-        "source": str(r.source),
-        "time_s": _list(r.time_s),
-        "inputs": list(r.inputs),
-        "outputs": [_output_to_dict(o) for o in r.outputs],
-        "reference_shifts": {k: _num(v) for k, v in r.reference_shifts.items()},
-        "rmse": _num(r.rmse),
-        "tic": _num(r.tic),
-        "growth": _num(r.growth),
-        "unstable": bool(r.unstable),
-        "notice": r.notice,
-        "excited": r.excited,
-        "off_axis": list(r.off_axis),
-        "unstable_modes": list(r.unstable_modes),
-    }
-
-
 def verification_to_dict(
     verification: Verification,
     *,
@@ -149,46 +109,11 @@ def verification_to_dict(
         "tic": _num(v.tic),
         "summary": [s.to_dict() for s in v.summary],
         "off_axis": [s.to_dict() for s in v.off_axis],
-        "records": [_record_to_dict(r) for r in v.records],
-        "without_wind": [_record_to_dict(r) for r in v.without_wind],
+        "records": [r.to_dict() for r in v.records],
+        "without_wind": [r.to_dict() for r in v.without_wind],
         "wind_correction": [c.to_dict() for c in v.wind_correction],
         "unverified": list(v.unverified),
     }
-
-
-def _output_from_dict(d: Mapping[str, Any]) -> OutputVerification:
-    predicted = d.get("predicted")
-    return OutputVerification(
-        name=d["name"],
-        unit=d["unit"],
-        measured=_array(d["measured"]),
-        simulated=_array(d["simulated"]),
-        bias=_float(d["bias"]),
-        rmse=_float(d["rmse"]),
-        tic=_float(d["tic"]),
-        predicted=None if predicted is None else _array(predicted),
-        prediction_rmse=_optional(d.get("prediction_rmse")),
-        prediction_tic=_optional(d.get("prediction_tic")),
-    )
-
-
-def _record_from_dict(d: Mapping[str, Any]) -> RecordVerification:
-    return RecordVerification(
-        label=d["label"],
-        source=Path(d["source"]),
-        time_s=_array(d["time_s"]),
-        inputs=tuple(d["inputs"]),
-        outputs=tuple(_output_from_dict(o) for o in d["outputs"]),
-        reference_shifts={k: _float(v) for k, v in d["reference_shifts"].items()},
-        rmse=_float(d["rmse"]),
-        tic=_float(d["tic"]),
-        growth=_float(d["growth"]),
-        unstable=bool(d["unstable"]),
-        notice=d.get("notice", ""),
-        excited=d.get("excited"),
-        off_axis=tuple(d.get("off_axis", ())),
-        unstable_modes=tuple(d.get("unstable_modes", ())),
-    )
 
 
 def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") -> SavedVerification:
@@ -225,11 +150,11 @@ def verification_from_dict(doc: Mapping[str, Any], *, source: str = "<dict>") ->
         )
     try:
         verification = Verification(
-            records=tuple(_record_from_dict(r) for r in doc["records"]),
+            records=tuple(RecordVerification.from_dict(r) for r in doc["records"]),
             summary=tuple(OutputSummary.from_dict(s) for s in doc["summary"]),
             rmse=_float(doc["rmse"]),
             tic=_float(doc["tic"]),
-            without_wind=tuple(_record_from_dict(r) for r in doc.get("without_wind", [])),
+            without_wind=tuple(RecordVerification.from_dict(r) for r in doc.get("without_wind", [])),
             wind_correction=tuple(WindCorrection.from_dict(c) for c in doc.get("wind_correction", [])),
             off_axis=tuple(OutputSummary.from_dict(s) for s in doc.get("off_axis", [])),
             unverified=tuple(str(text) for text in doc.get("unverified", [])),
@@ -278,6 +203,7 @@ def write_verification(
     --------
     >>> import tempfile
     >>> import numpy as np
+    >>> from sysid.verify.results import OutputVerification
     >>> t = np.arange(3) * 0.01
     >>> out = OutputVerification(name="q", unit="rad/s", measured=np.array([0.0, 1.0, 0.0]),
     ...                          simulated=np.array([0.0, 0.9, 0.1]), bias=0.0, rmse=0.08, tic=0.05)

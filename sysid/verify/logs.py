@@ -3,98 +3,134 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
 from flightlogs.errors import DataError
 from flightlogs.readers.dispatch import ReadOptions
-from flightlogs.store.campaign import ingest_campaign
+from flightlogs.store.sources import conditioned_sources, is_dataset
 from sysid.fit.result import IdentifiedModel
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify.engine import VerificationOptions, verify
-from sysid.verify.records import AFTER_S, BEFORE_S, MIXER_INPUTS, DoubletRecords, doublet_records
+from sysid.verify.records import (
+    AFTER_S,
+    BEFORE_S,
+    MIXER_INPUTS,
+    DoubletRecords,
+    check_given_doublets,
+    doublet_records,
+)
 from sysid.verify.results import Verification
 from sysid.verify.submodel import axis_outputs
 
-__all__ = ["SEGMENTS_HINT", "verify_logs", "verify_flights", "verify_identified", "verification_provenance"]
+__all__ = [
+    "SEGMENTS_HINT",
+    "Validation",
+    "verify_logs",
+    "verify_flights",
+    "verify_identified",
+    "verification_provenance",
+]
 
 #: What a message says to do when no doublet is found in logs (a caller with a dataset says otherwise).
 SEGMENTS_HINT = "give their times with `segments` if they were not detected"
 
 
+@dataclass(frozen=True)
+class Validation:
+    """A model verified on the doublets of flights it was not fitted to: what ``sysid validate`` makes.
+
+    Parameters
+    ----------
+    verification : Verification
+        The verification, with the wind term where the flights carry the wind.
+    provenance : dict
+        How it was made (:func:`verification_provenance`), as its file and the report record it.
+    notes : tuple of str
+        What the reader should know: the clock offset taken from the model's fit, the wind term not
+        verified, the axes without a doublet.
+    """
+
+    verification: Verification
+    provenance: dict[str, Any]
+    notes: tuple[str, ...]
+
+
 def verify_logs(
-    model: DelayedStateSpace,
-    log_paths: Sequence[Path],
+    identified: IdentifiedModel,
+    sources: Sequence[str | Path],
     *,
-    wind_model: DelayedStateSpace | None = None,
-    wind_paths: Sequence[Path] = (),
-    axes: Mapping[str, Sequence[str]] | None = None,
+    wind_paths: Sequence[str | Path] = (),
     conditioning: ConditioningOptions = ConditioningOptions(),
+    segments_path: str | Path | None = None,
     options: VerificationOptions = VerificationOptions(),
     before_s: float = BEFORE_S,
     after_s: float = AFTER_S,
     progress: Callable[[str, int, int], None] | None = None,
-    unidentified: Mapping[str, str] | None = None,
     reading: ReadOptions = ReadOptions(),
-) -> Verification:
-    """Verify `model` (and `wind_model`) on every doublet of the logs.
+) -> Validation:
+    """Verify an identified model on the doublets of logs or datasets: ``sysid validate``.
+
+    With anemometer files and no clock offset given, the wind is aligned
+    with the offset the model's own fit measured (said in the notes).
 
     Parameters
     ----------
-    model : DelayedStateSpace
-        The model without the wind term (or the only one).
-    log_paths : sequence of Path
-        Flight logs with doublets not used in the fit.
-    wind_model : DelayedStateSpace, optional
-        The model with G_w; needs `wind_paths`.
-    wind_paths : sequence of Path, optional
-        Anemometer CSV files or folders of them.
-    axes : Mapping[str, sequence of str], optional
-        On-axis outputs of each mixer input (:func:`sysid.verify.axis_outputs`);
-        each doublet is judged on its axis' outputs (see :func:`sysid.verify.verify`).
+    identified : IdentifiedModel
+        The model, as :func:`sysid.fit.read_model` reads it.
+    sources : sequence of str or Path
+        Flight logs with doublets not used in the fit, or HDF5 datasets of them.
+    wind_paths : sequence of str or Path, optional
+        Anemometer CSV files or folders of them (logs only): the wind term is verified too.
     conditioning : ConditioningOptions, optional
-        Alignment, rate and segment choices (as for ``sysid ingest``).
+        Alignment, rate and segment choices (as for the ingest).
+    segments_path : str or Path, optional
+        The file `conditioning.segments` was read from: each doublet it gives is checked to lie in a flight.
     options : VerificationOptions, optional
         Bias, reference shift, initial state and instability choices.
     before_s, after_s : float, optional
         Quiet stretch kept before and response after each doublet, s.
     progress : callable, optional
-        ``progress(file_name, done, total)`` while reading, bytes.
-    unidentified : Mapping[str, str], optional
-        Mixer inputs of the model's unidentified axes, with the reason (see :func:`verify_flights`).
+        ``progress(file_name, done, total)`` while reading logs, bytes.
     reading : ReadOptions, optional
-        How tables among `log_paths` are read, and whether a log of another vehicle is refused.
+        How tables among the logs are read, and whether a log of another vehicle is refused.
 
     Returns
     -------
-    Verification
+    Validation
 
     Raises
     ------
     DataError
-        If a wind model is given without wind, or no log holds a doublet on
-        an axis of the model (doublets on other axes are skipped).
+        If a source cannot be used, a given doublet lies outside every flight, or no flight holds a doublet
+        on an axis of the model.
     """
-    if wind_model is not None and not wind_paths:
-        raise DataError(
-            "the model has wind terms but no anemometer file was given (`wind_paths`); "
-            "without wind only the model without G_w can be verified"
+    measured = identified.measured_clock_offset_s if wind_paths and conditioning.wind_offset_s is None else None
+    if measured is not None:
+        conditioning = replace(conditioning, wind_offset_s=measured)
+    flights = conditioned_sources(sources, wind_paths, options=conditioning, progress=progress, reading=reading)
+    if segments_path is not None and conditioning.segments is not None:
+        check_given_doublets(Path(segments_path), conditioning.segments, flights)
+    hint = (
+        ""
+        if segments_path is not None
+        else "give their times to the ingest that wrote the dataset, in a segments file"
+        if sources and is_dataset(sources[0])
+        else SEGMENTS_HINT
+    )
+    verification, said = verify_identified(
+        identified, flights, options=options, before_s=before_s, after_s=after_s, hint=hint
+    )
+    notes = []
+    if measured is not None:
+        notes.append(
+            f"anemometer clock offset {measured:+.2f} s, as the model's fit measured it (`wind_offset_s` to override)"
         )
-    campaign = ingest_campaign(
-        list(log_paths), list(wind_paths), options=conditioning, progress=progress, reading=reading
-    )
-    return verify_flights(
-        model,
-        campaign.require_flights(),
-        wind_model=wind_model,
-        axes=axes,
-        options=options,
-        before_s=before_s,
-        after_s=after_s,
-        unidentified=unidentified,
-    )
+    names = {"sources": [Path(p).name for p in sources], "winds": [Path(p).name for p in wind_paths]}
+    provenance = verification_provenance(options, before_s=before_s, after_s=after_s, **names)
+    return Validation(verification=verification, provenance=provenance, notes=(*notes, *said))
 
 
 def verify_flights(
@@ -109,7 +145,7 @@ def verify_flights(
     hint: str = SEGMENTS_HINT,
     unidentified: Mapping[str, str] | None = None,
 ) -> Verification:
-    """Verify `model` (and `wind_model`) on every doublet of conditioned flights (see :func:`verify_logs`).
+    """Verify `model` (and `wind_model`) on every doublet of conditioned flights.
 
     Parameters
     ----------

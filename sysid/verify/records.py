@@ -8,8 +8,9 @@ from pathlib import Path
 
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import DataError
-from flightlogs.maneuvers.segments import Segment
+from flightlogs.readers.segments_file import segment_line
 from flightlogs.record import Record
+from flightlogs.segment import Segment
 
 __all__ = ["AFTER_S", "BEFORE_S", "DoubletRecords", "check_given_doublets", "doublet_records", "MIXER_INPUTS"]
 
@@ -110,23 +111,9 @@ def check_given_doublets(path: Path, segments: Sequence[Segment], flights: Seque
             for f in flights
             if f.records
         )
-        line = _line_of(path, segment.start_s, segment.end_s)
+        line = segment_line(path, segment)
         where = f"{path}" + (f" line {line}" if line else "")
         raise DataError(
             f"{where}: the {segment.axis} doublet at {segment.start_s:g}-{segment.end_s:g} s starts "
             f"outside every log's records ({spans})"
         )
-
-
-def _line_of(path: Path, start_s: float, end_s: float) -> int | None:
-    """The CSV line (from 1) whose first two fields are `start_s`, `end_s`, if there is one."""
-    if path.suffix.lower() != ".csv":
-        return None
-    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
-        fields = line.split(",")
-        try:
-            if len(fields) >= 2 and (float(fields[0]), float(fields[1])) == (start_s, end_s):
-                return number
-        except ValueError:
-            continue
-    return None

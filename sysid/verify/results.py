@@ -11,7 +11,7 @@ from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
-from sysid._json import finite_or_none, float_or_nan
+from sysid._json import finite_or_none, float_array, float_or_nan, json_floats
 
 __all__ = [
     "rms_error",
@@ -101,6 +101,10 @@ def _vector(value: np.ndarray, name: str, n: int) -> np.ndarray:
     return array
 
 
+def _optional(value: Any) -> float | None:
+    return None if value is None else float(value)
+
+
 def mode_names(labels: Sequence[str]) -> str:
     """Mode labels as words: ``"pitch mode"``, ``"pitch and roll modes"``; ``"modes"`` for none.
 
@@ -167,6 +171,44 @@ class OutputVerification:
         object.__setattr__(self, "simulated", _vector(self.simulated, "simulated", n))
         if self.predicted is not None:
             object.__setattr__(self, "predicted", _vector(self.predicted, "predicted", n))
+
+    def to_dict(self, *, histories: bool = True) -> dict[str, Any]:
+        """Its JSON entry: name, unit, bias, RMS error and TIC (non-finite as None), with the time histories.
+
+        Parameters
+        ----------
+        histories : bool, optional
+            Include ``measured``, ``simulated`` and ``predicted`` (the verification file does; ``--json`` not).
+
+        Returns
+        -------
+        dict
+        """
+        entry: dict[str, Any] = {"name": self.name, "unit": self.unit}
+        if histories:
+            entry |= {"measured": json_floats(self.measured), "simulated": json_floats(self.simulated)}
+            entry["predicted"] = None if self.predicted is None else json_floats(self.predicted)
+        entry |= {"bias": finite_or_none(self.bias), "rmse": finite_or_none(self.rmse), "tic": finite_or_none(self.tic)}
+        entry["prediction_rmse"] = finite_or_none(self.prediction_rmse)
+        entry["prediction_tic"] = finite_or_none(self.prediction_tic)
+        return entry
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> OutputVerification:
+        """Rebuild it from :meth:`to_dict` with its histories (missing numbers as NaN)."""
+        predicted = d.get("predicted")
+        return cls(
+            name=d["name"],
+            unit=d["unit"],
+            measured=float_array(d["measured"]),
+            simulated=float_array(d["simulated"]),
+            bias=float_or_nan(d["bias"]),
+            rmse=float_or_nan(d["rmse"]),
+            tic=float_or_nan(d["tic"]),
+            predicted=None if predicted is None else float_array(predicted),
+            prediction_rmse=_optional(d.get("prediction_rmse")),
+            prediction_tic=_optional(d.get("prediction_tic")),
+        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -272,6 +314,60 @@ class RecordVerification:
     def informative(self) -> tuple[OutputVerification, ...]:
         """The off-axis outputs, shown for information only."""
         return tuple(o for o in self.outputs if o.name in self.off_axis)
+
+    def to_dict(self, *, histories: bool = True) -> dict[str, Any]:
+        """Its JSON entry, as the verification file and ``sysid validate --json`` give it.
+
+        Parameters
+        ----------
+        histories : bool, optional
+            Include ``time_s`` and each output's time histories (the file does); without them,
+            ``start_s`` and ``end_s`` say where the record lies (``--json``).
+
+        Returns
+        -------
+        dict
+            Non-finite numbers as None; ``on_axis`` names the outputs it is judged on.
+        """
+        entry: dict[str, Any] = {"label": self.label, "source": str(self.source)}
+        if histories:
+            entry["time_s"] = json_floats(self.time_s)
+        else:
+            entry |= {"start_s": float(self.time_s[0]), "end_s": float(self.time_s[-1])}
+        return entry | {
+            "inputs": list(self.inputs),
+            "outputs": [o.to_dict(histories=histories) for o in self.outputs],
+            "reference_shifts": {k: finite_or_none(v) for k, v in self.reference_shifts.items()},
+            "rmse": finite_or_none(self.rmse),
+            "tic": finite_or_none(self.tic),
+            "growth": finite_or_none(self.growth),
+            "unstable": bool(self.unstable),
+            "notice": self.notice,
+            "excited": self.excited,
+            "on_axis": [o.name for o in self.judged],
+            "off_axis": list(self.off_axis),
+            "unstable_modes": list(self.unstable_modes),
+        }
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> RecordVerification:
+        """Rebuild it from :meth:`to_dict` with its histories (missing numbers as NaN)."""
+        return cls(
+            label=d["label"],
+            source=Path(d["source"]),
+            time_s=float_array(d["time_s"]),
+            inputs=tuple(d["inputs"]),
+            outputs=tuple(OutputVerification.from_dict(o) for o in d["outputs"]),
+            reference_shifts={k: float_or_nan(v) for k, v in d["reference_shifts"].items()},
+            rmse=float_or_nan(d["rmse"]),
+            tic=float_or_nan(d["tic"]),
+            growth=float_or_nan(d["growth"]),
+            unstable=bool(d["unstable"]),
+            notice=d.get("notice", ""),
+            excited=d.get("excited"),
+            off_axis=tuple(d.get("off_axis", ())),
+            unstable_modes=tuple(d.get("unstable_modes", ())),
+        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -466,6 +562,31 @@ class Verification:
         """True when any record's simulation is flagged as diverging open loop."""
         return any(r.unstable for r in (*self.records, *self.without_wind))
 
+    def record_notes(self) -> tuple[str, ...]:
+        """What a reader of the records should know, one sentence each.
+
+        Records that diverge open loop share one sentence when there are
+        several (the model's unstable modes, the largest growth, their
+        labels); every other record's own notice follows, prefixed with its label.
+
+        Returns
+        -------
+        tuple of str
+        """
+        unstable = [r for r in self.records if r.unstable]
+        notes = []
+        if len(unstable) > 1:  # one note, not the same sentence per record
+            growth = max(r.growth for r in unstable)
+            names = mode_names([m for r in unstable for m in r.unstable_modes])
+            notes.append(
+                f"the model is unstable open loop in its {names} and grows up to {growth:.0f}-fold over "
+                f"{len(unstable)} records ({'; '.join(r.label for r in unstable)}): small input or initial-state "
+                "errors diverge there, so judge them also by the one-step-ahead prediction error "
+                "(`prediction_rmse`, `prediction_tic`)"
+            )
+        notes += [f"{r.label}: {r.notice}" for r in self.records if r.notice and (len(unstable) < 2 or not r.unstable)]
+        return tuple(notes)
+
     def output(self, name: str) -> OutputSummary:
         """The pooled verification of one output.
 
@@ -507,26 +628,7 @@ class Verification:
             ``wind_correction``.
         """
         digest: dict[str, Any] = {
-            "records": [
-                {
-                    "label": r.label,
-                    "source": str(r.source),
-                    "start_s": float(r.time_s[0]),
-                    "end_s": float(r.time_s[-1]),
-                    "rmse": r.rmse,
-                    "tic": r.tic,
-                    "unstable": r.unstable,
-                    "growth": r.growth,
-                    "unstable_modes": list(r.unstable_modes),
-                    "notice": r.notice,
-                    "reference_shifts": dict(r.reference_shifts),
-                    "bias": {o.name: o.bias for o in r.outputs},
-                    "excited": r.excited,
-                    "on_axis": [o.name for o in r.judged],
-                    "off_axis": list(r.off_axis),
-                }
-                for r in self.records
-            ],
+            "records": [r.to_dict(histories=False) for r in self.records],
             "summary": {s.name: s.to_dict() for s in self.summary},
             "off_axis": {s.name: s.to_dict() for s in self.off_axis},
             "overall": {"rmse": self.rmse, "tic": self.tic},

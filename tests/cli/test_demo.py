@@ -38,7 +38,14 @@ def demo_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.mark.slow
 def test_demo_writes_the_flight_and_the_aligned_dataset(demo_run: tuple[Path, str]) -> None:
     demo_dir, output = demo_run
-    assert f"dataset: {demo_dir / 'dataset.h5'}" in output
+    assert f"wrote {demo_dir / 'dataset.h5'}" in output
+    # each table states its units: the signals', the wind step's residual RMS
+    assert any(
+        line.split()[:3] == ["signal", "samples", "rate"] and line.split()[-2:] == ["unit", "source"]
+        for line in output.splitlines()
+    )
+    (wind_line,) = [line for line in output.splitlines() if "wind step residual RMS" in line]
+    assert wind_line.count("m/s^2") == 2, wind_line
     truth = json.loads((demo_dir / "truth.json").read_text())
     summary = json.loads((demo_dir / "ingest.json").read_text())
     alignment = summary["wind_alignment"]

@@ -14,6 +14,7 @@ import pytest
 from click.testing import CliRunner
 
 from flightlogs.errors import DataError
+from reports.ingest_card import ingest_card
 from reports.model_report import model_report_html
 from simulator.campaign.fly import run_scenario
 from simulator.campaign.scenario import read_scenario
@@ -21,7 +22,6 @@ from sysid.fit import IdentifiedModel, read_model, write_model
 from sysid.verify import Verification
 from sysid.verify.io import read_verification, write_verification
 from sysid_cli.main import cli
-from sysid_cli.report import ingest_card
 
 import builders
 

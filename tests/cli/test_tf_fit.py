@@ -52,6 +52,15 @@ def test_the_generators_known_roll_response_is_recovered(known_roll, fmt: str, t
         assert parameter["cr_percent"] <= 20.0, (name, parameter)
         assert abs(parameter["value"] / truth - 1) <= 0.10, (name, parameter, truth)
     assert tf["delay_s"] == tf["parameters"]["tau"]["value"] and tf["stable"] and tf["minimum_phase"]
+    units = {name: p["unit"] for name, p in tf["parameters"].items()}  # p in rad/s, delta_lat normalised
+    assert units == {
+        "b2": "rad/s per normalised, s^-2",
+        "a3": "s^-1",
+        "a2": "s^-2",
+        "a1": "s^-3",
+        "a0": "s^-4",
+        "tau": "s",
+    }
     assert tf["denominator"][0] == 1.0 and len(tf["numerator"]) == 3 and len(tf["poles"]) == 4
     low, high = tf["band_rad_s"]
     assert low < 1.0 and high > 30.0  # the 0.08-8 Hz chirp's coherent range

@@ -65,7 +65,7 @@ _READER_MODULES = (
     "flightlogs.readers.tlog",
     "flightlogs.readers.ulog",
     "flightlogs.readers.anemometer",
-    "flightlogs.maneuvers.segments",
+    "flightlogs.readers.segments_file",
     "flightlogs.store.dataset",
     "simulator.campaign.scenario",
     "sysid.fit.model_file",
@@ -99,7 +99,7 @@ def _reader(module: str, function: str) -> Callable[[Path], object]:
 
 _log = _reader("flightlogs.readers", "read_log")
 _anemometer = _reader("flightlogs.readers.anemometer", "read_anemometer_csv")
-_segments = _reader("flightlogs.maneuvers.segments", "read_segments_file")
+_segments = _reader("flightlogs.readers.segments_file", "read_segments_file")
 _model = _reader("sysid.fit.model_file", "read_model")
 _scenario = _reader("simulator.campaign.scenario", "read_scenario")
 _dataset = _reader("flightlogs.store.dataset", "read_dataset")

@@ -16,9 +16,9 @@ from flightlogs.maneuvers.segments import (
     Segment,
     SegmentDetector,
     detect_segments,
-    read_segments_file,
     segments_from_sid,
 )
+from flightlogs.readers.segments_file import read_segments_file
 
 RATE_HZ = 100.0
 AMPLITUDE = {"lat": 0.1, "lon": 0.1, "yaw": 0.08, "thr": 0.05}  # mixer units, 0-1 scale

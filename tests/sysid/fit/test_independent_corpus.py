@@ -43,7 +43,7 @@ import pytest
 from independent_sim.fixtures import independent_corpus_fixture  # noqa: F401 (registers the fixture)
 
 from flightlogs.conditioning.condition import ConditioningOptions
-from flightlogs.maneuvers.segments import read_segments_file
+from flightlogs.readers.segments_file import read_segments_file
 from sysid.fit import IdentifyOptions, identify_logs
 from sysid.fit.result import IdentifiedModel
 

@@ -689,7 +689,7 @@ def test_the_wind_correction_round_trips_with_its_band() -> None:
 
 def test_a_given_doublet_outside_every_record_names_its_line(calm_flights: list[ConditionedFlight], tmp_path) -> None:  # type: ignore[no-untyped-def]
     """``sysid validate --segments``: a doublet no record reaches is one sentence with the file's line."""
-    from flightlogs.maneuvers.segments import read_segments_file
+    from flightlogs.readers.segments_file import read_segments_file
     from sysid.verify import check_given_doublets
 
     inside = calm_flights[0].segments[0]

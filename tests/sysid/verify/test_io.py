@@ -106,3 +106,16 @@ def test_the_axes_not_verified_are_saved(sample: Verification, tmp_path: Path) -
     loaded = read_verification(write_verification(tmp_path / "v.json", said)).verification
     assert loaded.unverified == ("lat: no doublet in 2 logs; not verified",)
     assert read_verification(write_verification(tmp_path / "w.json", sample)).verification.unverified == ()
+
+
+def test_validate_json_gives_each_record_as_the_file_does_without_its_histories(sample: Verification) -> None:
+    """One vocabulary (issue 33): a record of ``validate --json`` is the file's entry less its time histories."""
+    saved = verification_to_dict(sample)
+    for record, entry, digested in zip(sample.records, saved["records"], sample.digest()["records"]):
+        assert (digested["start_s"], digested["end_s"]) == (record.time_s[0], record.time_s[-1])
+        kept = {k: v for k, v in entry.items() if k != "time_s"}
+        kept["outputs"] = [
+            {k: v for k, v in o.items() if k not in ("measured", "simulated", "predicted")} for o in entry["outputs"]
+        ]
+        assert {k: v for k, v in digested.items() if k not in ("start_s", "end_s")} == kept
+        assert digested["on_axis"] == [o.name for o in record.judged] and digested["on_axis"]
