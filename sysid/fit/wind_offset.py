@@ -45,6 +45,7 @@ import numpy as np
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import FitWarning
 from flightlogs.frames import air_velocity_body, wind_to_body_axes
+from flightlogs.parallel import map_forked, worker_count
 from flightlogs.record import Record
 from sysid.fit.result import WindClockOffset
 from sysid.fit.wind import residual_inflation, wind_cost
@@ -323,10 +324,10 @@ def scan_wind_offset(
         return cost_of([m.columns(shift) for m in movable])
 
     coarse = np.round(np.arange(-half_width_s, half_width_s + 1e-9, _COARSE_STEP_S), 10)
-    rough = {float(s): coarse_cost_of([m.columns(float(s)) for m in sparse])[0] for s in coarse}
+    rough = _costs(coarse, coarse_cost_of, sparse)
     centre = min(rough, key=rough.__getitem__)
     fine = np.round(centre + np.arange(-_FINE_HALF_WIDTH_S, _FINE_HALF_WIDTH_S + 1e-9, _FINE_STEP_S), 10)
-    costs = {float(s): at(float(s))[0] for s in fine}
+    costs = _costs(fine, cost_of, movable)
     level = costs[centre] / rough[centre]  # the coarse pass's samples and weights, brought to the fine pass's
     costs |= {s: c * level for s, c in rough.items() if s not in costs}
     shift = np.array(sorted(costs))
@@ -349,6 +350,17 @@ def scan_wind_offset(
     )
     reason = _unclaimed(scan, half_width_s)
     return replace(scan, measured=not reason, reason=reason)
+
+
+def _costs(shifts: np.ndarray, cost_of: CostOf, movable: Sequence[_Moved]) -> dict[float, float]:
+    """The cost at each move of the wind, s, by shift: the moves split over the cores, each computed as in a loop."""
+    chunks = np.array_split(shifts, worker_count(shifts.size))
+
+    def chunk(k: int) -> list[float]:
+        return [cost_of([m.columns(float(s)) for m in movable])[0] for s in chunks[k]]
+
+    found = [c for part in map_forked(chunk, len(chunks)) for c in part]
+    return dict(zip((float(s) for s in shifts), found))
 
 
 def _parabola(shift: np.ndarray, cost: np.ndarray, k: int) -> tuple[float, float]:
