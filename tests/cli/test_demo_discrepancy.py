@@ -10,7 +10,10 @@ from click.testing import CliRunner
 
 from sysid_cli.main import cli
 
-pytestmark = [pytest.mark.slow, pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning")]
+pytestmark = [
+    pytest.mark.long,  # 66 s: run by .ci/run with -m long, out of the README's ten-minute suite
+    pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning"),
+]
 
 
 def test_the_discrepancy_demo_finds_the_delay_and_ends_with_its_report(tmp_path: Path) -> None:

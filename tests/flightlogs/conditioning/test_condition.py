@@ -108,7 +108,7 @@ def test_hover_is_found_between_maneuvers(demo: dict) -> None:
         assert all(segment.end_s <= m["start_s"] or segment.start_s >= m["end_s"] for m in truth)
 
 
-@pytest.mark.slow
+@pytest.mark.long  # 70 s: run by .ci/run with -m long, out of the README's ten-minute suite
 @pytest.mark.filterwarnings("ignore:no wind given:flightlogs.errors.DataQualityWarning")  # u v w are not used here
 def test_closed_loop_doublets_over_twelve_flights(tmp_path: Path) -> None:
     """Doublets the rate loop cancels in the mixer input, found from the excitation left once the

@@ -48,7 +48,7 @@ from sysid_cli.main import cli
 from builders import discrepancy_series
 
 pytestmark = [
-    pytest.mark.slow,
+    pytest.mark.long,  # 100 s on 2 cores: run by .ci/run with -m long, out of the README's ten-minute suite
     pytest.mark.timeout(900),
     pytest.mark.filterwarnings("ignore::flightlogs.errors.SysidWarning"),
 ]
