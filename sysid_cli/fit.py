@@ -196,7 +196,6 @@ def fit(
         FitOptions,
         IdentifyOptions,
         fit_summary,
-        identify_flights,
         identify_logs,
         write_mat,
         write_model,
@@ -265,23 +264,17 @@ def fit(
         partial=partial,
         responses=ResponseOptions(window_lengths_s=windows),
     )
-    dataset = check_sources(logs, log_only)
+    check_sources(logs, log_only)
     with staged_progress("identifying", quiet=quiet) as progress:
-        if dataset:
-            from flightlogs.store.sources import dataset_flights
-
-            flights = dataset_flights(logs)
-            model = identify_flights(flights, structure, options=options, files=list(logs), progress=progress)
-        else:
-            model = identify_logs(
-                list(logs),
-                structure,
-                wind_paths=list(wind_paths),
-                conditioning=conditioning,
-                options=options,
-                progress=progress,
-                reading=reading,
-            )
+        model = identify_logs(
+            list(logs),
+            structure,
+            wind_paths=list(wind_paths),
+            conditioning=conditioning,
+            options=options,
+            progress=progress,
+            reading=reading,
+        )
     if out is not None:
         write_model(out, model)
     if mat is not None:

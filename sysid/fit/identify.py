@@ -470,7 +470,7 @@ def identify_logs(
     Parameters
     ----------
     log_paths : sequence of str or Path
-        Flight logs with sweeps (any supported format).
+        Flight logs with sweeps (any supported format), or the HDF5 datasets an ingest wrote of them.
     structure : ModelStructure or str
         The structure, or a built-in name / structure file.
     wind_paths : sequence of str or Path, optional
@@ -495,19 +495,13 @@ def identify_logs(
     FitError
         If nothing can be fitted.
     """
-    from flightlogs.store.campaign import expand_wind_paths, ingest_campaign
+    from flightlogs.store.campaign import expand_wind_paths
+    from flightlogs.store.sources import conditioned_sources
 
     def read(name: str, done: int, total: int) -> None:
         _report(progress, f"reading {name}", done, total)
 
-    campaign = ingest_campaign(
-        [Path(p) for p in log_paths],
-        [Path(p) for p in wind_paths],
-        options=conditioning,
-        progress=read,
-        reading=reading,
-    )
-    flights = list(campaign.require_flights())
+    flights = conditioned_sources(log_paths, wind_paths, options=conditioning, progress=read, reading=reading)
     winds = expand_wind_paths([Path(p) for p in wind_paths])
     return identify_flights(flights, structure, options=options, files=[*log_paths, *winds], progress=progress)
 
