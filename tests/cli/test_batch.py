@@ -150,6 +150,7 @@ def test_a_rerun_takes_everything_from_the_cache_and_writes_the_same_table(
     assert time.perf_counter() - started < summary["seconds"]
 
 
+@pytest.mark.long  # 31 s of scheduler and worker start-up: run by .ci/run with -m long
 def test_a_scheduler_and_two_workers_started_apart_give_the_local_runs_results(
     local_run, fleet: Path, tmp_path: Path
 ) -> None:

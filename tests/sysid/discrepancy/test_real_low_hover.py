@@ -38,6 +38,7 @@ def test_the_take_off_ramp_on_the_ground_is_not_flight(real_data: Path) -> None:
     assert 87.0 < series.time_s[-1] - start < 89.5
 
 
+@pytest.mark.long  # 26 s: run by .ci/run with -m long
 def test_a_simulation_of_another_airframe_is_flagged_not_trusted(real_data: Path, tmp_path: Path) -> None:
     result = CliRunner().invoke(cli, ["simulate", "low-hover-quad", "-o", str(tmp_path), "-q"])
     assert result.exit_code == 0, result.output
