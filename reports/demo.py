@@ -18,15 +18,12 @@ from flightlogs.conditioning.condition import ConditioningOptions
 from flightlogs.store.campaign import ingest_campaign
 from flightlogs.store.summary import campaign_summary
 from flightlogs.writers.jsonio import write_json
-from simulator.campaign.demo_flight import FlightFiles
+from simulator.campaign.demo_flight import DEMO_ANEMOMETER_DISTANCE_M, FlightFiles
 from sysid.discrepancy import DiscrepancyResult
 from sysid.fit import IdentifiedModel, Verdict
 from sysid.verify import Verification
 
 __all__ = ["DemoRun", "DiscrepancyDemo", "run_demo", "run_discrepancy_demo"]
-
-#: The demo's anemometer: 4.6 m upstream of the vehicle (the dissertation's set-up).
-DEMO_WIND_DISTANCE_M = 4.6
 
 Progress = Callable[[str, int, int], None]
 
@@ -110,6 +107,7 @@ def run_demo(out_dir: str | Path, *, progress: Progress | None = None) -> DemoRu
     -------
     DemoRun
     """
+    from flightlogs.store.dataset import write_dataset  # h5py: loaded only here
     from simulator.campaign.demo_flight import write_demo_flight
     from sysid.fit import IdentifyOptions, fit_summary, identify_flights, model_verdict, write_model
     from sysid.verify import VerificationOptions, verification_provenance, verify_identified
@@ -121,12 +119,10 @@ def run_demo(out_dir: str | Path, *, progress: Progress | None = None) -> DemoRu
     out = Path(out_dir)
     _step(progress, "simulating", 0, 4)
     flight = write_demo_flight(out)
-    conditioning = ConditioningOptions(wind_distance_m=DEMO_WIND_DISTANCE_M, estimate_wind_offset=True)
+    conditioning = ConditioningOptions(wind_distance_m=DEMO_ANEMOMETER_DISTANCE_M, estimate_wind_offset=True)
     campaign = ingest_campaign([flight.log], [flight.wind_csv], options=conditioning, progress=progress)
     flights = campaign.require_flights()
     dataset, ingest_json = out / "dataset.h5", out / "ingest.json"
-    from flightlogs.store.dataset import write_dataset  # h5py: only to write
-
     write_dataset(dataset, campaign.logs, campaign.winds, list(flights))
     ingested = campaign_summary(campaign, dataset)
     write_json(ingest_json, ingested)

@@ -11,9 +11,12 @@ from simulator.flights.linear import WindField, simulate_hover
 from simulator.output.ardupilot import AnemometerSetup, write_anemometer_csv, write_ardupilot_log, write_truth
 from simulator.vehicle.identified import CALM_HOVER, LIGHT_WIND_TERMS
 
-__all__ = ["FlightFiles", "demo_maneuvers", "write_demo_flight"]
+__all__ = ["DEMO_ANEMOMETER_DISTANCE_M", "FlightFiles", "demo_maneuvers", "write_demo_flight"]
 
 _DEMO_UTC = datetime(2024, 5, 1, 10, 0, 0, tzinfo=UTC)
+
+#: The demo's ground anemometer stands this far upstream of the vehicle, m (the dissertation's set-up).
+DEMO_ANEMOMETER_DISTANCE_M = 4.6
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -92,7 +95,7 @@ def write_demo_flight(
         wind_terms=LIGHT_WIND_TERMS,
         seed=seed,
     )
-    setup = AnemometerSetup(distance_m=4.6, rate_hz=20.0, clock_offset_s=clock_offset_s)
+    setup = AnemometerSetup(distance_m=DEMO_ANEMOMETER_DISTANCE_M, rate_hz=20.0, clock_offset_s=clock_offset_s)
     return FlightFiles(
         log=write_ardupilot_log(flight, folder / "flight.bin", utc_start=utc_start),
         wind_csv=write_anemometer_csv(flight, folder / "anemometer.csv", utc_start=utc_start, setup=setup),

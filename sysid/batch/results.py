@@ -118,9 +118,9 @@ class GroupFit:
         parameters = tuple(
             ParameterEstimate(**(dict(p) | {k: float_or_nan(p[k]) for k in _NUMBERS})) for p in doc["parameters"]
         )
-        fields = {name: doc[name] for name in _fields(cls) if name in doc}
+        kept = {name: doc[name] for name in _fields(cls) if name in doc}
         return cls(
-            **fields
+            **kept
             | {"logs": tuple(doc["logs"]), "parameters": parameters, "cost_average": float_or_nan(doc["cost_average"])}
         )
 

@@ -102,6 +102,7 @@ def _vector(value: np.ndarray, name: str, n: int) -> np.ndarray:
 
 
 def _optional(value: Any) -> float | None:
+    """A JSON number that may be absent: None stays None."""
     return None if value is None else float(value)
 
 
@@ -424,8 +425,8 @@ class OutputSummary:
             tic=float_or_nan(doc["tic"]),
             n_records=int(doc["n_records"]),
             n_samples=int(doc["n_samples"]),
-            prediction_rmse=None if doc.get("prediction_rmse") is None else float(doc["prediction_rmse"]),
-            prediction_tic=None if doc.get("prediction_tic") is None else float(doc["prediction_tic"]),
+            prediction_rmse=_optional(doc.get("prediction_rmse")),
+            prediction_tic=_optional(doc.get("prediction_tic")),
         )
 
 

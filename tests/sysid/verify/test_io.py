@@ -119,3 +119,14 @@ def test_validate_json_gives_each_record_as_the_file_does_without_its_histories(
         ]
         assert {k: v for k, v in digested.items() if k not in ("start_s", "end_s")} == kept
         assert digested["on_axis"] == [o.name for o in record.judged] and digested["on_axis"]
+
+
+def test_records_that_diverge_share_one_note_and_the_others_keep_their_own(sample: Verification) -> None:
+    first, second = sample.records[:2]
+    diverging = dataclasses.replace(first, unstable=True, growth=40.0, unstable_modes=("pitch",), notice="own-a")
+    also = dataclasses.replace(second, unstable=True, growth=12.0, unstable_modes=("pitch", "roll"), notice="own-b")
+    (shared,) = dataclasses.replace(sample, records=(diverging, also)).record_notes()
+    assert "pitch and roll modes" in shared and "up to 40-fold over 2 records" in shared
+    assert f"({first.label}; {second.label})" in shared and "own-" not in shared  # their notices: the shared one
+    one = dataclasses.replace(sample, records=(diverging, dataclasses.replace(second, notice="cut short")))
+    assert one.record_notes() == (f"{first.label}: own-a", f"{second.label}: cut short")  # one alone: its own
