@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import click
 
 from ._common import OutputPath, SysidCommand, staged_progress
 from ._tables import print_discrepancy, print_fit, print_ingest
+
+if TYPE_CHECKING:  # the library is imported when the command runs: `sysid --help` stays fast
+    from sysid.verify import Verification
 
 __all__ = ["demo"]
 
@@ -20,7 +23,7 @@ Examples:
 """
 
 
-def _wind_lines(verification: Any) -> str:
+def _wind_lines(verification: Verification) -> str:
     """How much G_w changes each output's RMS error, beside the dissertation's Table 3.6."""
     table = {"ax": "−13 to −16 %", "az": "−7 to −15 %"}  # dissertation Table 3.6
     lines = ""

@@ -14,6 +14,17 @@ heading turned: in a fleet flight's 1.4 m/s wind the lateral airspeed read from
 the log carried about 0.07 m/s RMS the airframe never felt, a model fitted on
 that log had its ``L_v`` and ``Y_v`` 6.5 % short, and the same vehicle in another
 wind was named a CG offset.)
+
+The states are linear perturbations in the heading frame: ``vd`` is ``w``, and
+pitch and roll do not turn the logged velocity. Turning it by the whole
+attitude (``R_b^i [u v w]``) looks more exact but is not, for this model: its
+dynamics have no ``q u - p v`` terms, so the mean airspeed a wind puts into
+``u`` would, turned by the pitch, make the vehicle climb at ``theta * W`` that
+its heave never felt. Tried on a 40-log fleet (issue 33): 30 of 40 fits
+beyond J_ave 100 (median 147) against 5 as written. Ingest still turns the
+logged velocity by the whole attitude, as it must for a real log; the
+``theta * u`` left in body ``w`` is second order, and
+:mod:`sysid.fit.trim_paths` does not fit the response it makes.
 """
 
 from __future__ import annotations

@@ -35,6 +35,7 @@ from sysid.fit.engine import FitOptions, FrequencyFit, fit_frequency_responses
 from sysid.fit.guidelines import Guidelines
 from sysid.fit.reduce import ReductionStep
 from sysid.fit.result import IdentifiedModel, ParameterEstimate, Provenance, WindClockOffset
+from sysid.fit.trim_paths import trim_only_responses
 from sysid.fit.wind import (
     WindStepResult,
     fit_wind,
@@ -296,7 +297,14 @@ def _identified(
         _report(progress, f"responses {flown[k]}", k + 1, len(_AXES) + 2)
         responses += found
         notes += [note] if note is not None else []
+    trim = _mean_trim([r for records in used.values() for r in records])
+    constants = structure.constants_from_trim(trim) | dict(options.constants or {})
     gated = gate_responses(responses, options.gating)
+    unfit = trim_only_responses(structure, gated.kept, structure.values(options.initial), constants, _swings(used))
+    if unfit:  # reached only through trims too small to carry them (sysid.fit.trim_paths)
+        left = {(d.input, d.output) for d in unfit}
+        kept = tuple(r for r in gated.kept if (r.input, r.output) not in left)
+        gated = dataclasses.replace(gated, kept=kept, dropped=(*gated.dropped, *unfit))
     axes = structure_axes(structure, flights, used, responses, gated, kind=options.kind, gating=options.gating)
     if flights and any(not a.identified for a in axes) and not (options.partial and gated.kept):
         raise FitError(unidentified_message(axes, model=structure.name, partial=options.partial))
@@ -311,8 +319,6 @@ def _identified(
     notes += [d.reason for d in gated.dropped]
     if not gated.kept:
         raise FitError("no frequency response passed gating: " + " ".join(d.reason for d in gated.dropped))
-    trim = _mean_trim([r for records in used.values() for r in records])
-    constants = structure.constants_from_trim(trim) | dict(options.constants or {})
     _report(progress, "fitting F, G_u", len(_AXES), len(_AXES) + 2)
     fit = fit_frequency_responses(
         structure, gated.kept, constants=constants, initial=options.initial, options=options.fit
@@ -504,6 +510,19 @@ def identify_logs(
     flights = conditioned_sources(log_paths, wind_paths, options=conditioning, progress=read, reading=reading)
     winds = expand_wind_paths([Path(p) for p in wind_paths])
     return identify_flights(flights, structure, options=options, files=[*log_paths, *winds], progress=progress)
+
+
+def _swings(used: Mapping[str, Sequence[Record]]) -> dict[str, dict[str, float]]:
+    """By mixer input, the RMS swing of u, v, w (m/s), phi and theta (rad) about each record's mean over that axis'
+    records."""
+    swings: dict[str, dict[str, float]] = {}
+    for axis, records in used.items():
+        swings[f"delta_{axis}"] = {
+            name: float(np.sqrt(np.mean(np.concatenate([(r[name] - np.mean(r[name])) ** 2 for r in records]))))
+            for name in ("u", "v", "w", "phi", "theta")
+            if records and all(name in r.signals for r in records)
+        }
+    return swings
 
 
 def _mean_trim(records: Sequence[Record]) -> dict[str, float]:

@@ -85,7 +85,9 @@ class GatingResult:
 def fit_range(omega: np.ndarray, coherence: np.ndarray, min_coherence: float) -> tuple[float, float] | None:
     """Widest frequency range (in decades) over which the coherence stays at or above `min_coherence`.
 
-    Dips narrower than :data:`BRIDGE_DECADES` are bridged.
+    Dips narrower than :data:`BRIDGE_DECADES` are bridged, except at the top
+    of the range, where the coherence must come back for more points than the
+    dip held.
 
     Parameters
     ----------
@@ -120,8 +122,36 @@ def fit_range(omega: np.ndarray, coherence: np.ndarray, min_coherence: float) ->
             runs[-1][1] = int(k)
         else:
             runs.append([int(k), int(k)])
+    runs = [[lo, _without_a_lone_top(good, lo, hi)] for lo, hi in runs]
     lo, hi = max(runs, key=lambda run: log_omega[run[1]] - log_omega[run[0]])
     return float(omega[lo]), float(omega[hi])
+
+
+def _without_a_lone_top(good: np.ndarray, lo: int, hi: int) -> int:
+    """The last index of a bridged run less the stretches at its top that hold no more points than the dip below.
+
+    A dip is bridged where the coherence comes back. Past the top of a sweep
+    the input carries only the autopilot's feedback, and a point or two
+    above the threshold there is chance, not the coherence coming back (on a
+    fleet log, one point at 70 rad/s with gamma^2 = 0.51 after two at 0.36
+    and 0.13, its gain a hundred times the response's, made J 687 of an
+    otherwise clean yaw response). The bottom is left as it is: a sweep
+    dwells there, and a short stretch below a dip carries the speed
+    derivatives (ax/delta_lon from 2.6 rad/s on an independent windy log).
+    """
+    stretches = _stretches(good, lo, hi)
+    while len(stretches) > 1 and stretches[-1][1] - stretches[-1][0] < stretches[-1][0] - stretches[-2][1] - 1:
+        stretches.pop()
+    return stretches[-1][1]
+
+
+def _stretches(good: np.ndarray, lo: int, hi: int) -> list[tuple[int, int]]:
+    """First and last index of each run of consecutive good points in `lo`..`hi` (inclusive)."""
+    index = lo + np.flatnonzero(good[lo : hi + 1])
+    breaks = np.flatnonzero(np.diff(index) > 1)
+    starts = np.concatenate([[0], breaks + 1])
+    ends = np.concatenate([breaks, [index.size - 1]])
+    return [(int(index[a]), int(index[b])) for a, b in zip(starts, ends)]
 
 
 def gate_responses(responses: Sequence[FrequencyResponse], gating: Gating = Gating()) -> GatingResult:

@@ -38,7 +38,7 @@ __all__ = [
 SEGMENTS_HINT = "give their times with `segments` if they were not detected"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Validation:
     """A model verified on the doublets of flights it was not fitted to: what ``sysid validate`` makes.
 

@@ -210,6 +210,20 @@ def test_x_w_lons_truth_is_inside_2_cr(outcomes: dict[str, _Outcome]) -> None:
     assert all(_inside_2_cr(outcome, "X_w_lon") for outcome in outcomes.values())
 
 
+def test_body_w_from_the_pitch_input_is_fitted_where_the_wind_carries_it(outcomes: dict[str, _Outcome]) -> None:
+    """In 5-6 m/s the trim airspeed U0 carries body w's answer to the pitch input at first order: the trim-path
+    rule (:mod:`sysid.fit.trim_paths`, set by analysis, its data check our fleet's still air) leaves out no
+    response of these logs, and w/delta_lon is fitted wherever it passed gating."""
+    for name, outcome in outcomes.items():
+        assert not [n for n in outcome.model["notes"] if "only through the trim" in n], name
+    fitted = [
+        n
+        for n, o in outcomes.items()
+        if any((r["output"], r["input"]) == ("w", "delta_lon") for r in o.model["responses"])
+    ]
+    assert "heldout-wind-clock-px4-behind" in fitted, fitted
+
+
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,

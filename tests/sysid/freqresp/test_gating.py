@@ -426,3 +426,20 @@ def test_the_phase_branch_is_fixed_where_the_response_is_coherent() -> None:
     coherent = ~noisy
     assert np.degrees(np.unwrap(np.angle(response.response)))[coherent][0] < -300.0  # the naive unwrap: a turn low
     assert response.phase_deg[coherent] == pytest.approx(-np.degrees(OMEGA[coherent] * 0.02), abs=1e-9)
+
+
+def test_a_lone_point_past_a_bridged_dip_at_the_top_does_not_extend_the_range() -> None:
+    """The shape met on a fleet log's yaw sweep: good to the sweep's top, a dip of two points, one point at 0.51
+    (its gain a hundred times the response's): the range ends below the dip. Coherence that comes back for more
+    points than the dip held is bridged, and at the bottom, where a sweep dwells, a short stretch is kept."""
+    coherence = _band(2.0, 40.0)
+    inside = np.flatnonzero(coherence > 0.5)
+    top = inside[-1]
+    coherence[top + 1 : top + 4] = [0.36, 0.13, 0.51]
+    assert np.log10(OMEGA[top + 3] / OMEGA[top + 1]) <= 0.05 + 1e-9  # a dip the bridge spans
+    assert fit_range(OMEGA, coherence, 0.5) == pytest.approx((OMEGA[inside[0]], OMEGA[top]))
+    coherence[top + 4 : top + 6] = 0.8
+    assert fit_range(OMEGA, coherence, 0.5) == pytest.approx((OMEGA[inside[0]], OMEGA[top + 5]))
+    bottom = inside[0]
+    coherence[bottom - 3 : bottom] = [0.51, 0.13, 0.36]
+    assert fit_range(OMEGA, coherence, 0.5) == pytest.approx((OMEGA[bottom - 3], OMEGA[top + 5]))
