@@ -81,13 +81,12 @@ def trim_only_responses(
         if response.input not in with_trims.inputs or response.output not in with_trims.outputs:
             continue
         omega = _fitted(response)
-        if _size(without, response, omega) > 1e-9 * _size(with_trims, response, omega):
+        through_trims = _size(with_trims, response, omega)
+        if _size(without, response, omega) > 1e-9 * through_trims:
             continue  # a path that needs no trim velocity
         swing = swings.get(response.input, {})
         at_swings = {**constants, **{name: swing.get(signal, 0.0) for name, signal in trims.items()}}
-        if _size(with_trims, response, omega) >= TRIM_FRACTION * _size(
-            _model(structure, values, at_swings), response, omega
-        ):
+        if through_trims >= TRIM_FRACTION * _size(_model(structure, values, at_swings), response, omega):
             continue
         used = ", ".join(f"{name} {constants[name]:+.2g} {_TRIMMED[signal]}" for name, signal in trims.items())
         swung = ", ".join(f"{signal} {swing.get(signal, 0.0):.2g} {_TRIMMED[signal]}" for signal in trims.values())
@@ -98,8 +97,8 @@ def trim_only_responses(
                 reason=(
                     f"{response.pair}: the structure reaches {response.output} from {response.input} only through "
                     f"the trim ({used}), a smaller path than the RMS swings in the records would make "
-                    f"({swung}): what is measured there is the products the linear model leaves out (θ·u in body "
-                    "w), not fitted"
+                    f"({swung}): what is measured there is the products the linear model leaves out (such as θ·u), "
+                    "not fitted"
                 ),
             )
         )

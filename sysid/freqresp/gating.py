@@ -7,6 +7,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from flightlogs.masks import true_runs
 from sysid.freqresp.response import FrequencyResponse
 
 __all__ = ["DroppedResponse", "Gating", "GatingResult", "gate_responses", "fit_range"]
@@ -139,19 +140,10 @@ def _without_a_lone_top(good: np.ndarray, lo: int, hi: int) -> int:
     dwells there, and a short stretch below a dip carries the speed
     derivatives (ax/delta_lon from 2.6 rad/s on an independent windy log).
     """
-    stretches = _stretches(good, lo, hi)
+    stretches = [(lo + start, lo + stop - 1) for start, stop in true_runs(good[lo : hi + 1])]  # inclusive
     while len(stretches) > 1 and stretches[-1][1] - stretches[-1][0] < stretches[-1][0] - stretches[-2][1] - 1:
         stretches.pop()
     return stretches[-1][1]
-
-
-def _stretches(good: np.ndarray, lo: int, hi: int) -> list[tuple[int, int]]:
-    """First and last index of each run of consecutive good points in `lo`..`hi` (inclusive)."""
-    index = lo + np.flatnonzero(good[lo : hi + 1])
-    breaks = np.flatnonzero(np.diff(index) > 1)
-    starts = np.concatenate([[0], breaks + 1])
-    ends = np.concatenate([breaks, [index.size - 1]])
-    return [(int(index[a]), int(index[b])) for a, b in zip(starts, ends)]
 
 
 def gate_responses(responses: Sequence[FrequencyResponse], gating: Gating = Gating()) -> GatingResult:
