@@ -47,7 +47,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from sysid.discrepancy._filters import welch_density
+from sysid._filters import welch_density
 from sysid.discrepancy.baseline import BaselineModel, fit_baseline
 from sysid.discrepancy.catalogue import (
     CATALOGUE,

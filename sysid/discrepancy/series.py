@@ -34,7 +34,7 @@ from flightlogs.errors import DataError
 from flightlogs.frames import earth_to_body, wind_to_body_axes
 from flightlogs.kinematics import SPECIFIC_FORCE_WINDOW_S, specific_force
 from flightlogs.record import Record
-from sysid.discrepancy._filters import butterworth_zero_phase, savgol_slope
+from sysid._filters import butterworth_zero_phase, savgol_slope
 
 __all__ = [
     "OUTPUTS",

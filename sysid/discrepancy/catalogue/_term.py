@@ -17,7 +17,7 @@ from typing import Literal
 import numpy as np
 
 from flightlogs._moving import moving_mean
-from sysid.discrepancy._filters import one_pole
+from sysid._filters import one_pole
 from sysid.discrepancy.baseline import BaselineModel
 from sysid.discrepancy.result import Finding, FittedParameter
 from sysid.discrepancy.series import COMMANDS, OUTPUTS, FlightSeries

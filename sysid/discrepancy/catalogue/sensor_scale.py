@@ -26,7 +26,7 @@ from dataclasses import replace
 import numpy as np
 
 from flightlogs.frames import euler_rates_to_body
-from sysid.discrepancy._filters import butterworth_zero_phase, savgol_slope
+from sysid._filters import butterworth_zero_phase, savgol_slope
 from sysid.discrepancy._folds import folds
 from sysid.discrepancy.catalogue._term import Calibration, Coefficient, Term, pm
 from sysid.discrepancy.result import Finding, FittedParameter

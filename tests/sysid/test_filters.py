@@ -1,4 +1,4 @@
-"""The discrepancy search's numpy filters equal the SciPy calls they replace, to rounding.
+"""The numpy filters of the discrepancy search and the wind step equal the SciPy calls they replace, to rounding.
 
 SciPy is the reference (cross-implementation). What is compared: the whole output, sample by sample,
 ``max |ours - scipy| <= 1e-9 * scale`` with `scale` the largest magnitude of SciPy's output (the
@@ -19,7 +19,7 @@ import pytest
 from scipy import ndimage, signal
 
 from flightlogs._moving import moving_mean  # the search's moving mean is ingest's: held to SciPy here too
-from sysid.discrepancy._filters import (
+from sysid._filters import (
     _butterworth_fractions,
     butterworth_zero_phase,
     one_pole,
@@ -27,6 +27,7 @@ from sysid.discrepancy._filters import (
     welch_density,
 )
 from sysid.discrepancy.series import _FILTER_PAD, _anti_aliased
+from sysid.fit.wind_offset import SMOOTHING_HZ, smoothed
 
 _RTOL = 1e-9  # of the signal's scale: rounding is 1e-12 at most
 
@@ -206,6 +207,17 @@ def test_a_long_log_is_filtered_as_scipy_filters_it() -> None:
     x = _signal("accelerometer", 60_000, 250.0, 7)
     expected = signal.sosfiltfilt(signal.butter(4, 20.0, fs=250.0, output="sos"), x, padlen=60)
     _assert_same(butterworth_zero_phase(x, 20.0, 250.0, order=4, pad=60), expected)
+
+
+@pytest.mark.parametrize("n", [32, 33, 1000, 20_000])
+@pytest.mark.parametrize("rate_hz", [8.5, 10.0, 50.0, 100.0, 400.0])
+def test_the_wind_steps_smoothing_is_sosfiltfilt_of_butter_with_its_default_padding(n: int, rate_hz: float) -> None:
+    """The anemometer's wind (north, east) low-passed at 2 Hz as SciPy's call with its defaults, column by column."""
+    wind = np.column_stack([_signal("command", n, rate_hz, 3) + 4.0, _signal("rate", n, rate_hz, 4) - 1.5])
+    expected = signal.sosfiltfilt(signal.butter(4, SMOOTHING_HZ, fs=rate_hz, output="sos"), wind, axis=0)
+    ours = smoothed(wind, rate_hz)
+    for column in range(2):
+        _assert_same(ours[:, column], expected[:, column])
 
 
 def test_what_sosfiltfilt_refuses_is_refused() -> None:

@@ -1,10 +1,11 @@
-"""The discrepancy search's filters in numpy, without importing scipy.signal or scipy.ndimage.
+"""Filters in numpy for the discrepancy search and the wind step, without importing scipy.signal or scipy.ndimage.
 
-``scipy.signal`` and ``scipy.ndimage`` take 0.8-0.9 s to import on top of what the search imports
-anyway (scipy.signal pulls in scipy.stats, scipy.interpolate and array-API decorators that parse
-docstrings), more than the filtering itself takes on a pair of flights. Four of the calls the search
-makes are written out here, each equal to SciPy's to rounding (``tests/sysid/discrepancy/test_filters.py``
-compares them); the fifth, ``uniform_filter1d``, is ingest's :func:`flightlogs._moving.moving_mean`:
+``scipy.signal`` and ``scipy.ndimage`` take 0.5-0.9 s to import on top of what the search or a fit
+imports anyway (scipy.signal pulls in scipy.stats, scipy.interpolate and array-API decorators that parse
+docstrings), more than the filtering itself takes on a pair of flights or the 90 anemometer pieces of a
+campaign. Four SciPy calls are written out here, each equal to SciPy's to rounding
+(``tests/sysid/test_filters.py`` compares them); ``uniform_filter1d`` is ingest's
+:func:`flightlogs._moving.moving_mean`:
 
 =====================================  ================================================================
 here                                   SciPy
@@ -30,7 +31,7 @@ from typing import cast
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-__all__: list[str] = []  # private to sysid.discrepancy
+__all__: list[str] = []  # private to sysid (the discrepancy search, the wind step)
 
 _EXPONENT = 200.0  # a block's pole^-k reaches at most e^200 (7e86): far from overflow
 _BLOCK = 256  # samples per block at most: the cumulative sum's rounding grows with the block
