@@ -9,8 +9,9 @@ States the record lacks (the actuator lags) are reconstructed by simulating
 their own rows from the recorded inputs and states. What is left in the
 accelerometer outputs is explained by ``H1 G_w u_w(t - tau_w)``: the G_w
 entries are found by linear least squares at given delays, each wind delay
-by a 1-D scan (coarse then fine, coordinate-wise, twice over), then all of
-them are polished together by nonlinear least squares. Each output's
+by a 1-D scan (coarse then fine, coordinate-wise, twice over when there are
+two delays or more), then all of them are polished together by nonlinear
+least squares. Each output's
 residual is weighted by its own level, and each record's mean is taken out of
 the residual and of the wind (a per-record bias, as VERIFY's: accelerometer
 bias and the trim leave a constant the wind does not explain). Wind
@@ -328,11 +329,15 @@ class _Normal:
 
 
 def _scan(problem: _Problem) -> np.ndarray:
-    """Each delay by a coarse then fine 1-D scan (gains solved at every point), twice over."""
+    """Each delay by a coarse then fine 1-D scan (gains solved at every point), twice over.
+
+    With one delay the second round is not run: the gains are solved afresh at every point, so it
+    would visit the same points at the same costs and change nothing.
+    """
     delays, gains = problem.delay_and_gain_index()
     normal = _Normal(problem, problem.start, gains)
     theta, best = normal.solve(problem.start)
-    for _ in range(2 if delays else 0):
+    for _ in range(2 if len(delays) > 1 else len(delays)):
         for k in delays:
             p = problem.structure.parameter(problem.free[k])
             lo, hi = max(p.lower, 0.0), min(p.upper, 1.0)
@@ -733,8 +738,9 @@ def speed_derivatives(
     (``X_u`` in ax, ``Z_w`` in az) is solved for with the G_w gains, each
     output weighted by its residual level, at the wind delays that leave the
     least residual (every 10 ms over each delay's bounds, then every 2 ms
-    about the best, coordinate-wise, twice: u carries the wind undelayed, so
-    the split between X_u and X_w_lon follows the delay).
+    about the best, coordinate-wise, twice where there are two delays or more:
+    u carries the wind undelayed, so the split between X_u and X_w_lon follows
+    the delay).
 
     The solution is by instrumental variables, not least squares. What tells
     X_u from X_w_lon is the ground speed (u is the wind less it), a few
@@ -823,7 +829,8 @@ def speed_derivatives(
     for k in delay_index if delays is not None else ():
         at[k] = (delays or {}).get(problem.free[k], at[k])
     best = solved(at)[0]
-    for _ in range(2 if delay_index and delays is None else 0):
+    rounds = 0 if delays is not None else 2 if len(delay_index) > 1 else len(delay_index)  # one delay: once, as _scan
+    for _ in range(rounds):
         for k in delay_index:
             p = structure.parameter(problem.free[k])
             lo, hi = max(p.lower, 0.0), min(p.upper, 0.5)
