@@ -256,16 +256,21 @@ class _Problem:
         self.assembler = Assembler(structure, free=self.free, fixed=values, constants=constants, include_wind=True)
         self.columns = [j for j, c in enumerate(self.assembler.channels) if c.wind]
         self.start = np.array([values[n] for n in self.free])
-        self._cache: dict[tuple[int, float], list[np.ndarray]] = {}
+        self._cache: dict[tuple[int, float], np.ndarray] = {}
+        self._ends = np.cumsum([t.size for t in data.times])[:-1]
 
     def shifted(self, k: int, tau: float) -> list[np.ndarray]:
-        """Wind channel `k` delayed by `tau`, per record."""
+        """Wind channel `k` delayed by `tau`, per record (views into :meth:`stacked`)."""
+        return np.split(self.stacked(k, tau), self._ends)
+
+    def stacked(self, k: int, tau: float) -> np.ndarray:
+        """Wind channel `k` delayed by `tau`, each record's mean taken out, the records end to end, shape (n,)."""
         key = (k, round(float(tau), 12))
         if key not in self._cache:
             if len(self._cache) > 64:  # the scan revisits few delays; the polish visits many once
                 self._cache.clear()
             shifted = [np.interp(t - tau, t, w[:, k]) for t, w in zip(self.data.times, self.data.winds)]
-            self._cache[key] = [x - x.mean() for x in shifted]  # as the residual: each record's bias taken out
+            self._cache[key] = np.concatenate([x - x.mean() for x in shifted])  # as the residual: a bias per record
         return self._cache[key]
 
     def parts(self, theta: np.ndarray) -> tuple[SystemMatrices, list[np.ndarray]]:
@@ -299,20 +304,20 @@ class _Normal:
         dm = problem.assembler.derivatives(zero, m0)
         self.e = np.array([dm.d[k][rows][:, columns] for k in self.gains]).reshape(len(self.gains), *self.d0.shape)
         self.weight = problem.data.scale**2
-        residual = np.vstack(problem.data.residual)
-        self.residual = residual
+        self.residual = np.vstack(problem.data.residual)
+        self._residual_squares = np.einsum("nr,nr->r", self.residual, self.residual)  # (n_out,): the scans reuse it
 
     def solve(self, theta: np.ndarray) -> tuple[np.ndarray, float]:
         """Least-squares gains at the delays of `theta` (entries linear in their gains) and the cost."""
         delays = self.problem.assembler.matrices(theta).delays[self.problem.columns]
-        winds = np.column_stack([np.concatenate(self.problem.shifted(k, tau)) for k, tau in enumerate(delays)])
+        winds = np.column_stack([self.problem.stacked(k, tau) for k, tau in enumerate(delays)])
         return self.solve_for(theta, winds, self.residual)
 
     def solve_for(self, theta: np.ndarray, winds: np.ndarray, residual: np.ndarray) -> tuple[np.ndarray, float]:
         """As :meth:`solve`, with the delayed winds (n, n_wind) and the residual (n, n_out) given."""
         gram = winds.T @ winds  # (n_wind, n_wind)
         cross = winds.T @ residual  # (n_wind, n_out)
-        rr = np.einsum("nr,nr->r", residual, residual)
+        rr = self._residual_squares if residual is self.residual else np.einsum("nr,nr->r", residual, residual)
         # target per output: residual - w d0^T; regressor g per output: w e_g^T
         tt = rr - 2 * np.einsum("rc,cr->r", self.d0, cross) + np.einsum("rc,cd,rd->r", self.d0, gram, self.d0)
         out = theta.copy()
@@ -543,9 +548,7 @@ def _lagged_wind(problem: _Problem) -> np.ndarray:
     """
     signals = [problem.assembler.channels[j].signal for j in problem.columns]
     first = [k for k, signal in enumerate(signals) if signals.index(signal) == k]
-    return np.column_stack(
-        [np.concatenate(problem.shifted(k, float(lag))) for k in first for lag in _INSTRUMENT_LAGS_S]
-    )
+    return np.column_stack([problem.stacked(k, float(lag)) for k in first for lag in _INSTRUMENT_LAGS_S])
 
 
 def _projected(columns: np.ndarray, basis: np.ndarray) -> np.ndarray:
@@ -820,7 +823,7 @@ def speed_derivatives(
     def solved(at: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
         """Cost and solution at the wind delays of `at`, and the delayed winds (n_samples, n_wind)."""
         delays = problem.assembler.matrices(at).delays[problem.columns]
-        wind = np.column_stack([np.concatenate(problem.shifted(k, tau)) for k, tau in enumerate(delays)])
+        wind = np.column_stack([problem.stacked(k, tau) for k, tau in enumerate(delays)])
         return (*joint.solve(wind), wind)
 
     # u carries the wind undelayed: the split between X_u and X_w_lon follows the wind delay, so it is scanned,
