@@ -39,6 +39,7 @@ from sysid.fit.trim_paths import trim_only_responses
 from sysid.fit.wind import (
     WindStepResult,
     fit_wind,
+    sharing_delayed_winds,
     speed_derivatives,
     speed_spread,
     step_one_spread,
@@ -350,7 +351,8 @@ def _identified(
             if untimed:
                 wind = unfitted_wind(structure, untimed)
             else:
-                wind = _wind_step(structure, fit, constants, records, options)
+                with sharing_delayed_winds():  # its fits scan the same delays of the same records' wind
+                    wind = _wind_step(structure, fit, constants, records, options)
             if wind.fit is not None:
                 identified = dict(fit.values) | dict(wind.speed_values) | dict(wind.values)
                 trace = wind_trace(structure, identified, constants, records, flights)

@@ -37,7 +37,9 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Literal
@@ -63,6 +65,7 @@ __all__ = [
     "identified_outputs",
     "prediction_residual",
     "residual_inflation",
+    "sharing_delayed_winds",
     "speed_derivatives",
     "speed_spread",
     "step_one_spread",
@@ -115,13 +118,73 @@ class WindStepResult:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class _Data:
-    """Eq. 3.14 residuals and wind signals of the records, with output weights."""
+    """Eq. 3.14 residuals of the records and their delayed winds (the signal of each wind channel), with output weights."""
 
     residual: list[np.ndarray]
-    winds: list[np.ndarray]
-    times: list[np.ndarray]
+    delayed: _DelayedWinds
+    signals: tuple[str, ...]
     rows: list[int]
     scale: np.ndarray
+
+
+class _DelayedWinds:
+    """The wind signals of a set of records delayed by any amount, each record's mean taken out, records end to end.
+
+    Cached by signal and delay, within :data:`_CACHE_BYTES`: the delay scans revisit their grids, the
+    channels that carry one signal (the along-nose wind on u and on w) share it, and within
+    :func:`sharing_delayed_winds` so do the fits of the same records.
+    """
+
+    def __init__(self, records: Sequence[Record], signals: Sequence[str]) -> None:
+        self.times = [record.time_s for record in records]
+        self.winds = {s: [record[s] for record in records] for s in signals}
+        self.ends = np.cumsum([t.size for t in self.times])[:-1]
+        self._cache: dict[tuple[str, float], np.ndarray] = {}
+
+    def stacked(self, signal: str, tau: float) -> np.ndarray:
+        """`signal` delayed by `tau` (s), shape (n_samples,), read-only."""
+        key = (signal, round(float(tau), 12))
+        if key not in self._cache:
+            if sum(x.nbytes for x in self._cache.values()) > _CACHE_BYTES:
+                self._cache.clear()
+            shifted = [np.interp(t - tau, t, w) for t, w in zip(self.times, self.winds[signal])]
+            stacked = np.concatenate([x - x.mean() for x in shifted])  # as the residual: a bias per record
+            stacked.flags.writeable = False
+            self._cache[key] = stacked
+        return self._cache[key]
+
+
+#: Bytes of delayed winds kept: a scan's grids of two channels (about 140 delays) at 100 000 samples.
+_CACHE_BYTES = 160 * 2**20
+
+_SHARED: ContextVar[dict[tuple[int, ...], tuple[Sequence[Record], _DelayedWinds]] | None] = ContextVar(
+    "_SHARED", default=None
+)
+
+
+@contextmanager
+def sharing_delayed_winds() -> Iterator[None]:
+    """Within this, the wind step's fits of the same records (the same arrays) share their delayed winds.
+
+    :func:`speed_derivatives`, :func:`fit_wind` and the spreads scan the same delays on the same records;
+    the cache is freed on leaving.
+    """
+    token = _SHARED.set({})
+    try:
+        yield
+    finally:
+        _SHARED.reset(token)
+
+
+def _delayed_winds(records: Sequence[Record], signals: Sequence[str]) -> _DelayedWinds:
+    """The records' delayed winds: shared with earlier fits of the same arrays inside :func:`sharing_delayed_winds`."""
+    shared = _SHARED.get()
+    if shared is None:
+        return _DelayedWinds(records, signals)
+    key = tuple(id(a) for r in records for a in (r.time_s, *(r[s] for s in sorted(set(signals)))))
+    if key not in shared:  # the entry holds the records, so the arrays the key names outlive it
+        shared[key] = (list(records), _DelayedWinds(records, signals))
+    return shared[key][1]
 
 
 def prediction_residual(
@@ -172,17 +235,15 @@ def _prediction_data(
     )
     m = plain.matrices(np.zeros(0))
     rows = [structure.outputs.index(o) for o in outputs]
-    signals = [c.signal for c in structure.wind_inputs]
-    residual, winds, times = [], [], []
+    signals = tuple(c.signal for c in structure.wind_inputs)
+    residual = []
     for record in records:
         x, u = _states(record, structure, plain, m)
         y = np.column_stack([record[o] for o in outputs])
         r = y - x @ m.c[rows].T - u @ m.d[rows].T
         residual.append(r - r.mean(axis=0))  # a bias per record (sensor bias, trim): not the wind's
-        winds.append(np.column_stack([record[s] for s in signals]))
-        times.append(record.time_s)
     scale = 1.0 / np.maximum(np.vstack(residual).std(axis=0), 1e-12)
-    return _Data(residual=residual, winds=winds, times=times, rows=rows, scale=scale)
+    return _Data(residual=residual, delayed=_delayed_winds(records, signals), signals=signals, rows=rows, scale=scale)
 
 
 def _states(
@@ -256,22 +317,14 @@ class _Problem:
         self.assembler = Assembler(structure, free=self.free, fixed=values, constants=constants, include_wind=True)
         self.columns = [j for j, c in enumerate(self.assembler.channels) if c.wind]
         self.start = np.array([values[n] for n in self.free])
-        self._cache: dict[tuple[int, float], np.ndarray] = {}
-        self._ends = np.cumsum([t.size for t in data.times])[:-1]
 
     def shifted(self, k: int, tau: float) -> list[np.ndarray]:
         """Wind channel `k` delayed by `tau`, per record (views into :meth:`stacked`)."""
-        return np.split(self.stacked(k, tau), self._ends)
+        return np.split(self.stacked(k, tau), self.data.delayed.ends)
 
     def stacked(self, k: int, tau: float) -> np.ndarray:
         """Wind channel `k` delayed by `tau`, each record's mean taken out, the records end to end, shape (n,)."""
-        key = (k, round(float(tau), 12))
-        if key not in self._cache:
-            if len(self._cache) > 64:  # the scan revisits few delays; the polish visits many once
-                self._cache.clear()
-            shifted = [np.interp(t - tau, t, w[:, k]) for t, w in zip(self.data.times, self.data.winds)]
-            self._cache[key] = np.concatenate([x - x.mean() for x in shifted])  # as the residual: a bias per record
-        return self._cache[key]
+        return self.data.delayed.stacked(self.data.signals[k], tau)
 
     def parts(self, theta: np.ndarray) -> tuple[SystemMatrices, list[np.ndarray]]:
         m = self.assembler.matrices(theta)

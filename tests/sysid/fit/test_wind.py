@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ from simulator.autopilot.excitation import Maneuver
 from simulator.flights.linear import WindField, simulate_hover
 from simulator.vehicle.identified import CALM_HOVER, STRONG_WIND_TERMS
 from sysid.fit import FrequencyFit, fit_frequency_responses, fit_wind, model_from_fit, synthetic_responses
-from sysid.fit.wind import unfitted_wind
+from sysid.fit.wind import _prediction_data, sharing_delayed_winds, unfitted_wind
 from sysid.model import ModelStructure, load_structure, structure_model
 
 CONTROLS = ("X_lon", "M_lon", "Y_lat", "L_lat", "N_yaw", "Z_thr")
@@ -93,6 +94,35 @@ def test_unresolved_wind_delays_are_dropped_to_zero(records: list[Record]) -> No
     assert {step.parameter for step in result.reduction} == {"tau_w_lon", "tau_w_thr"}
     assert all(step.action == "dropped" and result.values[step.parameter] == 0.0 for step in result.reduction)
     assert np.all(result.accuracy.insensitivity_percent <= 10)
+
+
+def test_fits_of_the_same_records_share_their_delayed_winds_and_give_what_each_gives_alone(
+    records: list[Record],
+) -> None:
+    """Inside :func:`sharing_delayed_winds` the fits reuse one set of delayed winds; the values are bitwise the same."""
+    structure = load_structure("hover-wind")
+    values = structure.values(dict(CALM_HOVER) | {"N_r": 0.0, "Z_w": 0.0})
+    constants = structure.default_constants()
+    alone = fit_wind(structure, values, constants, records)
+
+    def data(of: list[Record]):  # type: ignore[no-untyped-def]
+        return _prediction_data(structure, values, constants, of, ["ax", "az"])
+
+    assert data(records).delayed is not data(records).delayed  # outside: each fit its own
+    with sharing_delayed_winds():
+        shared = data(records).delayed
+        assert data(records).delayed is shared
+        moved = [replace(records[0], columns=dict(records[0].columns) | {"wind_lon": records[0]["wind_lon"] + 0.1})]
+        assert data(moved).delayed is not shared  # another wind array: not the same winds
+        twice = [fit_wind(structure, values, constants, records) for _ in range(2)]
+        delayed = shared.stacked("wind_lon", 0.013)
+    assert all(dict(fit.values) == dict(alone.values) for fit in twice)
+    assert all(fit.accuracy.cramer_rao.tolist() == alone.accuracy.cramer_rao.tolist() for fit in twice)
+    t, wind = records[0].time_s, records[0]["wind_lon"]
+    expected = np.interp(t - 0.013, t, wind)
+    np.testing.assert_array_equal(delayed[: t.size], expected - expected.mean())
+    assert not delayed.flags.writeable
+    assert data(records).delayed is not shared  # freed on leaving
 
 
 def test_records_without_wind_are_refused(records: list[Record]) -> None:
