@@ -1,7 +1,7 @@
 """Time ``sysid fit`` on one wind condition of the chapter 3 campaign flown by the linear model.
 
     python benchmarks/bench_fit.py [--condition calm|light|strong] [--trials 5] [--folder DIR] [--threads 2]
-    python benchmarks/bench_fit.py --campaign [--folder DIR] [--repeat 3]
+    python benchmarks/bench_fit.py --campaign [--folder DIR] [--repeat 3] [--stages]
 
 Simulates 5 sweeps per axis (4 axes, 20 ArduPilot logs with a ground
 anemometer) of the Table 3.3 model in the chosen wind (not timed), then
@@ -16,6 +16,9 @@ With ``--campaign`` it flies the whole chapter 3 campaign instead (``sysid simul
 chapter3-campaign``, 120 trials, not timed) and times ``sysid fit`` of its 60 sweeps (4 axes x
 3 winds x 5 trials) with all 120 anemometer files, as a whole process, best of ``--repeat``:
 issue 16's target is under 4 s. BLAS threads are then the command's own default (one).
+``--stages`` then runs the same fit once in this process and prints the wall time of each stage
+(reading and conditioning, the responses of each pass, the clock-offset scan, the wind step and its
+parts), in the order they start: where the seconds go, for whoever takes the 4 s on next.
 """
 
 from __future__ import annotations
@@ -48,9 +51,10 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--campaign", action="store_true", help="time sysid fit of the 60 campaign sweeps")
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--stages", action="store_true", help="with --campaign: also each stage's wall time")
     args = parser.parse_args()
     if args.campaign:
-        _campaign(args.folder or Path(tempfile.mkdtemp(prefix="bench-fit-")), args.repeat)
+        _campaign(args.folder or Path(tempfile.mkdtemp(prefix="bench-fit-")), args.repeat, stages=args.stages)
         return
     for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[name] = str(args.threads)
@@ -129,8 +133,8 @@ def main() -> None:
         print("note: the default number of starts is not 1", file=sys.stderr)
 
 
-def _campaign(folder: Path, repeat: int) -> None:
-    """Time ``sysid fit`` of the chapter 3 campaign's 60 sweeps, whole process, best of `repeat`."""
+def _campaign(folder: Path, repeat: int, *, stages: bool = False) -> None:
+    """Time ``sysid fit`` of the chapter 3 campaign's 60 sweeps, whole process, best of `repeat`; then its stages."""
     logs_dir = folder / "chapter3-campaign"
     folder.mkdir(parents=True, exist_ok=True)  # a --folder given need not exist yet
     if not any(logs_dir.glob("*-sweep-*.bin")):
@@ -151,6 +155,52 @@ def _campaign(folder: Path, repeat: int) -> None:
         f"sysid fit, {len(logs)} sweeps, {len(winds)} anemometer files, hover-wind: best {best:.2f} s of "
         f"{', '.join(f'{t:.2f}' for t in times)} (target < 4 s) {'OK' if best < 4 else 'SLOW'}"
     )
+    if stages:
+        _stages(command[2:])
+
+
+#: (module, function) of each stage timed by ``--stages``, where the caller looks it up.
+_STAGES = (
+    ("flightlogs.store.sources", "conditioned_sources"),
+    ("sysid.fit.identify", "fit_frequency_responses"),
+    ("sysid.fit.wind_offset", "scan_wind_offset"),
+    ("sysid.fit.identify", "moved_flights"),
+    ("sysid.fit.identify", "_wind_step"),
+    ("sysid.fit.identify", "speed_derivatives"),
+    ("sysid.fit.identify", "fit_wind"),
+    ("sysid.fit.identify", "step_one_spread"),
+)
+
+
+def _stages(arguments: list[str]) -> None:
+    """Run ``sysid fit ARGUMENTS`` in this process once, printing each stage's wall time and when it started."""
+    import functools
+    import importlib
+
+    from sysid_cli.main import cli
+
+    start = time.perf_counter()
+    spans: list[tuple[str, float, float]] = []
+
+    def timed(name: str, function):  # type: ignore[no-untyped-def]
+        @functools.wraps(function)
+        def wrapper(*args, **kwargs):  # type: ignore[no-untyped-def]
+            begun = time.perf_counter()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                spans.append((name, begun - start, time.perf_counter() - begun))
+
+        return wrapper
+
+    for module_name, name in _STAGES:
+        module = importlib.import_module(module_name)
+        setattr(module, name, timed(name, getattr(module, name)))
+    cli(["fit", *arguments], standalone_mode=False)
+    total = time.perf_counter() - start
+    print(f"stages of one in-process run ({total:.2f} s in all), in the order they start:")
+    for name, begun, length in sorted(spans, key=lambda span: span[1]):
+        print(f"  {name:<26} at {begun:6.2f} s  {length:6.2f} s")
 
 
 if __name__ == "__main__":
