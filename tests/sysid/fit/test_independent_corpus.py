@@ -64,15 +64,17 @@ CR_MULTIPLE = 2.0  # issue 14: truth inside 2 Cramér-Rao bounds
 _FITTED: dict[str, tuple[IdentifiedModel, dict[str, float]]] = {}
 
 
-def _fit(corpus, name: str) -> tuple[IdentifiedModel, dict[str, float]]:  # type: ignore[no-untyped-def]
+def _fit(corpus, name: str, *, partial: bool = False) -> tuple[IdentifiedModel, dict[str, float]]:  # type: ignore[no-untyped-def]
     """The `hover` fit of a held-out case with its true segments, and the truth (fitted once per session)."""
-    if name not in _FITTED:
+    key = f"{name} partial" if partial else name
+    if key not in _FITTED:
         files = corpus.files(name)
         conditioning = ConditioningOptions(segments=read_segments_file(files.segments_csv))
-        model = identify_logs([files.log], "hover", conditioning=conditioning, options=IdentifyOptions())
+        options = IdentifyOptions(partial=partial)
+        model = identify_logs([files.log], "hover", conditioning=conditioning, options=options)
         truth = json.loads(files.truth_json.read_text())["hover_parameters"]
-        _FITTED[name] = (model, truth)
-    return _FITTED[name]
+        _FITTED[key] = (model, truth)
+    return _FITTED[key]
 
 
 def _estimate(model: IdentifiedModel, name: str) -> tuple[float, float]:
@@ -147,3 +149,40 @@ def test_a_long_low_sweep_without_position_hold_gives_the_speed_derivatives_with
         value, cr = _estimate(model, name)
         assert abs(value / truth[name] - 1.0) <= 0.10, f"{name} = {value:.4g}, truth {truth[name]:.4g}"
         assert abs(value - truth[name]) <= CR_MULTIPLE * cr and cr <= 0.2 * abs(value), f"{name}: CR {cr:.3g}"
+
+
+#: Held-out cases for the speed derivatives' calibration (issue 32, item 4): three flown in closed loop with
+#: position hold (the piloted one has no lateral sweep: fitted with ``partial``), one long, low sweep without it.
+CALIBRATION_CASES = (*HELDOUT_SWEEPS, "heldout-px4-piloted", "heldout-px4-long-low")
+
+
+@pytest.mark.filterwarnings("ignore:model hover is partial:flightlogs.errors.FitWarning")  # px4-piloted: no lat
+@pytest.mark.xfail(
+    strict=True,
+    raises=AssertionError,  # the criterion missed, not a fit that fails
+    reason="issue 32 item 4: the truth inside 2 CR on 8 of 14 held-out speed derivatives (floor 90 %): M_u -13.8 % "
+    "at CR 4.0 % (ap-sweeps), -13.3 % at CR 3.6 % (px4-piloted), +87 % at CR 22 % (px4-sweeps); L_v -16.8 % at "
+    "CR 4.1 % and Y_v +13.6 % at CR 5.5 % (px4-sweeps); X_u -8.8 % at CR 4.4 % (px4-piloted). In closed loop the "
+    "Cramér-Rao bound does not carry the position loop's bias at the bottom of the fit range",
+)
+def test_the_speed_derivatives_truth_is_inside_2_cr_on_90_percent_of_the_held_out_cases(  # type: ignore[no-untyped-def]
+    independent_corpus,
+) -> None:
+    """Issue 32 item 4's criterion for X_u, M_u, Y_v, L_v: calibration, not a fixed percentage.
+
+    Unidentified estimates (Y_v and L_v without a lateral sweep) are not counted; every estimate is.
+    """
+    outside, counted = [], 0
+    for case in CALIBRATION_CASES:
+        model, truth = _fit(independent_corpus, case, partial=case == "heldout-px4-piloted")
+        for p in model.parameters:
+            if p.name not in SPEED_DERIVATIVES or p.status == "unidentified":
+                continue
+            counted += 1
+            cr = abs(p.cr_percent / 100.0 * p.value) if p.status == "estimated" else 0.0
+            if not abs(p.value - truth[p.name]) <= CR_MULTIPLE * cr:
+                outside.append(
+                    f"{case} {p.name} {100 * (p.value / truth[p.name] - 1):+.1f} % at CR {p.cr_percent:.1f} %"
+                )
+    assert counted >= 12
+    assert len(outside) <= 0.1 * counted, f"{counted - len(outside)} of {counted} inside 2 CR; outside: {outside}"
