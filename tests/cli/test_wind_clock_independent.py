@@ -170,6 +170,7 @@ def test_the_wind_term_cuts_az_as_much_as_the_true_model_does(outcomes: dict[str
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
+    raises=AssertionError,  # the floor missed, not a run that fails
     reason="az cut 19.8 % and 16.1 % on the two ArduPilot cases (77 % and 28 % on PX4); the true parameters "
     "themselves cut it by 20.8 % and 5.2 % there: on heldout-wind-clock-ap-none no model reaches the floor. "
     "In the wind's band (below 2 Hz) the fitted model cuts az by 37-85 % on all four: the error left is the "
@@ -227,6 +228,7 @@ def test_body_w_from_the_pitch_input_is_fitted_where_the_wind_carries_it(outcome
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
+    raises=AssertionError,  # the floor missed, not a run that fails
     reason="Z_w_lon's truth is inside 2 CR on 3 of 4 cases: px4-slight -11.0 % at CR 3.4 %, from step 1's Z_thr "
     "-8.3 % at CR 3.0 % (the thrust loop answers the gusts, so Z_thr's error moves Z_w_lon): issue 31 stays open",
 )
