@@ -11,13 +11,12 @@ accelerometer outputs is explained by ``H1 G_w u_w(t - tau_w)``: the G_w
 entries are found by linear least squares at given delays, each wind delay
 by a 1-D scan (coarse then fine, coordinate-wise, twice over when there are
 two delays or more), then all of them are polished together by nonlinear
-least squares. Each output's
-residual is weighted by its own level, and each record's mean is taken out of
-the residual and of the wind (a per-record bias, as VERIFY's: accelerometer
-bias and the trim leave a constant the wind does not explain). Wind
-parameters that miss the CR% /
-I% guidelines are dropped one at a time, as in step 1 (a wind delay the
-data cannot resolve becomes 0).
+least squares. Each output's residual is weighted by its own level, and each
+record's mean is taken out of the residual and of the wind (a per-record
+bias, as VERIFY's: accelerometer bias and the trim leave a constant the wind
+does not explain). Wind parameters that miss the CR% / I% guidelines are
+dropped one at a time, as in step 1 (a wind delay the data cannot resolve
+becomes 0).
 
 Cramér–Rao bounds are those of the weighted least squares, corrected for
 the residual's autocorrelation by an effective number of independent
