@@ -385,16 +385,21 @@ class _Normal:
         return out, cost
 
 
-def _scan(problem: _Problem) -> np.ndarray:
-    """Each delay by a coarse then fine 1-D scan (gains solved at every point), twice over.
+def _rounds(n_delays: int) -> int:
+    """Rounds of a coordinate-wise delay scan: two, or one for a single delay (none without one).
 
-    With one delay the second round is not run: the gains are solved afresh at every point, so it
-    would visit the same points at the same costs and change nothing.
+    The gains are solved afresh at every point, so with one delay a second round would visit the
+    same points at the same costs and change nothing.
     """
+    return 2 if n_delays > 1 else n_delays
+
+
+def _scan(problem: _Problem) -> np.ndarray:
+    """Each delay by a coarse then fine 1-D scan (gains solved at every point), :func:`_rounds` times over."""
     delays, gains = problem.delay_and_gain_index()
     normal = _Normal(problem, problem.start, gains)
     theta, best = normal.solve(problem.start)
-    for _ in range(2 if len(delays) > 1 else len(delays)):
+    for _ in range(_rounds(len(delays))):
         for k in delays:
             p = problem.structure.parameter(problem.free[k])
             lo, hi = max(p.lower, 0.0), min(p.upper, 1.0)
@@ -884,8 +889,7 @@ def speed_derivatives(
     for k in delay_index if delays is not None else ():
         at[k] = (delays or {}).get(problem.free[k], at[k])
     best = solved(at)[0]
-    rounds = 0 if delays is not None else 2 if len(delay_index) > 1 else len(delay_index)  # one delay: once, as _scan
-    for _ in range(rounds):
+    for _ in range(0 if delays is not None else _rounds(len(delay_index))):
         for k in delay_index:
             p = structure.parameter(problem.free[k])
             lo, hi = max(p.lower, 0.0), min(p.upper, 0.5)
