@@ -20,15 +20,23 @@ Gauss–Newton Hessian of J (``2 J_r^T J_r``); with that factor every CR and
 I would be smaller by sqrt(2). The choice is ours
 where the book's normalisation could not be checked, and it is the more
 conservative one.
+
+That bound carries random error only. :func:`robust_bounds` raises it to the
+residual's own sandwich bound where that is larger (a residual bigger than
+the weights assume, or one that runs over neighbouring frequencies), and
+:func:`with_spread` adds a further standard deviation in quadrature (the
+fit range's spread, step 1's uncertainty carried into the wind step):
+:func:`sysid.fit.engine.fit_frequency_responses` reports both.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-__all__ = ["Accuracy", "accuracy"]
+__all__ = ["Accuracy", "accuracy", "robust_bounds", "with_spread"]
 
 _NULL = 1e-12  # eigenvalues of H below this fraction of the largest are taken as unidentifiable directions
 
@@ -127,14 +135,7 @@ def accuracy(jacobian: np.ndarray, values: np.ndarray, names: tuple[str, ...]) -
             insensitivity=np.zeros(0),
             correlation=np.zeros((0, 0)),
         )
-    # scale to unit diagonal before inverting: parameters differ by orders of magnitude
-    scale = np.where(diagonal > 0, 1.0 / np.sqrt(np.maximum(diagonal, 1e-300)), 0.0)
-    scaled = hessian * scale[:, None] * scale[None, :]
-    eigenvalues, vectors = np.linalg.eigh(scaled)
-    keep = eigenvalues > _NULL * max(float(eigenvalues.max()), 1e-300)
-    inverse = (vectors[:, keep] / eigenvalues[keep]) @ vectors[:, keep].T
-    covariance = inverse * scale[:, None] * scale[None, :]
-    null = np.any(np.abs(vectors[:, ~keep]) > 1e-6, axis=1) | (diagonal <= 0)
+    covariance, null = _inverse(hessian)
     cramer_rao = np.where(null, np.inf, np.sqrt(np.maximum(np.diag(covariance), 0.0)))
     with np.errstate(divide="ignore", invalid="ignore"):
         sd = np.sqrt(np.diag(covariance))
@@ -149,3 +150,107 @@ def accuracy(jacobian: np.ndarray, values: np.ndarray, names: tuple[str, ...]) -
         insensitivity=insensitivity,
         correlation=correlation,
     )
+
+
+def robust_bounds(acc: Accuracy, jacobian: np.ndarray, residual: np.ndarray, series: Sequence[np.ndarray]) -> Accuracy:
+    """`acc` with each Cramér–Rao bound raised to the residual's sandwich bound where that is the larger.
+
+    Tischler's bound takes every weighted residual for an independent error
+    of unit size. A fit whose residual is larger, or keeps one sign over
+    many neighbouring frequencies (a model that cannot follow part of the
+    band: in closed loop the position loop's pull at the bottom of the fit
+    range), measures its parameters less well than that. The sandwich
+    (Huber-White, with Newey-West's Bartlett weights between neighbouring
+    points of one series)::
+
+        C = H^-1 (sum_s sum_{k,l in s} (1 - |k - l| / (L_s + 1)) g_k g_l^T) H^-1,   g_k = r_k dr_k/dtheta
+
+    measures it from the residual itself; ``L_s`` is the lag at which the
+    series' residual autocorrelation first falls below 0.05 (as
+    :func:`sysid.fit.wind.residual_inflation` does in the time domain), less
+    one.
+
+    Parameters
+    ----------
+    acc : Accuracy
+        Tischler's accuracy of the fit (:func:`accuracy` of `jacobian`).
+    jacobian : ndarray, shape (n_residuals, n_par)
+        Derivatives of the weighted residual vector.
+    residual : ndarray, shape (n_residuals,)
+        The weighted residual at the estimate.
+    series : sequence of ndarray of int
+        Indices into `residual` of each series of neighbouring points, in
+        frequency order (a response's magnitude, its phase).
+
+    Returns
+    -------
+    Accuracy
+        `acc` with ``cramer_rao = max(cramer_rao, sandwich)``; the Hessian,
+        insensitivities and correlations unchanged.
+
+    Examples
+    --------
+    A residual of twice the unit size doubles the bounds; one of half, none.
+
+    >>> jac = np.array([[1.0], [1.0], [1.0], [1.0]])
+    >>> base = accuracy(jac, np.array([1.0]), ("a",))
+    >>> series = [np.arange(4)]
+    >>> float(robust_bounds(base, jac, 2.0 * np.array([1.0, -1.0, 1.0, -1.0]), series).cramer_rao[0] / base.cramer_rao[0])
+    2.0
+    >>> float(robust_bounds(base, jac, 0.5 * np.array([1.0, -1.0, 1.0, -1.0]), series).cramer_rao[0] / base.cramer_rao[0])
+    1.0
+    """
+    if acc.names == ():
+        return acc
+    covariance, null = _inverse(acc.hessian)
+    scores = np.asarray(jacobian, dtype=float) * np.asarray(residual, dtype=float)[:, None]
+    meat = np.zeros_like(covariance)
+    for rows in series:
+        g, n = scores[rows], len(rows)
+        bandwidth = _bandwidth(np.asarray(residual, dtype=float)[rows])
+        for lag in range(min(bandwidth, n - 1) + 1):
+            product = g[lag:].T @ g[: n - lag]
+            meat += (1.0 - lag / (bandwidth + 1.0)) * (product if lag == 0 else product + product.T)
+    sandwich = np.sqrt(np.maximum(np.diag(covariance @ meat @ covariance), 0.0))
+    return replace(acc, cramer_rao=np.where(null, np.inf, np.maximum(acc.cramer_rao, sandwich)))
+
+
+def with_spread(acc: Accuracy, spread: Mapping[str, float]) -> Accuracy:
+    """`acc` with each parameter's Cramér–Rao bound and `spread` added in quadrature.
+
+    Parameters
+    ----------
+    acc : Accuracy
+        An accuracy.
+    spread : Mapping[str, float]
+        Further standard deviations, by name, in the parameters' units.
+
+    Returns
+    -------
+    Accuracy
+    """
+    extra = np.array([spread.get(n, 0.0) for n in acc.names])
+    return replace(acc, cramer_rao=np.sqrt(acc.cramer_rao**2 + extra**2))
+
+
+def _inverse(hessian: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``H^-1`` (pseudo-inverse over the identifiable directions) and which parameters lie in a null direction."""
+    diagonal = np.diag(hessian).copy()
+    # scale to unit diagonal before inverting: parameters differ by orders of magnitude
+    scale = np.where(diagonal > 0, 1.0 / np.sqrt(np.maximum(diagonal, 1e-300)), 0.0)
+    scaled = hessian * scale[:, None] * scale[None, :]
+    eigenvalues, vectors = np.linalg.eigh(scaled)
+    keep = eigenvalues > _NULL * max(float(eigenvalues.max()), 1e-300)
+    inverse = (vectors[:, keep] / eigenvalues[keep]) @ vectors[:, keep].T
+    null = np.any(np.abs(vectors[:, ~keep]) > 1e-6, axis=1) | (diagonal <= 0)
+    return inverse * scale[:, None] * scale[None, :], null
+
+
+def _bandwidth(residual: np.ndarray) -> int:
+    """Lags of a series' residual carried in the Bartlett sum: until its autocorrelation falls below 0.05."""
+    centred = residual - residual.mean()
+    autocovariance = np.correlate(centred, centred, "full")[centred.size - 1 :]
+    if autocovariance[0] <= 0:
+        return 0
+    below = np.flatnonzero(autocovariance / autocovariance[0] < 0.05)
+    return int(below[0]) - 1 if below.size else centred.size - 1

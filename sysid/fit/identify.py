@@ -29,7 +29,7 @@ from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.record import Record
 from flightlogs.store.dataset import file_sha256
 from flightlogs.writers.jsonio import jsonable
-from sysid.fit.accuracy import Accuracy
+from sysid.fit.accuracy import Accuracy, with_spread
 from sysid.fit.axes import merge_axes, partial_warning, structure_axes, unidentified_message
 from sysid.fit.engine import FitOptions, FrequencyFit, fit_frequency_responses
 from sysid.fit.guidelines import Guidelines
@@ -44,7 +44,6 @@ from sysid.fit.wind import (
     speed_spread,
     step_one_spread,
     unfitted_wind,
-    with_spread,
 )
 from sysid.fit.wind_offset import moved_flights, moved_wind, offset_given, timed_wind, untimed_wind
 from sysid.fit.wind_trace import wind_trace

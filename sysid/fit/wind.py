@@ -68,7 +68,6 @@ __all__ = [
     "speed_derivatives",
     "speed_spread",
     "step_one_spread",
-    "with_spread",
     "unfitted_wind",
     "wind_cost",
 ]
@@ -1059,24 +1058,6 @@ def speed_spread(
             if status == "estimated" and again.status.get(n) == "estimated":
                 squares[n] = squares.get(n, 0.0) + (again.values[n] - base.values[n]) ** 2
     return {n: math.sqrt(v) for n, v in squares.items()}
-
-
-def with_spread(acc: Accuracy, spread: Mapping[str, float]) -> Accuracy:
-    """`acc` with each parameter's Cramér–Rao bound and `spread` added in quadrature.
-
-    Parameters
-    ----------
-    acc : Accuracy
-        An accuracy.
-    spread : Mapping[str, float]
-        Further standard deviations, by name, in the parameters' units.
-
-    Returns
-    -------
-    Accuracy
-    """
-    extra = np.array([spread.get(n, 0.0) for n in acc.names])
-    return replace(acc, cramer_rao=np.sqrt(acc.cramer_rao**2 + extra**2))
 
 
 def identified_outputs(
