@@ -220,6 +220,43 @@ def _orthonormal(columns: np.ndarray) -> np.ndarray:
     return cast(np.ndarray, columns @ (vectors[:, keep] / np.sqrt(power[keep])))
 
 
+#: A coarse scan's lattice of samples up to this many: its Gram matrix (rows^2 numbers) replaces the gathered rows.
+_GRAM_ROWS = 1500
+
+
+@dataclass(frozen=True, slots=True)
+class _Gram:
+    """Inner products of the running sums' rows at the samples of a coarse scan: ``gram(a, b)[...] = S[a] . S[b]``.
+
+    The rows are taken less the scan's earliest, which leaves every difference
+    of two rows (a box's projection) as it is and keeps the products small.
+    """
+
+    products: np.ndarray  # (n_rows, n_rows)
+    position: np.ndarray  # (latest + 1,): row of each sample in `products`, -1 where not on the lattice
+
+    def __call__(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return cast(np.ndarray, self.products[self.position[a], self.position[b]])
+
+
+def _gram(sums: np.ndarray, widths: range, earliest: int, latest: int, offsets: np.ndarray) -> _Gram | None:
+    """The Gram matrix of the rows a scan of `widths` from earliest, earliest + step, ... reaches; None if too large.
+
+    Pulse edge ``c`` (`offsets`, in widths) of a box from ``earliest + step i``
+    of width ``widths.start + step j`` lies at ``earliest + c widths.start +
+    step (i + c j)``: one lattice per edge (one in all when the step divides
+    the narrowest width).
+    """
+    step = widths.step
+    rows = np.unique(np.concatenate([np.arange(earliest + int(c) * widths.start, latest + 1, step) for c in offsets]))
+    if rows.size > _GRAM_ROWS:
+        return None
+    centred = sums[rows] - sums[earliest]
+    position = np.full(latest + 1, -1, dtype=np.intp)
+    position[rows] = np.arange(rows.size)
+    return _Gram(products=centred @ centred.T, position=position)
+
+
 def _scan(
     resid: np.ndarray, basis: np.ndarray, dt: float, burst: tuple[int, int], units: tuple[int, ...]
 ) -> tuple[int, int] | None:
@@ -242,7 +279,9 @@ def _scan(
         return None
     grid = _best_on_grid if units == _DOUBLET else _best_template_on_grid
     step = max(1, int(round(_COARSE_S / dt)))
-    best = grid(sums, run, range(w_min, w_max + 1, step), earliest, latest, step)
+    coarse = range(w_min, w_max + 1, step)
+    lattice = _gram(sums, coarse, earliest, latest, np.cumsum((0, *units)))
+    best = grid(sums if lattice is None else lattice, run, coarse, earliest, latest, step)
     if best is None:
         return None
     first, width = best[1], best[2]
@@ -252,7 +291,7 @@ def _scan(
 
 
 def _best_on_grid(
-    sums: np.ndarray, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
+    sums: np.ndarray | _Gram, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
 ) -> tuple[float, int, int] | None:
     """(gain, first, width) of the best doublet starting at earliest, earliest + step, ... and ending by `latest`.
 
@@ -262,15 +301,15 @@ def _best_on_grid(
 
 
 def _best_template_on_grid(
-    sums: np.ndarray, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
+    sums: np.ndarray | _Gram, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
 ) -> tuple[float, int, int] | None:
     """(gain, first, width) of the best 3-2-1-1 (one amplitude, signs + - + -) on the grid, as :func:`_best_on_grid`."""
     return _best_by_blocks(_template_block, sums, run, widths, earliest, latest, step)
 
 
 def _best_by_blocks(
-    block: Callable[[np.ndarray, np.ndarray, range, int, int, int], tuple[float, int, int] | None],
-    sums: np.ndarray,
+    block: Callable[[np.ndarray | _Gram, np.ndarray, range, int, int, int], tuple[float, int, int] | None],
+    sums: np.ndarray | _Gram,
     run: np.ndarray,
     widths: range,
     earliest: int,
@@ -279,7 +318,8 @@ def _best_by_blocks(
 ) -> tuple[float, int, int] | None:
     """The best of `block` over `widths` taken a few at a time (the grid's arrays stay under `_GRID_ELEMENTS`)."""
     starts = max(1, (latest - earliest) // step + 1)
-    per_block = max(1, _GRID_ELEMENTS // (starts * max(1, sums.shape[1])))
+    depth = 1 if isinstance(sums, _Gram) else sums.shape[1]  # a lookup per start and width, or a row of the basis
+    per_block = max(1, _GRID_ELEMENTS // (starts * max(1, depth)))
     best: tuple[float, int, int] | None = None
     for lo in range(0, len(widths), per_block):
         found = block(sums, run, widths[lo : lo + per_block], earliest, latest, step)
@@ -289,18 +329,24 @@ def _best_by_blocks(
 
 
 def _doublet_block(
-    sums: np.ndarray, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
+    sums: np.ndarray | _Gram, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
 ) -> tuple[float, int, int] | None:
     grid = _grid(widths, earliest, latest, step, 2)
     if grid is None:
         return None
     width, first, ok = grid
     mid, end = first + width, first + 2 * width
-    q1, q2 = sums[mid] - sums[first], sums[end] - sums[mid]  # (n_widths, n_starts, n_basis)
+    if isinstance(sums, _Gram):  # q1 = S[mid] - S[first], q2 = S[end] - S[mid], their products looked up
+        ff, mm, ee = sums(first, first), sums(mid, mid), sums(end, end)
+        fm, fe, me = sums(first, mid), sums(first, end), sums(mid, end)
+        p11, p22, p12 = mm - 2 * fm + ff, ee - 2 * me + mm, me - mm - fe + fm
+    else:
+        q1, q2 = sums[mid] - sums[first], sums[end] - sums[mid]  # (n_widths, n_starts, n_basis)
+        p11 = np.einsum("wij,wij->wi", q1, q1)
+        p22 = np.einsum("wij,wij->wi", q2, q2)
+        p12 = np.einsum("wij,wij->wi", q1, q2)
     v1, v2 = run[mid] - run[first], run[end] - run[mid]
-    g11 = width - np.einsum("wij,wij->wi", q1, q1)
-    g22 = width - np.einsum("wij,wij->wi", q2, q2)
-    g12 = -np.einsum("wij,wij->wi", q1, q2)
+    g11, g22, g12 = width - p11, width - p22, -p12
     det = g11 * g22 - g12 * g12
     ok &= det > 1e-9 * width * width
     gain = np.where(ok, (g22 * v1 * v1 - 2 * g12 * v1 * v2 + g11 * v2 * v2) / np.where(ok, det, 1.0), -np.inf)
@@ -308,7 +354,7 @@ def _doublet_block(
 
 
 def _template_block(
-    sums: np.ndarray, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
+    sums: np.ndarray | _Gram, run: np.ndarray, widths: range, earliest: int, latest: int, step: int
 ) -> tuple[float, int, int] | None:
     offsets = np.cumsum((0, *_3211))
     grid = _grid(widths, earliest, latest, step, int(offsets[-1]))
@@ -316,9 +362,18 @@ def _template_block(
         return None
     width, first, ok = grid
     edges = [first + width * int(o) for o in offsets]
-    q = sum(sign * (sums[edges[k + 1]] - sums[edges[k]]) for k, sign in enumerate(_SIGNS))
+    if isinstance(sums, _Gram):  # q = sum_k c_k S[edge k]: |q|^2 from the products of the edges' rows
+        c = np.diff(np.r_[0.0, _SIGNS, 0.0]) * -1.0  # -1, 2, -2, 2, -1
+        pp = sum(
+            (1.0 if k == m else 2.0) * c[k] * c[m] * sums(edges[k], edges[m])
+            for k in range(len(edges))
+            for m in range(k, len(edges))
+        )
+    else:
+        q = sum(sign * (sums[edges[k + 1]] - sums[edges[k]]) for k, sign in enumerate(_SIGNS))
+        pp = np.einsum("wij,wij->wi", q, q)
     v = sum(sign * (run[edges[k + 1]] - run[edges[k]]) for k, sign in enumerate(_SIGNS))
-    g = offsets[-1] * width - np.einsum("wij,wij->wi", q, q)
+    g = offsets[-1] * width - pp
     ok &= g > 1e-9 * width
     gain = np.where(ok, v * v / np.where(ok, g, 1.0), -np.inf)
     return _best_of(gain, width, first)
