@@ -25,8 +25,8 @@ That bound carries random error only. :func:`robust_bounds` raises it to the
 residual's own sandwich bound where that is larger (a residual bigger than
 the weights assume, or one that runs over neighbouring frequencies), and
 :func:`with_spread` adds a further standard deviation in quadrature (the
-fit range's spread, step 1's uncertainty carried into the wind step):
-:func:`sysid.fit.engine.fit_frequency_responses` reports both.
+fit range's spread, step 1's uncertainty carried into the wind step); see
+:mod:`sysid.fit.bias`.
 """
 
 from __future__ import annotations

@@ -32,8 +32,9 @@ import numpy as np
 from scipy import optimize
 
 from flightlogs.errors import FitError
-from sysid.fit.accuracy import Accuracy, accuracy, robust_bounds, with_spread
+from sysid.fit.accuracy import Accuracy, accuracy
 from sysid.fit.axes import AxisStatus, axis_name
+from sysid.fit.bias import RAISED_BOTTOMS, bounds_with_bias, raised_range
 from sysid.fit.cost import CostSummary, CostWeights, FitPoints, ResponseModel, fit_points
 from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
 from sysid.fit.reduce import ReductionStep, worst_parameter
@@ -116,7 +117,7 @@ class FrequencyFit:
     accuracy : Accuracy
         CR, I and correlations of the estimated parameters; each CR bound
         carries the residual's sandwich bound and the fit range's spread
-        (see :func:`fit_frequency_responses`).
+        (:mod:`sysid.fit.bias`).
     cost : CostSummary
         J_ave and per-pair costs of the final fit.
     reduction : tuple of ReductionStep
@@ -184,18 +185,9 @@ def fit_frequency_responses(
     Notes
     -----
     Structure reduction judges the parameters by Tischler's Cramér–Rao
-    bound. That bound carries random error only; in closed loop the position
-    and velocity loops pull the bottom of each fit range towards the
-    controller's inverse while the coherence stays high, a systematic error.
-    The bounds returned therefore carry two more terms measured from the fit
-    itself: each is raised to the residual's sandwich bound where that is
-    larger (:func:`~sysid.fit.accuracy.robust_bounds`: a residual that runs
-    over neighbouring frequencies), and the standard deviation of the
-    estimates over the fit and two refits with every range's bottom raised
-    ×1.25 and ×1.6 is added in quadrature. A bias the structure absorbs
-    without a trace in the residual or a move with the range is not seen:
-    on synthetic responses with 30 % of feedback below 1 rad/s, X_u is 13 %
-    off at a bound of 5 %.
+    bound; the bounds returned also carry the fit's systematic error
+    (:mod:`sysid.fit.bias`: the residual's sandwich bound, the fit range's
+    spread).
     """
     controls = {c.signal for c in structure.control_inputs}
     used = tuple(r for r in responses if r.input in controls and r.output in structure.outputs)
@@ -257,13 +249,6 @@ def _axes(
     return tuple(out)
 
 
-#: Each response's fit-range bottom is raised by these factors for the fit range's spread (a range left spanning
-#: less than `_KEPT_SPAN`, top over bottom, is kept as it is). On the tuning cases of the independent corpus
-#: (closed loop, position hold) X_u moved 10-21 points of the truth towards it over these two steps, M_u up to 8.
-_RAISED_BOTTOMS = (1.25, 1.6)
-_KEPT_SPAN = 1.5
-
-
 def _bounds_with_bias(
     search: _Search,
     used: Sequence[FrequencyResponse],
@@ -271,19 +256,15 @@ def _bounds_with_bias(
     status: Mapping[str, Status],
     acc: Accuracy,
 ) -> tuple[Accuracy, int]:
-    """`acc` raised to the residual's sandwich bound, the fit range's spread added; and the evaluations spent.
-
-    See :func:`fit_frequency_responses`, Notes.
-    """
+    """`acc` carrying the fit's systematic error (:mod:`sysid.fit.bias`); and the evaluations its refits spent."""
     estimated = [n for n, s in status.items() if s == "estimated"]
     if not estimated:
         return acc, 0
     theta = np.array([values[n] for n in estimated])
     model = search.model(estimated, values)
-    acc = robust_bounds(acc, model.jacobian(theta), model.residuals(theta), _series(search.points))
     estimates, spent = [theta], 0
-    for factor in _RAISED_BOTTOMS:
-        raised = [_raised_bottom(r, factor) for r in used]
+    for factor in RAISED_BOTTOMS:
+        raised = [_raised(r, factor) for r in used]
         if all(a is b for a, b in zip(raised, used)):
             continue
         points = fit_points(raised, weights=search.options.weights)
@@ -292,26 +273,14 @@ def _bounds_with_bias(
         )
         estimates.append(np.array([fitted[n] for n in estimated]))
         spent += evaluations
-    if len(estimates) < 2:
-        return acc, spent
-    spread = np.std(np.array(estimates), axis=0, ddof=1)
-    return with_spread(acc, dict(zip(estimated, spread.tolist()))), spent
+    return bounds_with_bias(acc, model.jacobian(theta), model.residuals(theta), search.points, estimates), spent
 
 
-def _series(points: FitPoints) -> list[np.ndarray]:
-    """Rows of the residual vector holding each pair's magnitude, then its phase, in frequency order."""
-    n = points.omega.size
-    rows = [np.flatnonzero(points.response == k) for k in range(len(points.pairs))]
-    return [*rows, *(r + n for r in rows)]
-
-
-def _raised_bottom(response: FrequencyResponse, factor: float) -> FrequencyResponse:
-    """`response` with its fit range's bottom raised by `factor`, or itself where that leaves under `_KEPT_SPAN`."""
+def _raised(response: FrequencyResponse, factor: float) -> FrequencyResponse:
+    """`response` with its fit range's bottom raised by `factor` (:func:`~sysid.fit.bias.raised_range`), or itself."""
     assert response.fit_range is not None  # fitted responses have one (fit_points)
-    low, high = response.fit_range
-    if high / low <= _KEPT_SPAN * factor:
-        return response
-    return replace(response, fit_range=(low * factor, high))
+    raised = raised_range(response.fit_range, factor)
+    return response if raised is None else replace(response, fit_range=raised)
 
 
 def _reduce(

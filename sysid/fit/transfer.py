@@ -4,7 +4,9 @@ A :class:`~sysid.model.transfer.TransferStructure` (with an optional
 transport delay ``exp(-tau s)``) is fitted to a gated response by the same
 cost as the state-space fits (eq. 3.9: coherence-weighted magnitude and
 phase errors, :class:`~sysid.fit.cost.LogResponseCost`), with Cramér–Rao
-bounds and insensitivities from its Jacobian (:func:`~sysid.fit.accuracy.accuracy`).
+bounds and insensitivities from its Jacobian (:func:`~sysid.fit.accuracy.accuracy`),
+the bounds carrying the fit's systematic error as the state-space fits' do
+(:mod:`sysid.fit.bias`).
 
 The start is found, not guessed: for each delay on a 2 ms grid the
 coefficients come from the linear least-squares fit of ``N(s) - T(s) e^{tau s} D(s) = 0``
@@ -27,6 +29,7 @@ from scipy.optimize import least_squares
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import FitError
 from sysid.fit.accuracy import accuracy
+from sysid.fit.bias import RAISED_BOTTOMS, bounds_with_bias, raised_range
 from sysid.fit.cost import CostWeights, FitPoints, LogResponseCost, fit_points
 from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
 from sysid.freqresp.gating import Gating, gate_responses
@@ -281,7 +284,22 @@ def fit_transfer_function(
         model.residuals, start, jac=model.jacobian, bounds=(lower, upper), method="trf", x_scale="jac", xtol=1e-12
     )
     names = (*structure.parameters, *((_DELAY_NAME,) if options.delay else ()))
-    spread = accuracy(model.jacobian(found.x), found.x, names)
+    estimates = [found.x]
+    for factor in RAISED_BOTTOMS:  # the fit range's spread (sysid.fit.bias)
+        raised = raised_range(band, factor)
+        if raised is None:
+            continue
+        again = fit_points([dataclasses.replace(response, fit_range=raised)], weights=options.weights)
+        if 2 * again.omega.size <= n_free:
+            continue
+        other = _TransferCost(structure, again, delay=options.delay, weights=options.weights)
+        estimates.append(
+            least_squares(
+                other.residuals, found.x, jac=other.jacobian, bounds=(lower, upper), method="trf", x_scale="jac"
+            ).x
+        )
+    jacobian = model.jacobian(found.x)
+    spread = bounds_with_bias(accuracy(jacobian, found.x, names), jacobian, model.residuals(found.x), points, estimates)
     units = structure.parameter_units(response.output_unit, response.input_unit) | {_DELAY_NAME: "s"}
     coefficients = tuple(
         FittedCoefficient(
