@@ -22,13 +22,15 @@ range is not seen: on synthetic responses with 30 % of feedback below
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
 from sysid.fit.accuracy import Accuracy, robust_bounds, with_spread
 from sysid.fit.cost import FitPoints
+from sysid.freqresp import FrequencyResponse
 
-__all__ = ["KEPT_SPAN", "RAISED_BOTTOMS", "bounds_with_bias", "raised_range"]
+__all__ = ["KEPT_SPAN", "RAISED_BOTTOMS", "bounds_with_bias", "raised"]
 
 #: Factors the bottom of every fit range is raised by for the spread. On the tuning cases of the independent
 #: corpus (closed loop, position hold) X_u moved 10-21 points of the truth towards it over these two steps, M_u
@@ -38,27 +40,28 @@ RAISED_BOTTOMS = (1.25, 1.6)
 KEPT_SPAN = 1.5
 
 
-def raised_range(fit_range: tuple[float, float], factor: float) -> tuple[float, float] | None:
-    """`fit_range` (rad/s) with its bottom raised by `factor`; None where that leaves less than `KEPT_SPAN`.
+def raised(response: FrequencyResponse, factor: float) -> FrequencyResponse | None:
+    """`response` with the bottom of its fit range raised by `factor`; None where the range would keep less.
 
     Parameters
     ----------
-    fit_range : tuple of float
-        ``(low, high)``, rad/s.
+    response : FrequencyResponse
+        A response with a fit range.
     factor : float
-        What the bottom is multiplied by.
+        What the range's bottom is multiplied by.
 
     Returns
     -------
-    tuple of float or None
-
-    Examples
-    --------
-    >>> raised_range((0.5, 20.0), 1.6), raised_range((10.0, 20.0), 1.25)
-    ((0.8, 20.0), None)
+    FrequencyResponse or None
+        None when the raised range would span less than `KEPT_SPAN` (top
+        over bottom) or hold no frequency of the response.
     """
-    low, high = fit_range
-    return None if high / low <= KEPT_SPAN * factor else (low * factor, high)
+    assert response.fit_range is not None  # fitted responses have one (sysid.fit.cost.fit_points)
+    low, high = response.fit_range
+    if high / low <= KEPT_SPAN * factor:
+        return None
+    inside = (response.omega >= low * factor * (1 - 1e-9)) & (response.omega <= high * (1 + 1e-9))
+    return replace(response, fit_range=(low * factor, high)) if inside.any() else None
 
 
 def bounds_with_bias(

@@ -34,7 +34,7 @@ from scipy import optimize
 from flightlogs.errors import FitError
 from sysid.fit.accuracy import Accuracy, accuracy
 from sysid.fit.axes import AxisStatus, axis_name
-from sysid.fit.bias import RAISED_BOTTOMS, bounds_with_bias, raised_range
+from sysid.fit.bias import RAISED_BOTTOMS, bounds_with_bias, raised
 from sysid.fit.cost import CostSummary, CostWeights, FitPoints, ResponseModel, fit_points
 from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
 from sysid.fit.reduce import ReductionStep, worst_parameter
@@ -264,23 +264,16 @@ def _bounds_with_bias(
     model = search.model(estimated, values)
     estimates, spent = [theta], 0
     for factor in RAISED_BOTTOMS:
-        raised = [_raised(r, factor) for r in used]
-        if all(a is b for a, b in zip(raised, used)):
+        moved = [raised(r, factor) for r in used]
+        if not any(moved):
             continue
-        points = fit_points(raised, weights=search.options.weights)
+        points = fit_points([m or r for m, r in zip(moved, used)], weights=search.options.weights)
         fitted, evaluations = _Search(search.structure, points, search.constants, search.options).refit(
             dict(values), status
         )
         estimates.append(np.array([fitted[n] for n in estimated]))
         spent += evaluations
     return bounds_with_bias(acc, model.jacobian(theta), model.residuals(theta), search.points, estimates), spent
-
-
-def _raised(response: FrequencyResponse, factor: float) -> FrequencyResponse:
-    """`response` with its fit range's bottom raised by `factor` (:func:`~sysid.fit.bias.raised_range`), or itself."""
-    assert response.fit_range is not None  # fitted responses have one (fit_points)
-    raised = raised_range(response.fit_range, factor)
-    return response if raised is None else replace(response, fit_range=raised)
 
 
 def _reduce(

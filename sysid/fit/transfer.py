@@ -29,7 +29,7 @@ from scipy.optimize import least_squares
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import FitError
 from sysid.fit.accuracy import accuracy
-from sysid.fit.bias import RAISED_BOTTOMS, bounds_with_bias, raised_range
+from sysid.fit.bias import RAISED_BOTTOMS, bounds_with_bias, raised
 from sysid.fit.cost import CostWeights, FitPoints, LogResponseCost, fit_points
 from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
 from sysid.freqresp.gating import Gating, gate_responses
@@ -270,7 +270,8 @@ def fit_transfer_function(
                 f"{response.pair}: the band {options.band_rad_s[0]:g}-{options.band_rad_s[1]:g} rad/s misses the "
                 f"coherent range {response.fit_range[0]:.3g}-{response.fit_range[1]:.3g} rad/s"
             )
-    points = fit_points([dataclasses.replace(response, fit_range=band)], weights=options.weights)
+    banded = dataclasses.replace(response, fit_range=band)
+    points = fit_points([banded], weights=options.weights)
     n_free = len(structure.parameters) + int(options.delay)
     if 2 * points.omega.size <= n_free:
         raise FitError(f"{response.pair}: {points.omega.size} frequency points for {n_free} parameters")
@@ -286,10 +287,10 @@ def fit_transfer_function(
     names = (*structure.parameters, *((_DELAY_NAME,) if options.delay else ()))
     estimates = [found.x]
     for factor in RAISED_BOTTOMS:  # the fit range's spread (sysid.fit.bias)
-        raised = raised_range(band, factor)
-        if raised is None:
+        moved = raised(banded, factor)
+        if moved is None:
             continue
-        again = fit_points([dataclasses.replace(response, fit_range=raised)], weights=options.weights)
+        again = fit_points([moved], weights=options.weights)
         if 2 * again.omega.size <= n_free:
             continue
         other = _TransferCost(structure, again, delay=options.delay, weights=options.weights)
@@ -321,7 +322,7 @@ def fit_transfer_function(
         band_rad_s=band,
         poles=poles,
         zeros=zeros,
-        response=dataclasses.replace(response, fit_range=band),
+        response=banded,
         notes=_notes(structure.pair, coefficients, cost, poles, zeros, options.guidelines),
         guidelines=options.guidelines,
     )

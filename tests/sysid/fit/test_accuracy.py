@@ -8,6 +8,8 @@ rho))`` at most, and the truth falls outside it more often.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -76,3 +78,20 @@ def test_a_spread_adds_in_quadrature() -> None:
     tischler = accuracy(np.full((4, 1), 2.0), np.array([1.0]), ("a",))  # bound 0.25
     assert with_spread(tischler, {"a": 0.75 / 1.0}).cramer_rao[0] == np.hypot(0.25, 0.75)
     assert with_spread(tischler, {"b": 3.0}).cramer_rao[0] == 0.25
+
+
+def test_a_range_too_narrow_or_empty_to_raise_is_kept() -> None:
+    """The fit range's spread refits with the bottom raised only where at least a span of 1.5 and a frequency
+    of the response are left."""
+    from sysid.fit.bias import raised
+    from sysid.fit.synthetic import synthetic_responses
+    from sysid.model import load_structure, structure_model
+
+    model, _ = structure_model(load_structure("hover"), load_structure("hover").values())
+    omega = np.array([0.5, 1.0, 2.0, 30.0])
+    (response,) = synthetic_responses(model, ["p/delta_lat"], omega=omega, fit_range=(0.5, 30.0))
+    assert raised(response, 1.6) is not None and raised(response, 1.6).fit_range == (0.8, 30.0)  # type: ignore[union-attr]
+    narrow = dataclasses.replace(response, fit_range=(10.0, 20.0))
+    assert raised(narrow, 1.25) is None  # 20 / 12.5 = 1.6 would be left: under 1.5 x 1.25
+    empty = dataclasses.replace(response, fit_range=(2.5, 29.0))
+    assert raised(empty, 1.6) is None  # 4-29 rad/s holds none of 0.5, 1, 2, 30
