@@ -21,7 +21,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -281,11 +281,9 @@ def fit_transfer_function(
     lower = -upper.copy()
     if options.delay:
         lower[-1], upper[-1] = 0.0, options.max_delay_s
-    found = least_squares(
-        model.residuals, start, jac=model.jacobian, bounds=(lower, upper), method="trf", x_scale="jac", xtol=1e-12
-    )
+    fitted = _searched(model, start, lower, upper)
     names = (*structure.parameters, *((_DELAY_NAME,) if options.delay else ()))
-    estimates = [found.x]
+    estimates = [fitted]
     for factor in RAISED_BOTTOMS:  # the fit range's spread (sysid.fit.bias)
         moved = raised(banded, factor)
         if moved is None:
@@ -294,30 +292,26 @@ def fit_transfer_function(
         if 2 * again.omega.size <= n_free:
             continue
         other = _TransferCost(structure, again, delay=options.delay, weights=options.weights)
-        estimates.append(
-            least_squares(
-                other.residuals, found.x, jac=other.jacobian, bounds=(lower, upper), method="trf", x_scale="jac"
-            ).x
-        )
-    jacobian = model.jacobian(found.x)
-    spread = bounds_with_bias(accuracy(jacobian, found.x, names), jacobian, model.residuals(found.x), points, estimates)
+        estimates.append(_searched(other, fitted, lower, upper))
+    jacobian = model.jacobian(fitted)
+    spread = bounds_with_bias(accuracy(jacobian, fitted, names), jacobian, model.residuals(fitted), points, estimates)
     units = structure.parameter_units(response.output_unit, response.input_unit) | {_DELAY_NAME: "s"}
     coefficients = tuple(
         FittedCoefficient(
             name=name, value=float(v), cr_percent=float(cr), insensitivity_percent=float(i), unit=units[name]
         )
-        for name, v, cr, i in zip(names, found.x, spread.cramer_rao_percent, spread.insensitivity_percent)
+        for name, v, cr, i in zip(names, fitted, spread.cramer_rao_percent, spread.insensitivity_percent)
     )
-    numerator, denominator = structure.coefficients(found.x[: len(structure.parameters)])
+    numerator, denominator = structure.coefficients(fitted[: len(structure.parameters)])
     poles = tuple(complex(p) for p in np.roots(denominator))
     zeros = tuple(complex(z) for z in np.roots(np.trim_zeros(numerator, "f")))
-    cost = model.cost(found.x).average
+    cost = model.cost(fitted).average
     return TransferFunctionFit(
         structure=structure,
         coefficients=coefficients,
         numerator=tuple(float(c) for c in numerator),
         denominator=tuple(float(c) for c in denominator),
-        delay_s=float(found.x[-1]) if options.delay else None,
+        delay_s=float(fitted[-1]) if options.delay else None,
         cost=cost,
         band_rad_s=band,
         poles=poles,
@@ -326,6 +320,14 @@ def fit_transfer_function(
         notes=_notes(structure.pair, coefficients, cost, poles, zeros, options.guidelines),
         guidelines=options.guidelines,
     )
+
+
+def _searched(model: _TransferCost, start: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """The nonlinear search from `start` within the bounds: the coefficients (and delay) of least cost."""
+    found = least_squares(
+        model.residuals, start, jac=model.jacobian, bounds=(lower, upper), method="trf", x_scale="jac", xtol=1e-12
+    )
+    return cast(np.ndarray, found.x)
 
 
 def _start(model: _TransferCost, options: TransferOptions) -> np.ndarray:
