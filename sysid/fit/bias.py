@@ -28,7 +28,7 @@ import numpy as np
 
 from sysid.fit.accuracy import Accuracy, robust_bounds, with_spread
 from sysid.fit.cost import FitPoints
-from sysid.freqresp import FrequencyResponse
+from sysid.freqresp import FrequencyResponse, Gating
 
 __all__ = ["KEPT_SPAN", "RAISED_BOTTOMS", "bounds_with_bias", "raised"]
 
@@ -36,8 +36,9 @@ __all__ = ["KEPT_SPAN", "RAISED_BOTTOMS", "bounds_with_bias", "raised"]
 #: corpus (closed loop, position hold) X_u moved 10-21 points of the truth towards it over these two steps, M_u
 #: up to 8.
 RAISED_BOTTOMS = (1.25, 1.6)
-#: A range left spanning less than this (top over bottom) is kept as it is.
-KEPT_SPAN = 1.5
+#: A range left spanning less than this (top over bottom) is kept as it is: a raised range is still one gating
+#: accepts (its shortest, eq. 3.8's 0.3 decade).
+KEPT_SPAN = 10 ** Gating().min_decades
 
 
 def raised(response: FrequencyResponse, factor: float) -> FrequencyResponse | None:

@@ -81,8 +81,8 @@ def test_a_spread_adds_in_quadrature() -> None:
 
 
 def test_a_range_too_narrow_or_empty_to_raise_is_kept() -> None:
-    """The fit range's spread refits with the bottom raised only where at least a span of 1.5 and a frequency
-    of the response are left."""
+    """The fit range's spread refits with the bottom raised only where a range gating accepts (0.3 decade) and a
+    frequency of the response are left."""
     from sysid.fit.bias import raised
     from sysid.fit.synthetic import synthetic_responses
     from sysid.model import load_structure, structure_model
@@ -92,6 +92,6 @@ def test_a_range_too_narrow_or_empty_to_raise_is_kept() -> None:
     (response,) = synthetic_responses(model, ["p/delta_lat"], omega=omega, fit_range=(0.5, 30.0))
     assert raised(response, 1.6) is not None and raised(response, 1.6).fit_range == (0.8, 30.0)  # type: ignore[union-attr]
     narrow = dataclasses.replace(response, fit_range=(10.0, 20.0))
-    assert raised(narrow, 1.25) is None  # 20 / 12.5 = 1.6 would be left: under 1.5 x 1.25
+    assert raised(narrow, 1.25) is None  # 12.5-20 rad/s: 0.2 decade
     empty = dataclasses.replace(response, fit_range=(2.5, 29.0))
     assert raised(empty, 1.6) is None  # 4-29 rad/s holds none of 0.5, 1, 2, 30
