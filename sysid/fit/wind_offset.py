@@ -94,15 +94,26 @@ class _Moved:
     piece_wind_ne: np.ndarray
     north: np.ndarray
     east: np.ndarray
+    north_body: np.ndarray
+    east_body: np.ndarray
 
     @classmethod
     def of(cls, record: Record, piece_time_s: np.ndarray, piece_wind_ne: np.ndarray) -> _Moved:
-        """`record` with its piece's time (n_piece,) and wind (n_piece, 2); u v w per unit of wind, (n, 3) each."""
+        """`record` with its piece's time (n_piece,) and wind (n_piece, 2); u v w per unit of wind, (n, 3) each,
+        and wind_lon, wind_lat per unit of wind, (n, 2) each (the heading's rotation, worked out once per record)."""
         angles = [record.absolute(n) for n in _ANGLES]
         unit = np.zeros((record.time_s.size, 3))
-        north = air_velocity_body(unit, np.column_stack([np.ones(unit.shape[0]), unit[:, 0]]), *angles)
-        east = air_velocity_body(unit, np.column_stack([unit[:, 0], np.ones(unit.shape[0])]), *angles)
-        return cls(record=record, piece_time_s=piece_time_s, piece_wind_ne=piece_wind_ne, north=north, east=east)
+        to_north = np.column_stack([np.ones(unit.shape[0]), unit[:, 0]])
+        to_east = np.column_stack([unit[:, 0], np.ones(unit.shape[0])])
+        return cls(
+            record=record,
+            piece_time_s=piece_time_s,
+            piece_wind_ne=piece_wind_ne,
+            north=air_velocity_body(unit, to_north, *angles),
+            east=air_velocity_body(unit, to_east, *angles),
+            north_body=wind_to_body_axes(to_north, angles[2]),
+            east_body=wind_to_body_axes(to_east, angles[2]),
+        )
 
     def every(self, rate_hz: float) -> _Moved:
         """The same with the record thinned to about `rate_hz` (every k-th sample), for a coarse look."""
@@ -132,7 +143,7 @@ class _Moved:
         out = {"wind_n": record["wind_n"] + change[:, 0], "wind_e": record["wind_e"] + change[:, 1]}
         uvw = change[:, :1] * self.north + change[:, 1:] * self.east
         out |= {n: record[n] + uvw[:, k] for k, n in enumerate("uvw") if n in record.signals}
-        body = wind_to_body_axes(change, record.absolute("psi"))
+        body = change[:, :1] * self.north_body + change[:, 1:] * self.east_body  # wind_to_body_axes(change, psi)
         for k, name in enumerate(("wind_lon", "wind_lat")):
             if name in record.signals:
                 out[name] = record[name] + body[:, k]
