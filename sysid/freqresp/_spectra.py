@@ -14,7 +14,6 @@ frequency is the variance of ``a``.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import cast
@@ -118,19 +117,28 @@ def _matrix_dft(flat: np.ndarray, dt: float, taper: np.ndarray, omega: np.ndarra
     return cast(np.ndarray, product[:, :n_freq] - 1j * product[:, n_freq:])
 
 
-@functools.lru_cache(maxsize=32)
 def _kernel(n_window: int, dt: float, taper: bytes, omega: bytes) -> tuple[np.ndarray, np.ndarray]:
     """The tapered Fourier kernel, shape (2 n_freq, n_window), and its row sums (2 n_freq,), read-only.
 
-    Kept for the next call: one identification asks for the same window on the same grid for its records,
-    the quiet flight's floor and each group of outputs (15 kernels for 152 transforms on the chapter 3
-    campaign), and the cosines and sines cost about as much as a third of the products.
+    Kept for the next call, within :data:`_KERNEL_BYTES`: one identification asks for the same window on
+    the same grid for its records, the quiet flight's floor and each group of outputs (15 kernels for 152
+    transforms on the chapter 3 campaign), and the cosines and sines cost about a third of the products.
     """
-    phase = np.outer(np.frombuffer(omega) * dt, np.arange(n_window))
-    kernel = np.concatenate([np.cos(phase), np.sin(phase)]) * np.frombuffer(taper)
-    kernel_sum = kernel.sum(axis=1)
-    kernel.flags.writeable = kernel_sum.flags.writeable = False
-    return kernel, kernel_sum
+    key = (n_window, dt, taper, omega)
+    if key not in _KERNELS:
+        phase = np.outer(np.frombuffer(omega) * dt, np.arange(n_window))
+        kernel = np.concatenate([np.cos(phase), np.sin(phase)]) * np.frombuffer(taper)
+        kernel_sum = kernel.sum(axis=1)
+        kernel.flags.writeable = kernel_sum.flags.writeable = False
+        while _KERNELS and sum(k.nbytes for k, _ in _KERNELS.values()) + kernel.nbytes > _KERNEL_BYTES:
+            del _KERNELS[next(iter(_KERNELS))]  # the oldest first
+        _KERNELS[key] = (kernel, kernel_sum)
+    return _KERNELS[key]
+
+
+#: Bytes of kernels kept (the campaign's 15 take 21 MB; a 400 Hz log's longest window alone may take 17).
+_KERNEL_BYTES = 64 * 2**20
+_KERNELS: dict[tuple[int, float, bytes, bytes], tuple[np.ndarray, np.ndarray]] = {}
 
 
 def _czt(flat: np.ndarray, dt: float, taper: np.ndarray, omega: np.ndarray) -> np.ndarray:

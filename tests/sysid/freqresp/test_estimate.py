@@ -429,6 +429,26 @@ def test_chirp_z_on_an_even_grid_equals_the_matrix_transform() -> None:
         np.testing.assert_allclose(by_czt.spectra, by_matrix.spectra, rtol=1e-8, atol=1e-12)
 
 
+def test_the_kernels_kept_are_those_computed_and_stay_within_their_budget(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """A transform from a kept kernel equals one from a fresh kernel, bit for bit; past the budget the oldest go."""
+    from sysid.freqresp import _spectra
+
+    rng = np.random.default_rng(3)
+    flat, taper = rng.normal(size=(12, 400)), np.hanning(400)
+    grids = [np.geomspace(1.0, 60.0, n) for n in (20, 30, 40)]
+    monkeypatch.setattr(_spectra, "_KERNELS", {})
+    monkeypatch.setattr(_spectra, "_KERNEL_BYTES", 2 * 2 * 40 * 400 * 8)  # room for two of the largest
+    fresh = [_spectra._matrix_dft(flat, 0.01, taper, omega) for omega in grids]
+    assert len(_spectra._KERNELS) == 2  # the 20-point grid's went to make room for the 40-point one
+    assert sum(k.nbytes for k, _ in _spectra._KERNELS.values()) <= _spectra._KERNEL_BYTES
+    kernels = dict(_spectra._KERNELS)
+    again = [_spectra._matrix_dft(flat, 0.01, taper, omega) for omega in grids[1:]]  # from the kernels kept
+    assert _spectra._KERNELS == kernels
+    for a, b in zip(fresh[1:], again):
+        np.testing.assert_array_equal(a, b)
+    assert all(not k.flags.writeable and not total.flags.writeable for k, total in _spectra._KERNELS.values())
+
+
 def test_autospectrum_scaling_of_white_noise() -> None:
     """One-sided density per rad/s: white noise of variance s^2 at step dt has G = s^2 dt / pi."""
     rng = np.random.default_rng(7)
