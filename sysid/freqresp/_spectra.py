@@ -14,6 +14,7 @@ frequency is the variance of ``a``.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import cast
@@ -123,22 +124,28 @@ def _kernel(n_window: int, dt: float, taper: bytes, omega: bytes) -> tuple[np.nd
     Kept for the next call, within :data:`_KERNEL_BYTES`: one identification asks for the same window on
     the same grid for its records, the quiet flight's floor and each group of outputs (15 kernels for 152
     transforms on the chapter 3 campaign), and the cosines and sines cost about a third of the products.
+    Under a lock: a Dask worker of the user's may run fits on several threads.
     """
     key = (n_window, dt, taper, omega)
-    if key not in _KERNELS:
-        phase = np.outer(np.frombuffer(omega) * dt, np.arange(n_window))
-        kernel = np.concatenate([np.cos(phase), np.sin(phase)]) * np.frombuffer(taper)
-        kernel_sum = kernel.sum(axis=1)
-        kernel.flags.writeable = kernel_sum.flags.writeable = False
+    with _KERNELS_LOCK:
+        found = _KERNELS.get(key)
+    if found is not None:
+        return found
+    phase = np.outer(np.frombuffer(omega) * dt, np.arange(n_window))
+    kernel = np.concatenate([np.cos(phase), np.sin(phase)]) * np.frombuffer(taper)
+    kernel_sum = kernel.sum(axis=1)
+    kernel.flags.writeable = kernel_sum.flags.writeable = False
+    with _KERNELS_LOCK:
         while _KERNELS and sum(k.nbytes for k, _ in _KERNELS.values()) + kernel.nbytes > _KERNEL_BYTES:
             del _KERNELS[next(iter(_KERNELS))]  # the oldest first
         _KERNELS[key] = (kernel, kernel_sum)
-    return _KERNELS[key]
+    return kernel, kernel_sum
 
 
 #: Bytes of kernels kept (the campaign's 15 take 21 MB; a 400 Hz log's longest window alone may take 17).
 _KERNEL_BYTES = 64 * 2**20
 _KERNELS: dict[tuple[int, float, bytes, bytes], tuple[np.ndarray, np.ndarray]] = {}
+_KERNELS_LOCK = threading.Lock()
 
 
 def _czt(flat: np.ndarray, dt: float, taper: np.ndarray, omega: np.ndarray) -> np.ndarray:
