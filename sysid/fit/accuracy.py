@@ -33,10 +33,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import cast
 
 import numpy as np
+from scipy.fft import next_fast_len
 
-__all__ = ["Accuracy", "accuracy", "robust_bounds", "with_spread"]
+__all__ = ["Accuracy", "accuracy", "correlated_lags", "robust_bounds", "with_spread"]
 
 _NULL = 1e-12  # eigenvalues of H below this fraction of the largest are taken as unidentifiable directions
 
@@ -165,10 +167,9 @@ def robust_bounds(acc: Accuracy, jacobian: np.ndarray, residual: np.ndarray, ser
 
         C = H^-1 (sum_s sum_{k,l in s} (1 - |k - l| / (L_s + 1)) g_k g_l^T) H^-1,   g_k = r_k dr_k/dtheta
 
-    measures it from the residual itself; ``L_s`` is the lag at which the
-    series' residual autocorrelation first falls below 0.05 (as
-    :func:`sysid.fit.wind.residual_inflation` does in the time domain), less
-    one.
+    measures it from the residual itself; ``L_s`` is the last lag at which the
+    series' residual autocorrelation is still at or above 0.05
+    (:func:`correlated_lags`, the wind step's rule in the time domain).
 
     Parameters
     ----------
@@ -207,7 +208,7 @@ def robust_bounds(acc: Accuracy, jacobian: np.ndarray, residual: np.ndarray, ser
     meat = np.zeros_like(covariance)
     for rows in series:
         g, n = scores[rows], len(rows)
-        bandwidth = _bandwidth(np.asarray(residual, dtype=float)[rows])
+        bandwidth = max(correlated_lags(np.asarray(residual, dtype=float)[rows]).size - 1, 0)
         for lag in range(min(bandwidth, n - 1) + 1):
             product = g[lag:].T @ g[: n - lag]
             meat += (1.0 - lag / (bandwidth + 1.0)) * (product if lag == 0 else product + product.T)
@@ -246,11 +247,31 @@ def _inverse(hessian: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return inverse * scale[:, None] * scale[None, :], null
 
 
-def _bandwidth(residual: np.ndarray) -> int:
-    """Lags of a series' residual carried in the Bartlett sum: until its autocorrelation falls below 0.05."""
+def correlated_lags(residual: np.ndarray) -> np.ndarray:
+    """A residual series' normalised autocorrelation, from lag 0 while it stays at or above 0.05.
+
+    The one rule for how far a residual's errors run together: the time-domain
+    inflation of the wind step (:func:`sysid.fit.wind.residual_inflation`) and
+    the sandwich's bandwidth (:func:`robust_bounds`).
+
+    Parameters
+    ----------
+    residual : ndarray, shape (n,)
+        The residual, in order (time or frequency).
+
+    Returns
+    -------
+    ndarray, shape (n_lags,)
+        ``rho_0 = 1, rho_1, ...`` up to the lag before the first below 0.05; empty for a constant residual.
+
+    Examples
+    --------
+    >>> correlated_lags(np.array([1.0, -1.0, 1.0, -1.0])).tolist()
+    [1.0]
+    """
     centred = residual - residual.mean()
-    autocovariance = np.correlate(centred, centred, "full")[centred.size - 1 :]
-    if autocovariance[0] <= 0:
-        return 0
-    below = np.flatnonzero(autocovariance / autocovariance[0] < 0.05)
-    return int(below[0]) - 1 if below.size else centred.size - 1
+    size = next_fast_len(2 * centred.size - 1, real=True)  # a 5-smooth length: 2 n may be a large prime's multiple
+    acf = np.fft.irfft(np.abs(np.fft.rfft(centred, size)) ** 2, size)[: centred.size]
+    rho = acf / acf[0] if acf[0] > 0 else np.zeros(1)
+    cut = int(np.argmax(rho < 0.05)) if np.any(rho < 0.05) else rho.size
+    return cast(np.ndarray, rho[:cut])

@@ -45,12 +45,11 @@ from typing import Literal
 
 import numpy as np
 from scipy import linalg, optimize
-from scipy.fft import next_fast_len
 
 from flightlogs.errors import FitError, FitWarning
 from flightlogs.parallel import map_forked
 from flightlogs.record import Record
-from sysid.fit.accuracy import Accuracy, accuracy
+from sysid.fit.accuracy import Accuracy, accuracy, correlated_lags
 from sysid.fit.guidelines import DEFAULT_GUIDELINES, Guidelines
 from sysid.fit.reduce import ReductionStep, worst_parameter
 from sysid.fit.result import WindFit
@@ -428,12 +427,8 @@ def residual_inflation(residual: np.ndarray) -> float:
     """
     factor = 0.0
     for column in residual.T:
-        c = column - column.mean()
-        size = next_fast_len(2 * c.size - 1, real=True)  # a 5-smooth length: 2 n may be a large prime's multiple
-        acf = np.fft.irfft(np.abs(np.fft.rfft(c, size)) ** 2, size)[: c.size]
-        rho = acf / acf[0] if acf[0] > 0 else np.zeros(1)
-        cut = int(np.argmax(rho < 0.05)) if np.any(rho < 0.05) else rho.size
-        factor = max(factor, (1.0 + 2.0 * float(np.sum(rho[1:cut]))) * float(np.mean(column**2)))
+        rho = correlated_lags(column)
+        factor = max(factor, (1.0 + 2.0 * float(np.sum(rho[1:]))) * float(np.mean(column**2)))
     return max(factor, 1e-12)
 
 
