@@ -249,6 +249,10 @@ def verify_identified(
             f"the model's wind term is not verified: the records carry no {', '.join(wind_inputs)} "
             "(the flights conditioned with an anemometer, `wind_paths`)"
         )
+    if use_wind:
+        from sysid.fit.wind_offset import smoothed_flights  # here: sysid.fit loads SciPy's optimisers
+
+        flights = smoothed_flights(flights)  # G_w's inputs are the wind the fit regressed on
     verification = verify_flights(
         model,
         flights,
