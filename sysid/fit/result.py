@@ -160,9 +160,12 @@ class WindClockOffset:
     def contrast(self) -> float:
         """How much the timing of the wind matters: the residual at the best move below its median over the scan.
 
-        A fraction of that median: 0 when the cost is flat (calm air, no wind information).
+        A fraction of that median: 0 when the cost is flat (calm air, no wind information). The median is
+        that of the cost at 101 evenly spaced moves across the scan (its coarse trials), so that the fine
+        trials about the minimum, as many as the search took, do not pull it down.
         """
-        median = float(np.median(self.cost))
+        even = np.interp(np.linspace(self.shift_s[0], self.shift_s[-1], 101), self.shift_s, self.cost)
+        median = float(np.median(even))
         return 1.0 - self.cost_at(self.best_shift_s) / median if median > 0 else 0.0
 
     def cost_at(self, shift_s: float) -> float:

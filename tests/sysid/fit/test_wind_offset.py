@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -12,7 +13,8 @@ from flightlogs.frames import air_velocity_body, wind_to_body_axes
 from flightlogs.readers.anemometer import read_anemometer_csv
 from flightlogs.readers.dispatch import read_log
 from simulator.campaign.demo_flight import write_demo_flight
-from sysid.fit.wind_offset import SMOOTHING_HZ, smoothed, smoothed_flights
+from sysid.fit.result import WindClockOffset
+from sysid.fit.wind_offset import SMOOTHING_HZ, CostOf, _fine_costs, smoothed, smoothed_flights
 
 
 @pytest.fixture(scope="module")
@@ -62,3 +64,61 @@ def test_the_wind_is_low_passed_and_u_v_w_follow_it(flight: ConditionedFlight) -
 def test_a_flight_without_wind_is_kept_as_it_is(flight: ConditionedFlight) -> None:
     calm = replace(flight, wind=None)
     assert smoothed_flights([calm])[0] is calm
+
+
+class _Trial:
+    """Stands for a record moved by the scan: the move it was asked for is what the cost reads."""
+
+    def columns(self, shift_s: float) -> dict[str, float]:
+        return {"shift_s": shift_s}
+
+
+def _cost_of(true_shift_s: float) -> CostOf:
+    """A residual least at `true_shift_s`, with a ripple of 0.3 s (the wind low-passed at 2 Hz) on a parabola."""
+
+    def cost(moved: Sequence[Mapping[str, float]]) -> tuple[float, float, np.ndarray]:
+        s = moved[0]["shift_s"] - true_shift_s
+        return 1.0 + 4.0 * s**2 + 0.05 * (1.0 - np.cos(2 * np.pi * s / 0.3)), 2.0, np.zeros(1)
+
+    return cost
+
+
+@pytest.mark.parametrize("true_shift_s", [0.0, 0.013, -0.047, 0.08, -0.099, 0.14, -0.2])
+def test_the_fine_pass_finds_the_least_cost_of_the_whole_fine_grid(true_shift_s: float) -> None:
+    """The coarse pass leaves the minimum within a coarse step of the centre (0.1 s); beyond it (-0.2 s) the
+    fine pass walks to its ±0.15 s edge. Every cost it computes is the full grid's at that move."""
+    centre, cost_of, trials = 0.0, _cost_of(true_shift_s), [_Trial()]
+    grid = np.round(centre + np.arange(-0.15, 0.15 + 1e-9, 0.01), 10)
+    whole = {float(s): cost_of([{"shift_s": float(s)}])[0] for s in grid}
+    found = _fine_costs(centre, cost_of, trials)  # type: ignore[arg-type]
+    assert min(found, key=found.__getitem__) == min(whole, key=whole.__getitem__)
+    assert all(found[s] == whole[s] for s in found)
+    best = min(whole, key=whole.__getitem__)
+    assert all(round(best + k * 0.01, 10) in found for k in range(-3, 4) if abs(best + k * 0.01) <= 0.15 + 1e-9)
+    if abs(true_shift_s) <= 0.05:
+        assert len(found) <= 13  # not the 31 of the whole grid
+
+
+def test_the_contrast_is_the_same_however_many_fine_trials_were_made() -> None:
+    """The residual's median over the scan is that of its evenly spaced trials, not pulled down by the fine ones."""
+    coarse = np.round(np.arange(-5.0, 5.0 + 1e-9, 0.1), 10)
+    cost_of = _cost_of(1.234)
+    cost = np.array([cost_of([{"shift_s": float(s)}])[0] for s in coarse])
+    scan = WindClockOffset(
+        shift_s=coarse,
+        cost=cost,
+        cost_without_wind=2.0,
+        best_shift_s=1.2,
+        sigma_s=0.01,
+        used_clock_offset_s=0.0,
+        transport_delay_s=0.5,
+        measured=True,
+        reason="",
+        samples=1000,
+    )
+    fine = np.round(1.2 + np.arange(-0.15, 0.151, 0.01), 10)
+    shifts = np.union1d(coarse, fine)
+    denser = replace(scan, shift_s=shifts, cost=np.array([cost_of([{"shift_s": float(s)}])[0] for s in shifts]))
+    assert float(np.median(denser.cost)) < float(np.median(cost))  # what the plain median would have read
+    assert denser.contrast == pytest.approx(scan.contrast, abs=1e-12)
+    assert scan.contrast == pytest.approx(1.0 - scan.cost_at(1.2) / float(np.median(cost)), abs=1e-12)
