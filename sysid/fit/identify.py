@@ -23,7 +23,7 @@ import numpy as np
 from scipy import linalg
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
-from flightlogs.errors import FitError, FitWarning, collected_warnings
+from flightlogs.errors import FitError, FitWarning, SysidWarning, collected_warnings
 from flightlogs.parallel import map_forked
 from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.record import Record
@@ -50,6 +50,7 @@ from sysid.fit.wind_trace import wind_trace
 from sysid.freqresp import (
     FrequencyResponse,
     Gating,
+    GatingResult,
     ResponseOptions,
     coupled_inputs,
     frequency_responses,
@@ -277,8 +278,10 @@ def _identified(
 ) -> IdentifiedModel:
     """The identification; `timed` is the clock offset scanned and applied to the flights by an earlier pass.
 
-    When the offset measured moves the wind, the identification is run again on the moved flights and
-    `superseded` is called first: the first pass's warnings are said again by the second where they still hold.
+    When the offset is to be measured, it is scanned on a fit of the wind axes alone first
+    (:func:`_scouted_wind`); when it moves the wind, the identification is run again on the moved flights,
+    the other axes' responses never computed on the unmoved ones, and `superseded` is called first: the first
+    pass's warnings are said again by the second where they still hold.
     """
     if isinstance(structure, str):
         structure = load_structure(structure)
@@ -290,21 +293,31 @@ def _identified(
         band = maneuver_band(flights, flown[k], kind=options.kind)
         return _axis_responses(structure, used[flown[k]], flown[k], options, band, quiet_records(flights, flown[k]))
 
-    responses: list[FrequencyResponse] = []
-    notes: list[str] = []
-    _report(progress, "responses", 0, len(_AXES) + 2)
-    for k, (found, note) in enumerate(map_forked(axis_responses, len(flown))):  # the axes on the cores
-        _report(progress, f"responses {flown[k]}", k + 1, len(_AXES) + 2)
-        responses += found
-        notes += [note] if note is not None else []
+    computed: dict[str, tuple[tuple[FrequencyResponse, ...], str | None]] = {}
+
+    def compute(wanted: Sequence[str]) -> None:
+        todo = [k for k, axis in enumerate(flown) if axis in wanted and axis not in computed]
+        for k, found in zip(todo, map_forked(lambda j: axis_responses(todo[j]), len(todo))):  # the axes on the cores
+            _report(progress, f"responses {flown[k]}", len(computed) + 1, len(_AXES) + 2)
+            computed[flown[k]] = found
+
     trim = _mean_trim([r for records in used.values() for r in records])
     constants = structure.constants_from_trim(trim) | dict(options.constants or {})
-    gated = gate_responses(responses, options.gating)
-    unfit = trim_only_responses(structure, gated.kept, structure.values(options.initial), constants, _swings(used))
-    if unfit:  # reached only through trims too small to carry them (sysid.fit.trim_paths)
-        left = {(d.input, d.output) for d in unfit}
-        kept = tuple(r for r in gated.kept if (r.input, r.output) not in left)
-        gated = dataclasses.replace(gated, kept=kept, dropped=(*gated.dropped, *unfit))
+    _report(progress, "responses", 0, len(_AXES) + 2)
+    scouted = None
+    if timed is None and _scouts(structure, flights, used, options):
+        compute(options.wind_axes)
+        scouted = _scouted_wind(structure, flights, used, computed, constants, options)
+        clock = scouted[1] if scouted is not None else None
+        if scouted is not None and clock is not None and clock.measured and _moves(clock, flights):
+            if superseded is not None:  # step 1 on the moved flights, u v w in time
+                superseded()
+            moved = moved_flights(flights, clock.best_shift_s)
+            return _identified(moved, structure, options, files, progress, timed=(clock, scouted[2]))
+    compute(flown)
+    responses = [r for axis in flown for r in computed[axis][0]]
+    notes = [note for axis in flown if (note := computed[axis][1]) is not None]
+    gated = _gated(structure, responses, used, constants, options)
     axes = structure_axes(structure, flights, used, responses, gated, kind=options.kind, gating=options.gating)
     if flights and any(not a.identified for a in axes) and not (options.partial and gated.kept):
         raise FitError(unidentified_message(axes, model=structure.name, partial=options.partial))
@@ -334,7 +347,9 @@ def _identified(
         signals = {c.signal for c in structure.wind_inputs}
         records = [r for axis in options.wind_axes for r in used.get(axis, [])]
         if any(signals <= set(r.signals) for r in records):
-            if timed is None:
+            if scouted is not None:
+                records, clock, said = scouted
+            elif timed is None:
                 records, clock, said = timed_wind(
                     structure, fit.values, constants, records, flights, options.wind_outputs
                 )
@@ -455,6 +470,72 @@ def _unmeasured(
         cost_average=fit.cost.average,
         cost_average_after=fit.cost.average,
     )
+
+
+def _gated(
+    structure: ModelStructure,
+    responses: Sequence[FrequencyResponse],
+    used: Mapping[str, Sequence[Record]],
+    constants: Mapping[str, float],
+    options: IdentifyOptions,
+) -> GatingResult:
+    """The responses gating keeps, less those the structure reaches only through trims too small to carry them
+    (:mod:`sysid.fit.trim_paths`), those added to the dropped."""
+    gated = gate_responses(responses, options.gating)
+    unfit = trim_only_responses(structure, gated.kept, structure.values(options.initial), constants, _swings(used))
+    if unfit:
+        left = {(d.input, d.output) for d in unfit}
+        kept = tuple(r for r in gated.kept if (r.input, r.output) not in left)
+        gated = dataclasses.replace(gated, kept=kept, dropped=(*gated.dropped, *unfit))
+    return gated
+
+
+def _scouts(
+    structure: ModelStructure,
+    flights: Sequence[ConditionedFlight],
+    used: Mapping[str, Sequence[Record]],
+    options: IdentifyOptions,
+) -> bool:
+    """Whether the anemometer's clock is to be measured (its offset not given) from wind-axis records that carry
+    the wind: then it is scanned on a fit of the wind axes alone (:func:`_scouted_wind`) before the other axes'
+    responses are computed, which a clock that moves the wind would only have to compute again."""
+    signals = {c.signal for c in structure.wind_inputs}
+    records = [r for axis in options.wind_axes for r in used.get(axis, [])]
+    return (
+        bool(structure.wind_parameters)
+        and not offset_given(flights)
+        and any(signals <= set(r.signals) for r in records)
+    )
+
+
+def _scouted_wind(
+    structure: ModelStructure,
+    flights: Sequence[ConditionedFlight],
+    used: Mapping[str, Sequence[Record]],
+    computed: Mapping[str, tuple[tuple[FrequencyResponse, ...], str | None]],
+    constants: Mapping[str, float],
+    options: IdentifyOptions,
+) -> tuple[list[Record], WindClockOffset | None, list[str]] | None:
+    """:func:`~sysid.fit.wind_offset.timed_wind` on F and G_u fitted to the wind axes' responses alone.
+
+    The residual of eq. 3.14 on the wind outputs (a_x, a_z) reads only the wind axes' parameters, so the
+    other axes' responses are not needed to time the wind. None when those responses cannot be fitted (the
+    whole identification then says why); the fit's warnings are the whole identification's to say.
+    """
+    responses = [r for axis in options.wind_axes if axis in computed for r in computed[axis][0]]
+    records = [r for axis in options.wind_axes for r in used.get(axis, [])]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SysidWarning)
+        gated = _gated(structure, responses, used, constants, options)
+        if not gated.kept:
+            return None
+        try:
+            fit = fit_frequency_responses(
+                structure, gated.kept, constants=constants, initial=options.initial, options=options.fit
+            )
+        except FitError:
+            return None
+        return timed_wind(structure, fit.values, constants, records, flights, options.wind_outputs)
 
 
 def _moves(clock: WindClockOffset, flights: Sequence[ConditionedFlight]) -> bool:
