@@ -305,7 +305,7 @@ def _identified(
     constants = structure.constants_from_trim(trim) | dict(options.constants or {})
     _report(progress, "responses", 0, len(_AXES) + 2)
     scouted = None
-    if timed is None and _scouts(structure, flights, used, options):
+    if timed is None and _measures_clock(structure, flights, used, options):
         compute(options.wind_axes)
         scouted = _scouted_wind(structure, flights, used, computed, constants, options)
         clock = scouted[1] if scouted is not None else None
@@ -490,7 +490,7 @@ def _gated(
     return gated
 
 
-def _scouts(
+def _measures_clock(
     structure: ModelStructure,
     flights: Sequence[ConditionedFlight],
     used: Mapping[str, Sequence[Record]],
@@ -520,11 +520,12 @@ def _scouted_wind(
 
     The residual of eq. 3.14 on the wind outputs (a_x, a_z) reads only the wind axes' parameters, so the
     other axes' responses are not needed to time the wind. None when those responses cannot be fitted (the
-    whole identification then says why); the fit's warnings are the whole identification's to say.
+    whole identification then says why); the fit's warnings are the whole identification's to say, the
+    scan's are said here.
     """
     responses = [r for axis in options.wind_axes if axis in computed for r in computed[axis][0]]
     records = [r for axis in options.wind_axes for r in used.get(axis, [])]
-    with warnings.catch_warnings():
+    with warnings.catch_warnings():  # said by the fit of every axis, or by the one on the moved flights
         warnings.simplefilter("ignore", SysidWarning)
         gated = _gated(structure, responses, used, constants, options)
         if not gated.kept:
@@ -535,7 +536,7 @@ def _scouted_wind(
             )
         except FitError:
             return None
-        return timed_wind(structure, fit.values, constants, records, flights, options.wind_outputs)
+    return timed_wind(structure, fit.values, constants, records, flights, options.wind_outputs)
 
 
 def _moves(clock: WindClockOffset, flights: Sequence[ConditionedFlight]) -> bool:

@@ -165,7 +165,7 @@ def test_the_clock_is_scanned_on_the_wind_axes_alone_as_on_every_axis(
     monkeypatch.setattr(identify, "_axis_responses", counting)
     scouted = identify_logs(logs, "hover-wind", wind_paths=[folder], conditioning=options)
     assert sorted(counted) == ["lat", "lon", "lon", "thr", "thr", "yaw"], counted
-    monkeypatch.setattr(identify, "_scouts", lambda *_: False)
+    monkeypatch.setattr(identify, "_measures_clock", lambda *_: False)
     whole = identify_logs(logs, "hover-wind", wind_paths=[folder], conditioning=options)
     assert scouted.wind is not None and scouted.wind.clock_offset is not None
     assert whole.wind is not None and whole.wind.clock_offset is not None
