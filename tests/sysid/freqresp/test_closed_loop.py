@@ -241,3 +241,16 @@ def test_coupled_inputs_are_those_that_move_with_the_maneuver() -> None:
     flown = Record.from_table(table, units=units, trim={}, source=record.source)
     found = coupled_inputs([flown], "delta_lon", ["delta_lat", "delta_yaw", "delta_thr"], OPTIONS)
     assert found == ("delta_thr",)
+    # the candidates are judged together (one transform of the control per window length), each as if alone
+    alone = [
+        name
+        for name in ("delta_lat", "delta_yaw", "delta_thr")
+        if coupled_inputs([flown], "delta_lon", [name], OPTIONS)
+    ]
+    assert tuple(alone) == found
+    both = flown.table.assign(delta_lat=flown["delta_thr"] + 0.1 * np.std(delta) * rng.normal(size=delta.size))
+    twice = Record.from_table(both, units=units, trim={}, source=record.source)
+    assert coupled_inputs([twice], "delta_lon", ["delta_thr", "delta_yaw", "delta_lat"], OPTIONS) == (
+        "delta_thr",
+        "delta_lat",
+    )  # in the order given
