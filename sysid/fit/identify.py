@@ -344,9 +344,8 @@ def _identified(
     wind = None
     if structure.wind_parameters:
         _report(progress, "wind step", len(_AXES) + 1, len(_AXES) + 2)
-        signals = {c.signal for c in structure.wind_inputs}
-        records = [r for axis in options.wind_axes for r in used.get(axis, [])]
-        if any(signals <= set(r.signals) for r in records):
+        records = _wind_records(used, options)
+        if _carry_wind(structure, records):
             if scouted is not None:
                 records, clock, said = scouted
             elif timed is None:
@@ -373,7 +372,8 @@ def _identified(
                 wind = dataclasses.replace(wind, fit=dataclasses.replace(wind.fit, clock_offset=clock, trace=trace))
         else:
             notes.append(
-                f"no record carries {', '.join(sorted(signals))}: wind parameters left out (give `wind_paths`)"
+                f"no record carries {', '.join(sorted({c.signal for c in structure.wind_inputs}))}: wind parameters "
+                "left out (give `wind_paths`)"
             )
     _report(progress, "done", len(_AXES) + 2, len(_AXES) + 2)
     maneuvers = sorted({f"{s.kind} {s.axis} {s.source}" for f in flights for s in f.segments if s.kind == options.kind})
@@ -499,13 +499,19 @@ def _measures_clock(
     """Whether the anemometer's clock is to be measured (its offset not given) from wind-axis records that carry
     the wind: then it is scanned on a fit of the wind axes alone (:func:`_scouted_wind`) before the other axes'
     responses are computed, which a clock that moves the wind would only have to compute again."""
+    records = _wind_records(used, options)
+    return bool(structure.wind_parameters) and not offset_given(flights) and _carry_wind(structure, records)
+
+
+def _wind_records(used: Mapping[str, Sequence[Record]], options: IdentifyOptions) -> list[Record]:
+    """The wind step's records: the maneuvers of its axes (``options.wind_axes``)."""
+    return [r for axis in options.wind_axes for r in used.get(axis, [])]
+
+
+def _carry_wind(structure: ModelStructure, records: Sequence[Record]) -> bool:
+    """Whether any of `records` carries every wind signal the structure's G_w reads."""
     signals = {c.signal for c in structure.wind_inputs}
-    records = [r for axis in options.wind_axes for r in used.get(axis, [])]
-    return (
-        bool(structure.wind_parameters)
-        and not offset_given(flights)
-        and any(signals <= set(r.signals) for r in records)
-    )
+    return any(signals <= set(r.signals) for r in records)
 
 
 def _scouted_wind(
@@ -524,7 +530,7 @@ def _scouted_wind(
     scan's are said here.
     """
     responses = [r for axis in options.wind_axes if axis in computed for r in computed[axis][0]]
-    records = [r for axis in options.wind_axes for r in used.get(axis, [])]
+    records = _wind_records(used, options)
     with warnings.catch_warnings():  # said by the fit of every axis, or by the one on the moved flights
         warnings.simplefilter("ignore", SysidWarning)
         gated = _gated(structure, responses, used, constants, options)

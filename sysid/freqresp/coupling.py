@@ -86,11 +86,10 @@ def coupled_inputs(
     response, as it should, since the data cannot tell the two paths apart.
     """
     dt = _common_step(records)
-    data = [_channels(r, (control,)) for r in records]
-    lengths = _window_samples(data, dt, options)
-    omega = _grid(options, dt, max(lengths))
     names = [n for n in dict.fromkeys(candidates) if n != control]
-    blocks = [_channels(r, (control, *names)) for r in records]
+    blocks = [_channels(r, (control, *names)) for r in records]  # row 0 the control, then each candidate
+    lengths = _window_samples(blocks, dt, options)
+    omega = _grid(options, dt, max(lengths))
     left = [k for k in range(len(names)) if not all(np.ptp(block[k + 1]) == 0 for block in blocks)]
     found: set[str] = set()
     for n_window in lengths:  # every candidate still unfound at once: the control's transform made once

@@ -12,6 +12,7 @@ from flightlogs.errors import DataError
 from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.store.sources import conditioned_sources, is_dataset
 from sysid.fit.result import IdentifiedModel
+from sysid.fit.wind_offset import smoothed_flights
 from sysid.model.statespace import DelayedStateSpace
 from sysid.verify.engine import VerificationOptions, verify
 from sysid.verify.records import (
@@ -250,8 +251,6 @@ def verify_identified(
             "(the flights conditioned with an anemometer, `wind_paths`)"
         )
     if use_wind:
-        from sysid.fit.wind_offset import smoothed_flights  # here: sysid.fit loads SciPy's optimisers
-
         flights = smoothed_flights(flights)  # G_w's inputs are the wind the fit regressed on
     verification = verify_flights(
         model,
