@@ -159,7 +159,7 @@ class Record:
         return max(stop - first, 0)
 
     def between(self, start_s: float, end_s: float, *, label: str | None = None) -> Record:
-        """The part of the record from `start_s` to `end_s` (inclusive), same trim.
+        """The part of the record from `start_s` to `end_s` (inclusive), same trim; its columns are views of these.
 
         Parameters
         ----------
@@ -171,7 +171,7 @@ class Record:
         first, stop = self._rows(start_s, end_s)
         return Record(
             time_s=self.time_s[first:stop],
-            columns={name: values[first:stop].copy() for name, values in self.columns.items()},
+            columns={name: values[first:stop] for name, values in self.columns.items()},  # read-only views
             units=self.units,
             trim=self.trim,
             source=self.source,

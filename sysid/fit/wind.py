@@ -882,7 +882,7 @@ def speed_derivatives(
     at = problem.start.copy()
     for k in delay_index if delays is not None else ():
         at[k] = (delays or {}).get(problem.free[k], at[k])
-    best = solved(at)[0]
+    best = solved(at)[0] if delays is None else math.inf
     for _ in range(0 if delays is not None else _rounds(len(delay_index))):
         for k in delay_index:
             p = structure.parameter(problem.free[k])
@@ -896,11 +896,13 @@ def speed_derivatives(
                     if cost < best:
                         at, best = trial, cost
     _, solution, wind = solved(at)
-    after, design = joint.explicit(wind, solution)
     labels = tuple(free[k] for k in chosen) + tuple(problem.free[g] for g in gains)
     estimates = np.concatenate([theta[chosen] + solution[: len(chosen)], solution[len(chosen) :]])
-    inflation = residual_inflation(after) if with_accuracy else math.inf
-    acc = accuracy(design / math.sqrt(inflation), estimates, labels)
+    if with_accuracy:
+        after, design = joint.explicit(wind, solution)
+        acc = accuracy(design / math.sqrt(residual_inflation(after)), estimates, labels)
+    else:  # the values alone: no information, every bound infinite
+        acc = accuracy(np.zeros((1, len(labels))), estimates, labels)
     return {free[k]: float(estimates[j]) for j, k in enumerate(chosen)}, acc
 
 

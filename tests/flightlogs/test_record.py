@@ -40,6 +40,17 @@ def test_between_keeps_both_bounds_and_samples_between_counts_them() -> None:
     assert record.samples_between(11.5, 12.0) == 0
 
 
+def test_a_piece_reads_the_records_memory_and_stays_read_only() -> None:
+    record = _record()
+    piece = record.between(10.2, 10.5)
+    assert all(np.shares_memory(piece[name], record[name]) for name in record.signals)  # a view: nothing copied
+    with pytest.raises(ValueError):
+        piece["q"][0] = 1.0
+    again = pickle.loads(pickle.dumps(piece))  # a view pickles as its own samples
+    assert again["q"].size == 31 and not again["q"].flags.writeable
+    np.testing.assert_array_equal(again["q"], record["q"][20:51])
+
+
 def test_the_table_round_trips_through_from_table() -> None:
     record = _record()
     table = record.table

@@ -15,7 +15,7 @@ from simulator.autopilot.excitation import Maneuver
 from simulator.flights.linear import WindField, simulate_hover
 from simulator.vehicle.identified import CALM_HOVER, STRONG_WIND_TERMS
 from sysid.fit import FrequencyFit, fit_frequency_responses, fit_wind, model_from_fit, synthetic_responses
-from sysid.fit.wind import _prediction_data, sharing_delayed_winds, unfitted_wind
+from sysid.fit.wind import _prediction_data, sharing_delayed_winds, speed_derivatives, unfitted_wind
 from sysid.model import ModelStructure, load_structure, structure_model
 
 CONTROLS = ("X_lon", "M_lon", "Y_lat", "L_lat", "N_yaw", "Z_thr")
@@ -175,3 +175,22 @@ def test_the_first_order_recursion_is_lfilter_with_its_initial_state(phi: float)
     b, den = np.array([0.3, -0.1]), np.array([1.0, -phi])
     expected = sps.lfilter(b, den, f[1:], zi=sps.lfiltic(b, den, y=[0.7], x=[f[0]]))[0]
     np.testing.assert_allclose(_first_order(phi, 0.3, -0.1, f, 0.7), np.r_[0.7, expected], rtol=0, atol=1e-12)
+
+
+def test_the_speed_derivatives_without_bounds_are_those_with_them(records: list[Record]) -> None:
+    """The step 1 spreads want the values alone: the same values, every bound infinite, no correlation."""
+    structure = load_structure("hover-wind")
+    values = structure.values(dict(CALM_HOVER) | {"N_r": 0.0, "Z_w": 0.0})
+    estimated = [n for n in structure.parameter_names if n not in structure.wind_parameters]
+    constants = structure.default_constants()
+    delays = {"tau_w_lon": 0.1, "tau_w_thr": 0.1}
+    flown = [  # the speed regressors need every air-relative velocity: v, still, beside u and w
+        replace(r, columns=dict(r.columns) | {"v": np.zeros(r.time_s.size)}, units=dict(r.units) | {"v": "m/s"})
+        for r in records
+    ]
+    with_bounds = speed_derivatives(structure, values, constants, flown, estimated, delays=delays)
+    alone = speed_derivatives(structure, values, constants, flown, estimated, delays=delays, with_accuracy=False)
+    assert alone[0] == with_bounds[0] and {"X_u", "Z_w"} <= set(alone[0])
+    assert alone[1].names == with_bounds[1].names and len(alone[1].names) > 2
+    np.testing.assert_array_equal(alone[1].values, with_bounds[1].values)
+    assert np.all(np.isfinite(with_bounds[1].cramer_rao)) and np.all(np.isinf(alone[1].cramer_rao))
