@@ -122,7 +122,7 @@ def batch(
     from flightlogs.conditioning.condition import ConditioningOptions
     from flightlogs.readers.log_mapping import read_log_mapping
     from flightlogs.store.campaign import expand_wind_paths
-    from flightlogs.store.dataset import file_sha256
+    from flightlogs.store.hashing import file_sha256
     from reports.fleet_report import write_fleet_report
     from reports.fleet_table import write_tables
     from reports.model_report import write_model_report

@@ -51,6 +51,18 @@ def test_the_fit_loads_neither_scipy_signal_nor_python_control() -> None:
     assert "scipy.signal" not in loaded["scipy"] and "scipy.stats" not in loaded["scipy"]
 
 
+def test_a_fit_of_logs_to_a_json_model_loads_neither_h5py_nor_scipy_io(real_data: Path) -> None:
+    """HDF5 (h5py, 35 ms) only for datasets and response files, scipy.io (35 ms) only for a .mat model file."""
+    loaded = _loaded(
+        "import sysid_cli.fit, sysid.fit.identify, sysid.fit.model_file, flightlogs.store.campaign\n"
+        "from flightlogs.store import file_sha256\n"
+        f"file_sha256({str(real_data / ARDUPILOT)!r})\n"
+        "from sysid.freqresp import frequency_responses"
+    )
+    assert "h5py" not in loaded["top"] and "scipy.io" not in loaded["scipy"]
+    assert "scipy.optimize" in loaded["scipy"]  # the probe did load the fit
+
+
 def test_the_discrepancy_search_filters_a_flight_without_scipy_signal_ndimage_or_stats() -> None:
     """Its series (anti-alias filter, rate derivatives), lags, averages and bands are numpy (scipy.signal and ndimage: 0.8 s)."""
     loaded = _loaded(

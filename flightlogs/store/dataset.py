@@ -31,7 +31,6 @@ ignores groups it does not know.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -43,6 +42,7 @@ import numpy as np
 
 from flightlogs._arrays import ByContents
 from flightlogs.flightlog import FlightLog, Signal, SystemIdRun, WindMeasurement
+from flightlogs.store.hashing import file_sha256
 from flightlogs.store.schema import create_schema_file, open_schema, put_text, stamp_schema, text, text_dtype
 from flightlogs.writers.atomic import atomic_output
 from flightlogs.writers.jsonio import jsonable
@@ -56,7 +56,7 @@ if TYPE_CHECKING:  # conditioning loads when a dataset holds conditioned flights
 #: log held as float32 (:func:`_narrowed`), at no cost in time.
 _COMPRESSION: dict[str, Any] = {"compression": "lzf", "shuffle": True}
 
-__all__ = ["Dataset", "write_dataset", "read_dataset", "file_sha256", "SCHEMA_VERSION"]
+__all__ = ["Dataset", "write_dataset", "read_dataset", "SCHEMA_VERSION"]
 
 SCHEMA = "flight-sysid dataset"
 SCHEMA_VERSION = 2
@@ -85,21 +85,6 @@ class Dataset:
     conditioned: tuple[ConditionedFlight, ...] = ()
     sha256: dict[str, str] = dataclasses.field(default_factory=dict)
     schema_version: int = SCHEMA_VERSION
-
-
-def file_sha256(path: str | Path) -> str:
-    """SHA-256 hex digest of a file's bytes (provenance of ingested inputs).
-
-    Parameters
-    ----------
-    path : str or Path
-        File to hash.
-    """
-    digest = hashlib.sha256()
-    with Path(path).open("rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def write_dataset(

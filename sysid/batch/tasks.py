@@ -95,7 +95,7 @@ def survey_log(path: str, cache: str, reading: ReadOptions = ReadOptions()) -> L
     LogSurvey
     """
     from flightlogs.readers.dispatch import read_log
-    from flightlogs.store.dataset import file_sha256
+    from flightlogs.store.hashing import file_sha256
 
     try:
         sha256 = file_sha256(path)

@@ -27,7 +27,7 @@ from flightlogs.errors import FitError, FitWarning, SysidWarning, collected_warn
 from flightlogs.parallel import map_forked
 from flightlogs.readers.dispatch import ReadOptions
 from flightlogs.record import Record
-from flightlogs.store.dataset import file_sha256
+from flightlogs.store.hashing import file_sha256
 from flightlogs.writers.jsonio import jsonable
 from sysid.fit.accuracy import Accuracy, with_spread
 from sysid.fit.axes import merge_axes, partial_warning, structure_axes, unidentified_message

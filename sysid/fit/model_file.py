@@ -20,7 +20,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy import io as sio
 
 from flightlogs.errors import ModelError
 from flightlogs.writers.atomic import atomic_output
@@ -547,6 +546,8 @@ def write_mat(path: str | Path, model: IdentifiedModel) -> Path:
         "cost_average": model.cost.average,
         "structure": model.structure_text,
     }
+    from scipy import io as sio  # here: a .mat file is rare, and scipy.io takes 35 ms to load
+
     with atomic_output(path) as tmp:
         sio.savemat(tmp, content, appendmat=False, oned_as="column")
     return Path(path)

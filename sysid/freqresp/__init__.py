@@ -6,7 +6,8 @@ The public names live in small modules and are re-exported here:
 :mod:`~sysid.freqresp.gating` (:func:`gate_responses`),
 :mod:`~sysid.freqresp.records` (:func:`maneuver_records`, :func:`maneuver_band`,
 :func:`quiet_records`, :func:`within_band`, :data:`DEFAULT_PAIRS`, :func:`flight_responses`),
-:mod:`~sysid.freqresp.coupling` (:func:`coupled_inputs`) and :mod:`~sysid.freqresp.io` (HDF5).
+:mod:`~sysid.freqresp.coupling` (:func:`coupled_inputs`) and :mod:`~sysid.freqresp.io` (HDF5, loaded with
+h5py on first use: a fit that writes no responses does not load it).
 Private modules hold the numerics: ``_spectra`` (windowed spectra), ``_whole``
 (the records' whole-length transforms, the composite's bias-free member),
 ``_local`` (that member from one record: its neighbouring bins),
@@ -14,10 +15,12 @@ Private modules hold the numerics: ``_spectra`` (windowed spectra), ``_whole``
 ``_composite``.
 """
 
+from typing import TYPE_CHECKING
+
+from flightlogs._lazy import lazy_names
 from sysid.freqresp.coupling import coupled_inputs
 from sysid.freqresp.estimate import automatic_window_lengths, frequency_responses
 from sysid.freqresp.gating import DroppedResponse, Gating, GatingResult, fit_range, gate_responses
-from sysid.freqresp.io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
 from sysid.freqresp.options import ResponseOptions
 from sysid.freqresp.records import (
     DEFAULT_PAIRS,
@@ -33,6 +36,9 @@ from sysid.freqresp.records import (
     within_band,
 )
 from sysid.freqresp.response import FrequencyResponse
+
+if TYPE_CHECKING:
+    from sysid.freqresp.io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
 
 __all__ = [
     "FrequencyResponse",
@@ -60,3 +66,7 @@ __all__ = [
     "FlightResponses",
     "flight_responses",
 ]
+
+__getattr__, __dir__ = lazy_names(
+    __name__, dict.fromkeys(("RESPONSES_SCHEMA_VERSION", "read_responses", "write_responses"), "io")
+)

@@ -85,7 +85,7 @@ def verification_to_dict(
     model : str, optional
         The model file verified.
     model_sha256 : str, optional
-        SHA-256 of the model file's bytes (:func:`flightlogs.store.dataset.file_sha256`).
+        SHA-256 of the model file's bytes (:func:`flightlogs.store.hashing.file_sha256`).
     options : Mapping[str, Any], optional
         JSON-compatible options of the verification.
     created_utc : str, optional
@@ -217,7 +217,7 @@ def write_verification(
     """
     sha256 = ""
     if isinstance(model, Path):
-        from flightlogs.store.dataset import file_sha256
+        from flightlogs.store.hashing import file_sha256
 
         model, sha256 = model.name, file_sha256(model)
     if created_utc is None:
@@ -247,7 +247,7 @@ def require_verified_model(saved: SavedVerification, model_path: str | Path, *, 
     """
     model_path = Path(model_path)
     if saved.model_sha256:
-        from flightlogs.store.dataset import file_sha256
+        from flightlogs.store.hashing import file_sha256
 
         same = file_sha256(model_path) == saved.model_sha256
     else:
