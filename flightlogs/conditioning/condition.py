@@ -240,8 +240,9 @@ def _one_pass(
             f"{log.path}: no stretch of at least {options.min_record_s:g} s where every core signal has data"
         )
     values = resample_signals(cut_by | others, time_base, max_gap_samples=options.max_gap_samples)
-    for name, signal in others.items():
-        _hold_edges(values[name], time_base, 1.5 / signal.rate_hz if signal.rate_hz > 0 else 0.0)
+    holds = {name: 1.5 / rate for name, rate in ((n, s.rate_hz) for n, s in others.items()) if rate > 0}
+    for name in others:
+        _hold_edges(values[name], time_base, holds.get(name, 0.0))
     if "excitation" in values:  # logged only while a System ID run injects it: zero elsewhere
         np.nan_to_num(values["excitation"], nan=0.0, copy=False)
     units = {name: sig.unit for name, sig in (cut_by | others).items()}
@@ -259,7 +260,6 @@ def _one_pass(
     _derived(values, units, wind_given=bool(wind_signals))
     give_back_freed_memory()  # the resampler's working arrays: segmentation's are larger
     segments = _segments(log, time_base, values, options, spans.spans)
-    holds = {name: 1.5 / signal.rate_hz for name, signal in others.items() if signal.rate_hz > 0}
     records = tuple(
         _record(log, time_base, values, units, span, segments, f"piece {k + 1} of {len(spans.spans)}", holds)
         for k, span in enumerate(spans.spans)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 from flightlogs._lazy import lazy_names
 
 if TYPE_CHECKING:
-    from flightlogs.store.campaign import Campaign, expand_wind_paths, ingest_campaign
+    from flightlogs.store.campaign import Campaign, conditioned_campaign, expand_wind_paths, ingest_campaign
     from flightlogs.store.dataset import SCHEMA_VERSION, Dataset, read_dataset, write_dataset
     from flightlogs.store.hashing import file_sha256
     from flightlogs.store.schema import open_schema, software_version, stamp_schema
@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 __all__ = [
     "Campaign",
     "ingest_campaign",
+    "conditioned_campaign",
     "expand_wind_paths",
     "Dataset",
     "write_dataset",
@@ -42,7 +43,7 @@ __all__ = [
 ]
 
 _HOMES = {
-    **dict.fromkeys(("Campaign", "expand_wind_paths", "ingest_campaign"), "campaign"),
+    **dict.fromkeys(("Campaign", "conditioned_campaign", "expand_wind_paths", "ingest_campaign"), "campaign"),
     **dict.fromkeys(("SCHEMA_VERSION", "Dataset", "read_dataset", "write_dataset"), "dataset"),
     "file_sha256": "hashing",
     **dict.fromkeys(("open_schema", "software_version", "stamp_schema"), "schema"),

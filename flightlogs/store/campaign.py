@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,7 +16,7 @@ from flightlogs.parallel import map_forked
 from flightlogs.readers.anemometer import WindMeasurement, read_anemometer_csv
 from flightlogs.readers.dispatch import ReadOptions, read_log
 
-__all__ = ["Campaign", "ingest_campaign", "expand_wind_paths"]
+__all__ = ["Campaign", "ingest_campaign", "conditioned_campaign", "expand_wind_paths"]
 
 #: Logs conditioned in worker processes up to this much in all: each worker sends its result back.
 _MAX_FORKED_BYTES = 256 * 2**20
@@ -57,10 +57,7 @@ class Campaign:
         DataError
             If no log could be conditioned (the message gives each log's reason).
         """
-        if not self.flights:
-            reasons = "; ".join(note for notes in self.notes for note in notes)
-            raise DataError(f"no log could be conditioned ({reasons})")
-        return self.flights
+        return _required(self.conditioned, self.notes)
 
 
 def _size(path: str | Path) -> int:
@@ -152,26 +149,117 @@ def ingest_campaign(
     winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
     paired = pair_winds(logs, winds, clock_offset_s=options.wind_offset_s)
 
-    def condition(k: int) -> ConditionedFlight | DataError:
-        try:
-            return condition_flight(logs[k], paired[k], options)
-        except DataError as err:
-            return err
-        finally:
-            give_back_freed_memory()  # segmentation's working arrays, before the next log or the writing
+    def condition(k: int) -> tuple[bool, ConditionedFlight | DataError]:
+        return paired[k] is not None, _conditioned(logs[k], paired[k], options)
 
     forked = sum(sizes) <= _MAX_FORKED_BYTES  # larger logs one at a time, each spread over the cores by trace
+    results = map_forked(condition, len(logs)) if forked else map(condition, range(len(logs)))
+    conditioned, notes = _collected(results)
+    return Campaign(logs=tuple(logs), winds=tuple(winds), conditioned=conditioned, notes=notes)
+
+
+def conditioned_campaign(
+    log_paths: Sequence[Path],
+    wind_paths: Sequence[Path] = (),
+    *,
+    columns: Mapping[str, str] | None = None,
+    options: ConditioningOptions = ConditioningOptions(),
+    progress: Callable[[str, int, int], None] | None = None,
+    reading: ReadOptions = ReadOptions(),
+) -> tuple[ConditionedFlight, ...]:
+    """The flights of a campaign, conditioned as :func:`ingest_campaign` conditions them, each log read by the
+    worker process that conditions it: for a command that needs the flights alone (a fit, a validation).
+
+    The logs are read on the cores beside their conditioning, not one after the other before it, and none
+    comes back: only the flights do. The anemometer files are read first, here.
+
+    Parameters
+    ----------
+    log_paths, wind_paths, columns, options, reading
+        As :func:`ingest_campaign`'s.
+    progress : callable, optional
+        ``progress(file_name, done, total)``: the bytes of the logs read and conditioned so far, of all of
+        them, after each log in turn (from 0).
+
+    Returns
+    -------
+    tuple of ConditionedFlight
+        The flights that could be conditioned, in the order given.
+
+    Raises
+    ------
+    LogFormatError, DataError
+        As :func:`ingest_campaign`'s, and when no log could be conditioned (:meth:`Campaign.require_flights`).
+
+    Warns
+    -----
+    DataQualityWarning
+        As :func:`ingest_campaign`.
+    """
+    sizes = [_size(path) for path in log_paths]
+    winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
+
+    def condition(k: int) -> tuple[bool, ConditionedFlight | DataError]:
+        log = read_log(log_paths[k], reading=reading)
+        wind = pair_winds([log], winds, clock_offset_s=options.wind_offset_s)[0]
+        return wind is not None, _conditioned(log, wind, options)
+
+    def reported(
+        k: int, result: tuple[bool, ConditionedFlight | DataError]
+    ) -> tuple[bool, ConditionedFlight | DataError]:
+        if progress is not None:
+            progress(Path(log_paths[k]).name, sum(sizes[: k + 1]), sum(sizes))
+        return result
+
+    if progress is not None and log_paths:
+        progress(Path(log_paths[0]).name, 0, sum(sizes))
+    forked = sum(sizes) <= _MAX_FORKED_BYTES
+    results = map_forked(condition, len(log_paths)) if forked else map(condition, range(len(log_paths)))
+    return _required(*_collected(reported(k, result) for k, result in enumerate(results)))
+
+
+def _required(
+    conditioned: Sequence[ConditionedFlight | None], notes: Sequence[tuple[str, ...]]
+) -> tuple[ConditionedFlight, ...]:
+    """The flights conditioned, or DataError giving each log's reason when there is none."""
+    flights = tuple(flight for flight in conditioned if flight is not None)
+    if not flights:
+        reasons = "; ".join(note for log_notes in notes for note in log_notes)
+        raise DataError(f"no log could be conditioned ({reasons})")
+    return flights
+
+
+def _conditioned(
+    log: FlightLog, wind: WindMeasurement | None, options: ConditioningOptions
+) -> ConditionedFlight | DataError:
+    """`log` conditioned, or the DataError that says why it cannot be; freed memory given back after either."""
+    try:
+        return condition_flight(log, wind, options)
+    except DataError as err:
+        return err
+    finally:
+        give_back_freed_memory()  # segmentation's working arrays, before the next log or the writing
+
+
+def _collected(
+    results: Iterable[tuple[bool, ConditionedFlight | DataError]],
+) -> tuple[tuple[ConditionedFlight | None, ...], tuple[tuple[str, ...], ...]]:
+    """Each log's flight (None where it could not be conditioned) and notes, from ``(paired with wind, result)``.
+
+    A log paired with wind that cannot be conditioned raises its error: the user asked for wind alignment,
+    and its failure is the answer. One without wind is left out with a warning, its reason in its notes.
+    """
     conditioned: list[ConditionedFlight | None] = []
     notes: list[tuple[str, ...]] = []
-    for wind, flight in zip(paired, map_forked(condition, len(logs)) if forked else map(condition, range(len(logs)))):
+    for with_wind, flight in results:
         if isinstance(flight, ConditionedFlight):
             conditioned.append(flight)
             notes.append(())
             continue
-        if wind is not None:
-            raise flight  # the user asked for wind alignment: its failure is the answer
+        if with_wind:
+            raise flight
         conditioned.append(None)
         message = f"not conditioned: {flight}"
-        warnings.warn(DataQualityWarning(message), stacklevel=2)
+        warnings.warn(DataQualityWarning(message), stacklevel=3)
         notes.append((message,))
-    return Campaign(logs=tuple(logs), winds=tuple(winds), conditioned=tuple(conditioned), notes=tuple(notes))
+    return tuple(conditioned), tuple(notes)

@@ -102,7 +102,8 @@ def conditioned_sources(
     options : ConditioningOptions, optional
         How logs are conditioned (unused for datasets).
     progress : callable, optional
-        ``progress(file_name, done, total)`` while reading logs, bytes.
+        ``progress(file_name, done, total)``, bytes of the logs read and conditioned so far
+        (:func:`~flightlogs.store.campaign.conditioned_campaign`).
     reading : ReadOptions, optional
         How tables among the logs are read, and whether another vehicle is refused.
 
@@ -120,13 +121,9 @@ def conditioned_sources(
         if wind_paths:
             raise DataError("`wind_paths` go with logs: a dataset already holds its aligned wind")
         return dataset_flights(sources)
-    from flightlogs.store.campaign import ingest_campaign
+    from flightlogs.store.campaign import conditioned_campaign
 
-    campaign = ingest_campaign(
-        [Path(p) for p in sources],
-        [Path(p) for p in wind_paths],
-        options=options,
-        progress=progress,
-        reading=reading,
+    flights = conditioned_campaign(
+        [Path(p) for p in sources], [Path(p) for p in wind_paths], options=options, progress=progress, reading=reading
     )
-    return list(campaign.require_flights())
+    return list(flights)
