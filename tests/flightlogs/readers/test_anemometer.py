@@ -390,3 +390,65 @@ def test_texts_numpy_would_misread_go_row_by_row(texts: list[str]) -> None:
     from flightlogs.readers._anemometer_text import _iso_at_once
 
     assert _iso_at_once(texts, 0.0) is None
+
+
+# --------------------------------------------------------------------------- rows without quotes
+
+_ROW_TEXTS = [
+    "utc,speed\n2024-05-01T10:00:00Z,1.0\n",
+    "utc,speed\r\n\r\n# note\r\n2024-05-01T10:00:00Z , 1.0\r\n,,\r\n  # indented comment\n2024-05-01T10:00:01Z,2.0,\n",
+    "date\ttime\tspeed\n2024-05-01\t10:00:00\t1\n\n\n2024-05-01\t10:00:01\t 2 \n",
+    "t;v\n1714557600;1,5\n 1714557601 ;\n",
+]
+
+
+def _csv_rows(path: Path) -> tuple[list[list[str]], list[int]]:
+    """Rows as the csv module splits them (the path :func:`load_rows` takes for quoted text)."""
+    import csv
+    import io
+
+    text = path.read_bytes().decode("utf-8-sig")
+    first = next(line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#"))
+    reader = csv.reader(io.StringIO(text), delimiter=max(",;\t", key=first.count), skipinitialspace=True)
+    rows, numbers = [], []
+    for row in reader:
+        if row and "".join(row).strip() and not row[0].lstrip().startswith("#"):
+            rows.append([cell.strip() for cell in row])
+            numbers.append(reader.line_num)
+    return rows, numbers
+
+
+@pytest.mark.parametrize("text", _ROW_TEXTS)
+def test_text_without_quotes_is_split_into_the_csv_modules_rows_and_lines(tmp_path, text):
+    from flightlogs.readers._anemometer_text import load_rows
+
+    path = tmp_path / "wind.csv"
+    path.write_bytes(text.encode())
+    assert load_rows(path) == _csv_rows(path)
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    cells=st.lists(
+        st.lists(st.sampled_from(["", " ", "1.5", "a b", "#x", " 2 ", "-", "10:00"]), min_size=1, max_size=4),
+        min_size=1,
+        max_size=8,
+    ),
+    ending=st.sampled_from(["\n", "\r\n"]),
+    delimiter=st.sampled_from([",", ";", "\t"]),
+)
+def test_any_unquoted_table_splits_as_the_csv_module_splits_it(tmp_path, cells, ending, delimiter):
+    from flightlogs.readers._anemometer_text import load_rows
+
+    path = tmp_path / "wind.csv"
+    header = delimiter.join(["utc", "speed", "direction"])
+    path.write_bytes((ending.join([header, *(delimiter.join(row) for row in cells)]) + ending).encode())
+    assert load_rows(path) == _csv_rows(path)
+
+
+def test_every_layout_of_the_test_data_reads_as_before():
+    """The files of tests/data/anemometer (quoted or not) give the csv module's rows."""
+    from flightlogs.readers._anemometer_text import load_rows
+
+    for path in sorted(DATA.glob("*.csv")):
+        assert load_rows(path) == _csv_rows(path), path.name
