@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,6 +20,9 @@ __all__ = ["Campaign", "ingest_campaign", "conditioned_campaign", "expand_wind_p
 
 #: Logs conditioned in worker processes up to this much in all: each worker sends its result back.
 _MAX_FORKED_BYTES = 256 * 2**20
+
+#: A log's conditioning: whether it was paired with wind, and its flight or why it has none.
+_Conditioned = tuple[bool, ConditionedFlight | DataError]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -149,12 +152,10 @@ def ingest_campaign(
     winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
     paired = pair_winds(logs, winds, clock_offset_s=options.wind_offset_s)
 
-    def condition(k: int) -> tuple[bool, ConditionedFlight | DataError]:
+    def condition(k: int) -> _Conditioned:
         return paired[k] is not None, _conditioned(logs[k], paired[k], options)
 
-    forked = sum(sizes) <= _MAX_FORKED_BYTES  # larger logs one at a time, each spread over the cores by trace
-    results = map_forked(condition, len(logs)) if forked else map(condition, range(len(logs)))
-    conditioned, notes = _collected(results)
+    conditioned, notes = _collected(_each(condition, sizes))
     return Campaign(logs=tuple(logs), winds=tuple(winds), conditioned=conditioned, notes=notes)
 
 
@@ -199,23 +200,27 @@ def conditioned_campaign(
     sizes = [_size(path) for path in log_paths]
     winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
 
-    def condition(k: int) -> tuple[bool, ConditionedFlight | DataError]:
+    def condition(k: int) -> _Conditioned:
         log = read_log(log_paths[k], reading=reading)
         wind = pair_winds([log], winds, clock_offset_s=options.wind_offset_s)[0]
         return wind is not None, _conditioned(log, wind, options)
 
-    def reported(
-        k: int, result: tuple[bool, ConditionedFlight | DataError]
-    ) -> tuple[bool, ConditionedFlight | DataError]:
+    def reported(k: int, result: _Conditioned) -> _Conditioned:
         if progress is not None:
             progress(Path(log_paths[k]).name, sum(sizes[: k + 1]), sum(sizes))
         return result
 
     if progress is not None and log_paths:
         progress(Path(log_paths[0]).name, 0, sum(sizes))
-    forked = sum(sizes) <= _MAX_FORKED_BYTES
-    results = map_forked(condition, len(log_paths)) if forked else map(condition, range(len(log_paths)))
-    return _required(*_collected(reported(k, result) for k, result in enumerate(results)))
+    return _required(*_collected(reported(k, result) for k, result in enumerate(_each(condition, sizes))))
+
+
+def _each(condition: Callable[[int], _Conditioned], sizes: Sequence[int]) -> Iterator[_Conditioned]:
+    """``condition(k)`` for each log, in order: on the cores while the logs (of `sizes` bytes) are small enough
+    to send their flights back; larger ones one at a time here, each spread over the cores by trace."""
+    if sum(sizes) <= _MAX_FORKED_BYTES:
+        return map_forked(condition, len(sizes))
+    return map(condition, range(len(sizes)))
 
 
 def _required(
@@ -242,7 +247,7 @@ def _conditioned(
 
 
 def _collected(
-    results: Iterable[tuple[bool, ConditionedFlight | DataError]],
+    results: Iterable[_Conditioned],
 ) -> tuple[tuple[ConditionedFlight | None, ...], tuple[tuple[str, ...], ...]]:
     """Each log's flight (None where it could not be conditioned) and notes, from ``(paired with wind, result)``.
 
