@@ -159,17 +159,25 @@ _SHARED: ContextVar[dict[tuple[int, ...], tuple[Sequence[Record], _DelayedWinds]
 )
 
 
+_SIMULATED: ContextVar[dict[tuple[object, ...], tuple[Record, np.ndarray, np.ndarray]] | None] = ContextVar(
+    "_SIMULATED", default=None
+)
+
+
 @contextmanager
 def sharing_delayed_winds() -> Iterator[None]:
-    """Within this, the wind step's fits of the same records (the same arrays) share their delayed winds.
+    """Within this, the wind step's fits of the same records (the same arrays) share their delayed winds, and
+    the states simulated for them.
 
-    :func:`speed_derivatives`, :func:`fit_wind` and the spreads scan the same delays on the same records;
-    the cache is freed on leaving.
+    :func:`speed_derivatives`, :func:`fit_wind` and the spreads scan the same delays on the same records, and
+    simulate the states the records lack (the actuator lags) from rows most of step 1's moves leave alone;
+    the caches are freed on leaving.
     """
-    token = _SHARED.set({})
+    token, simulated = _SHARED.set({}), _SIMULATED.set({})
     try:
         yield
     finally:
+        _SIMULATED.reset(simulated)
         _SHARED.reset(token)
 
 
@@ -235,12 +243,29 @@ def _prediction_data(
     signals = tuple(c.signal for c in structure.wind_inputs)
     residual = []
     for record in records:
-        x, u = _states(record, structure, plain, m)
+        x, u = _simulated_states(record, structure, plain, m)
         y = np.column_stack([record[o] for o in outputs])
         r = y - x @ m.c[rows].T - u @ m.d[rows].T
         residual.append(r - r.mean(axis=0))  # a bias per record (sensor bias, trim): not the wind's
     scale = 1.0 / np.maximum(np.vstack(residual).std(axis=0), 1e-12)
     return _Data(residual=residual, delayed=_delayed_winds(records, signals), signals=signals, rows=rows, scale=scale)
+
+
+def _simulated_states(
+    record: Record, structure: ModelStructure, plain: Assembler, m: SystemMatrices
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_states`, read-only, kept within :func:`sharing_delayed_winds` for the next fit of the same record
+    with the same rows of the states it lacks and the same input delays: all that the simulation reads."""
+    kept = _SIMULATED.get()
+    if kept is None:
+        return _states(record, structure, plain, m)
+    lacking = [k for k, s in enumerate(structure.states) if s not in record.signals]
+    key = (id(record), id(structure), m.delays.tobytes(), m.a[lacking].tobytes(), m.b[lacking].tobytes())
+    if key not in kept:  # the entry holds the record, so the id the key names outlives it
+        x, u = _states(record, structure, plain, m)
+        x.flags.writeable = u.flags.writeable = False
+        kept[key] = (record, x, u)
+    return kept[key][1], kept[key][2]
 
 
 def _states(

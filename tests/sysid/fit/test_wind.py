@@ -194,3 +194,34 @@ def test_the_speed_derivatives_without_bounds_are_those_with_them(records: list[
     assert alone[1].names == with_bounds[1].names and len(alone[1].names) > 2
     np.testing.assert_array_equal(alone[1].values, with_bounds[1].values)
     assert np.all(np.isfinite(with_bounds[1].cramer_rao)) and np.all(np.isinf(alone[1].cramer_rao))
+
+
+def test_the_wind_steps_fits_simulate_the_missing_states_again_only_when_their_rows_change(
+    records: list[Record], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Inside sharing_delayed_winds, a move of X_lon (the u row: u is recorded) reuses the actuator lags simulated;
+    a move of T_a (the lags' own rows) simulates them again; the residuals are those computed without sharing."""
+    import sysid.fit.wind as wind_module
+
+    structure = load_structure("hover-wind")
+    constants = structure.default_constants()
+    values = structure.values(dict(CALM_HOVER) | {"N_r": 0.0, "Z_w": 0.0})
+    moves = [values, values | {"X_lon": values["X_lon"] * 1.1}, values | {"T_a": values["T_a"] * 1.1}]
+    alone = [_prediction_data(structure, v, constants, records, ["ax", "az"]).residual for v in moves]
+    simulated = wind_module._states
+    calls: list[str] = []
+
+    def counted(record: Record, *args: object) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(record.label)
+        return simulated(record, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(wind_module, "_states", counted)
+    with sharing_delayed_winds():
+        shared = []
+        for v in moves:
+            shared.append(_prediction_data(structure, v, constants, records, ["ax", "az"]).residual)
+            calls.append("|")
+    assert calls == ["lon sweep", "thr sweep", "|", "|", "lon sweep", "thr sweep", "|"]
+    for before, after in zip(alone, shared):
+        for a, b in zip(before, after):
+            np.testing.assert_array_equal(a, b)
