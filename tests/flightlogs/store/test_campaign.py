@@ -4,18 +4,21 @@ from __future__ import annotations
 
 import os
 import warnings
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from flightlogs.conditioning.condition import ConditionedFlight, ConditioningOptions
-from flightlogs.errors import DataError, LogFormatError
+from flightlogs.errors import DataError, DataQualityWarning, LogFormatError
 from flightlogs.flightlog import FlightLog
 from flightlogs.parallel import worker_count
 from flightlogs.store.campaign import Campaign, conditioned_campaign, ingest_campaign
 from simulator.campaign.fly import plan_trials, run_scenario
 from simulator.campaign.scenario import load_builtin
+from simulator.flights.linear import simulate_hover
+from simulator.output.px4 import write_px4_log
 
 
 def test_no_conditioned_flight_names_each_logs_reason() -> None:
@@ -120,12 +123,28 @@ def test_the_logs_are_read_in_the_workers_and_the_progress_counts_each_once(
     ]
 
 
-def test_a_log_that_cannot_be_read_is_named_and_none_conditioned_gives_each_reason(tmp_path: Path) -> None:
+def test_a_log_that_cannot_be_read_is_named(tmp_path: Path) -> None:
     broken = tmp_path / "broken.ulg"
     broken.write_bytes(b"not a log at all" * 64)
     with pytest.raises(LogFormatError, match="broken.ulg"):
         conditioned_campaign([broken])
-    short = tmp_path / "short.csv"
-    short.write_text("time_s,q\n0.0,0.1\n0.01,0.2\n")
-    with pytest.raises((DataError, LogFormatError), match="short.csv"):
-        conditioned_campaign([short])
+
+
+def test_a_log_too_short_to_condition_is_left_out_with_its_reason(real_data: Path, tmp_path: Path) -> None:
+    """Read in a worker but not conditioned (1.5 s of flight, under the 2 s a record needs): a warning and the
+    others kept; alone, the one sentence that gives its reason."""
+    flight = simulate_hover(1.5, (), rate_hz=25.0, substeps=2, seed=3)
+    short = write_px4_log(flight, tmp_path / "short.ulg", utc_start=datetime(2025, 5, 1, 10, tzinfo=UTC))
+    good = real_data / "dronekit-la-testdata" / "log171.bin"
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        kept = conditioned_campaign([short, good])
+    assert [f.source.name for f in kept] == [good.name]
+    assert any(
+        isinstance(w.message, DataQualityWarning) and str(w.message).startswith(f"not conditioned: {short}")
+        for w in seen
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(DataError, match=r"^no log could be conditioned \(not conditioned: .*short\.ulg"):
+            conditioned_campaign([short])
