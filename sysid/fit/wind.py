@@ -74,6 +74,8 @@ __all__ = [
 WindStatus = Literal["estimated", "dropped", "unidentified"]
 
 _SCAN_STEP_S = 0.002
+_LONGEST_SCAN_S = 1.0  # the longest wind delay the scans of the G_w fit reach, s
+_LONGEST_JOINT_SCAN_S = 0.5  # the longest the scans of the speed derivatives' joint solution reach, s
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -137,6 +139,9 @@ class _DelayedWinds:
         self.winds = {s: [record[s] for record in records] for s in signals}
         self.ends = np.cumsum([t.size for t in self.times])[:-1]
         self._cache: dict[tuple[str, float], np.ndarray] = {}
+        steps = [(t[-1] - t[0]) / (t.size - 1) if t.size > 1 else 0.0 for t in self.times]
+        uniform = all(dt > 0 and np.max(np.abs(np.diff(t) - dt)) <= 1e-9 * dt for t, dt in zip(self.times, steps))
+        self.steps = np.array(steps) if uniform else None  # (n_records,), s: None unless every record is uniform
 
     def stacked(self, signal: str, tau: float) -> np.ndarray:
         """`signal` delayed by `tau` (s), shape (n_samples,), read-only."""
@@ -153,6 +158,70 @@ class _DelayedWinds:
 
 #: Bytes of delayed winds kept: a scan's grids of two channels (about 140 delays) at 100 000 samples.
 _CACHE_BYTES = 160 * 2**20
+
+
+class _LagProducts:
+    """Products of each wind channel's delayed signal (:meth:`_DelayedWinds.stacked`) with fixed columns, at any
+    delay, from their products at whole-sample lags.
+
+    Within a uniformly sampled record, ``np.interp`` delays the wind by ``tau = (m + f) dt`` as ``1 - f``
+    times the wind delayed by m whole samples plus f times it delayed by m + 1, the first sample held before
+    the record, and its mean is the same blend of theirs; so are its products with the columns. Those of
+    every whole lag up to `longest_s` are computed at once (:func:`_whole_lag_products`), the records read
+    once, and a delay scan's point costs no pass over the columns. They equal the delayed winds' products to
+    rounding (np.interp's weights come from the sample times). Records not uniformly sampled, and negative
+    delays, take the delayed winds' products.
+
+    Parameters
+    ----------
+    delayed : _DelayedWinds
+        The records' winds.
+    signals : sequence of str
+        The signal of each wind channel.
+    fixed : ndarray, shape (n_samples, n_columns)
+        The columns, the records end to end.
+    longest_s : float
+        The longest delay expected, s (longer ones double the lags computed).
+    """
+
+    def __init__(self, delayed: _DelayedWinds, signals: Sequence[str], fixed: np.ndarray, longest_s: float) -> None:
+        self.delayed, self.signals, self.fixed, self.longest_s = delayed, list(signals), fixed, longest_s
+        self.pieces = np.split(fixed, delayed.ends)
+        self.tables: dict[str, np.ndarray] = {}  # by signal: (n_records, n_lags, n_columns)
+
+    def __call__(self, k: int, tau: float) -> np.ndarray:
+        """``stacked(signal of channel k, tau) @ fixed``, shape (n_columns,)."""
+        signal, steps = self.signals[k], self.delayed.steps
+        if steps is None or tau < 0:
+            direct: np.ndarray = self.delayed.stacked(signal, tau) @ self.fixed
+            return direct
+        position = tau / steps  # (n_records,): whole lag and fraction in each record
+        lag = np.floor(position).astype(int)
+        fraction = (position - lag)[:, None]
+        table = self.tables.get(signal)
+        if table is None or table.shape[1] < lag.max() + 2:
+            lags = int(np.max(np.ceil(self.longest_s / steps))) if table is None else 2 * table.shape[1]
+            pieces = zip(self.delayed.winds[signal], self.pieces)
+            table = np.array([_whole_lag_products(w, f, max(lags, int(lag.max()) + 1)) for w, f in pieces])
+            self.tables[signal] = table
+        records = np.arange(lag.size)
+        blend: np.ndarray = np.sum((1.0 - fraction) * table[records, lag] + fraction * table[records, lag + 1], axis=0)
+        return blend
+
+
+def _whole_lag_products(wind: np.ndarray, fixed: np.ndarray, lags: int) -> np.ndarray:
+    """Products of `wind` delayed by 0 to `lags` whole samples (its first sample held before it, as np.interp
+    holds it), each less its mean, with `fixed`'s columns (n_samples, n_columns): shape (lags + 1, n_columns)."""
+    n = wind.size
+    centred = wind - wind.mean()  # a constant changes no delayed wind less its mean
+    held = np.concatenate([np.full(lags, centred[0]), centred])
+    rows = np.ascontiguousarray(np.lib.stride_tricks.sliding_window_view(held, n)[::-1])  # row m: m samples late
+    sums = np.concatenate([[0.0], np.cumsum(centred)])  # sums[j]: of the first j samples
+    m = np.arange(lags + 1)
+    means = (sums[np.maximum(n - m, 0)] + np.minimum(m, n) * centred[0]) / n
+    table: np.ndarray = rows @ fixed - np.outer(means, fixed.sum(axis=0))
+    return table
+
 
 _SHARED: ContextVar[dict[tuple[int, ...], tuple[Sequence[Record], _DelayedWinds]] | None] = ContextVar(
     "_SHARED", default=None
@@ -348,6 +417,25 @@ class _Problem:
         """Wind channel `k` delayed by `tau`, each record's mean taken out, the records end to end, shape (n,)."""
         return self.data.delayed.stacked(self.data.signals[k], tau)
 
+    def products(self, fixed: np.ndarray, longest_s: float) -> _LagProducts:
+        """The products of each wind channel, delayed up to about `longest_s`, with `fixed` (n_samples, n_columns):
+        ``(k, tau) -> (n_columns,)``."""
+        return _LagProducts(self.data.delayed, self.data.signals, fixed, longest_s)
+
+    def gram(self, delays: np.ndarray) -> np.ndarray:
+        """Inner products of the wind channels delayed by `delays`, s, shape (n_wind, n_wind).
+
+        From the delayed winds themselves: tabulating them at whole lags, as :class:`_LagProducts` does the
+        products with fixed columns, cost the 60-sweep fit as much as it saved (a table of 100 by 100 lags
+        per record).
+        """
+        winds = [self.stacked(k, tau) for k, tau in enumerate(delays)]
+        out = np.empty((len(winds), len(winds)))
+        for k, a in enumerate(winds):
+            for j in range(k, len(winds)):
+                out[k, j] = out[j, k] = a @ winds[j]
+        return out
+
     def parts(self, theta: np.ndarray) -> tuple[SystemMatrices, list[np.ndarray]]:
         m = self.assembler.matrices(theta)
         delays = m.delays[self.columns]
@@ -381,18 +469,28 @@ class _Normal:
         self.weight = problem.data.scale**2
         self.residual = np.vstack(problem.data.residual)
         self._residual_squares = np.einsum("nr,nr->r", self.residual, self.residual)  # (n_out,): the scans reuse it
+        self._on_residual = problem.products(self.residual, _LONGEST_SCAN_S)
 
     def solve(self, theta: np.ndarray) -> tuple[np.ndarray, float]:
-        """Least-squares gains at the delays of `theta` (entries linear in their gains) and the cost."""
+        """Least-squares gains at the delays of `theta` (entries linear in their gains) and the cost.
+
+        The winds' products come from their products at whole-sample lags (:class:`_LagProducts`): a scan's
+        points cost no pass over the residual.
+        """
         delays = self.problem.assembler.matrices(theta).delays[self.problem.columns]
-        winds = np.column_stack([self.problem.stacked(k, tau) for k, tau in enumerate(delays)])
-        return self.solve_for(theta, winds, self.residual)
+        cross = np.array([self._on_residual(k, tau) for k, tau in enumerate(delays)])
+        return self._solved(theta, self.problem.gram(delays), cross, self._residual_squares)
 
     def solve_for(self, theta: np.ndarray, winds: np.ndarray, residual: np.ndarray) -> tuple[np.ndarray, float]:
         """As :meth:`solve`, with the delayed winds (n, n_wind) and the residual (n, n_out) given."""
-        gram = winds.T @ winds  # (n_wind, n_wind)
-        cross = winds.T @ residual  # (n_wind, n_out)
         rr = self._residual_squares if residual is self.residual else np.einsum("nr,nr->r", residual, residual)
+        return self._solved(theta, winds.T @ winds, winds.T @ residual, rr)
+
+    def _solved(
+        self, theta: np.ndarray, gram: np.ndarray, cross: np.ndarray, rr: np.ndarray
+    ) -> tuple[np.ndarray, float]:
+        """The gains and cost from the winds' inner products (n_wind, n_wind), their products with the residual
+        (n_wind, n_out) and the residual's squares per output (n_out,)."""
         # target per output: residual - w d0^T; regressor g per output: w e_g^T
         tt = rr - 2 * np.einsum("rc,cr->r", self.d0, cross) + np.einsum("rc,cd,rd->r", self.d0, gram, self.d0)
         out = theta.copy()
@@ -425,7 +523,7 @@ def _scan(problem: _Problem) -> np.ndarray:
     for _ in range(_rounds(len(delays))):
         for k in delays:
             p = problem.structure.parameter(problem.free[k])
-            lo, hi = max(p.lower, 0.0), min(p.upper, 1.0)
+            lo, hi = max(p.lower, 0.0), min(p.upper, _LONGEST_SCAN_S)
             for grid in (np.arange(lo, hi + 1e-12, 5 * _SCAN_STEP_S), None):
                 points = np.clip(theta[k] + np.arange(-5, 6) * _SCAN_STEP_S, lo, hi) if grid is None else grid
                 for tau in points:
@@ -744,6 +842,7 @@ class _Joint:
         self.speed_residual = self._inner(self.speeds, [self.residual])[:, 0]
         self.instrument_residual = self._inner(self.instruments, [self.residual])[:, 0]
         self.residual_residual = float(self._inner([self.residual], [self.residual])[0, 0])
+        self._on_fixed: _LagProducts | None = None
 
     def _inner(self, a: Sequence[np.ndarray], b: Sequence[np.ndarray]) -> np.ndarray:
         return np.array([[float(np.einsum("nr,nr,r->", x, y, self.weight)) for y in b] for x in a]).reshape(
@@ -752,9 +851,21 @@ class _Joint:
 
     def solve(self, wind: np.ndarray) -> tuple[float, np.ndarray]:
         """Cost (weighted residual sum of squares) and solution ``[speed changes, gains]`` for the winds (n, n_wind)."""
+        return self._solved(wind.T @ wind, wind.T @ self.fixed)
+
+    def solve_at(self, problem: _Problem, delays: np.ndarray) -> tuple[float, np.ndarray]:
+        """As :meth:`solve`, for `problem`'s winds delayed by `delays` (n_wind,), s: from their products at whole
+        lags (:class:`_LagProducts`), which a scan's points share."""
+        if self._on_fixed is None:
+            self._on_fixed = problem.products(self.fixed, _LONGEST_JOINT_SCAN_S)
+        cross = np.array([self._on_fixed(k, tau) for k, tau in enumerate(delays)])
+        return self._solved(problem.gram(delays), cross)
+
+    def _solved(self, gram: np.ndarray, products: np.ndarray) -> tuple[float, np.ndarray]:
+        """:meth:`solve` from the winds' inner products (n_wind, n_wind) and their products with the fixed
+        columns (n_wind, n_fixed n_out)."""
         e, d0, w, k = self.normal.e, self.normal.d0, self.weight, self.n_speed
-        gram = wind.T @ wind  # (n_wind, n_wind)
-        cross = (wind.T @ self.fixed).reshape(wind.shape[1], self.n_fixed, self.n_out).transpose(1, 0, 2)
+        cross = products.reshape(gram.shape[0], self.n_fixed, self.n_out).transpose(1, 0, 2)
         on_speeds, on_instruments, on_residual = cross[:k], cross[k : 2 * k], cross[2 * k]
         # <A, G_g> = sum_r w_r e_g[r, c] <A[:, r], wind[:, c]>; <A, T> = <A, res> - sum_r w_r d0[r, c] <A[:, r], wind[:, c]>
         speed_gain = np.einsum("r,grc,fcr->fg", w, e, on_speeds)
@@ -896,11 +1007,17 @@ def speed_derivatives(
     lagged = _lagged_wind(problem) if speeds else np.zeros((0, 0))
     joint = _Joint(normal, data, speeds, [_projected(c, lagged) for c in speeds])
 
-    def solved(at: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-        """Cost and solution at the wind delays of `at`, and the delayed winds (n_samples, n_wind)."""
-        delays = problem.assembler.matrices(at).delays[problem.columns]
-        wind = np.column_stack([problem.stacked(k, tau) for k, tau in enumerate(delays)])
-        return (*joint.solve(wind), wind)
+    def winds(at: np.ndarray) -> np.ndarray:
+        """The winds delayed as `at` says, shape (n_samples, n_wind)."""
+        taus = problem.assembler.matrices(at).delays[problem.columns]
+        return np.column_stack([problem.stacked(k, tau) for k, tau in enumerate(taus)])
+
+    def solved(at: np.ndarray) -> tuple[float, np.ndarray]:
+        """Cost and solution at the wind delays of `at`: a scan's point (:meth:`_Joint.solve_at`), or the one
+        solution at given delays."""
+        if delays is not None:
+            return joint.solve(winds(at))
+        return joint.solve_at(problem, problem.assembler.matrices(at).delays[problem.columns])
 
     # u carries the wind undelayed: the split between X_u and X_w_lon follows the wind delay, so it is scanned,
     # every 10 ms then every 2 ms about the best
@@ -911,7 +1028,7 @@ def speed_derivatives(
     for _ in range(0 if delays is not None else _rounds(len(delay_index))):
         for k in delay_index:
             p = structure.parameter(problem.free[k])
-            lo, hi = max(p.lower, 0.0), min(p.upper, 0.5)
+            lo, hi = max(p.lower, 0.0), min(p.upper, _LONGEST_JOINT_SCAN_S)
             for grid in (np.arange(lo, hi + 1e-12, 5 * _SCAN_STEP_S), None):
                 points = np.clip(at[k] + np.arange(-5, 6) * _SCAN_STEP_S, lo, hi) if grid is None else grid
                 for tau in points:
@@ -920,11 +1037,11 @@ def speed_derivatives(
                     cost = solved(trial)[0]
                     if cost < best:
                         at, best = trial, cost
-    _, solution, wind = solved(at)
+    _, solution = solved(at)
     labels = tuple(free[k] for k in chosen) + tuple(problem.free[g] for g in gains)
     estimates = np.concatenate([theta[chosen] + solution[: len(chosen)], solution[len(chosen) :]])
     if with_accuracy:
-        after, design = joint.explicit(wind, solution)
+        after, design = joint.explicit(winds(at), solution)
         acc = accuracy(design / math.sqrt(residual_inflation(after)), estimates, labels)
     else:  # the values alone: no information, every bound infinite
         acc = accuracy(np.zeros((1, len(labels))), estimates, labels)

@@ -15,7 +15,17 @@ from simulator.autopilot.excitation import Maneuver
 from simulator.flights.linear import WindField, simulate_hover
 from simulator.vehicle.identified import CALM_HOVER, STRONG_WIND_TERMS
 from sysid.fit import FrequencyFit, fit_frequency_responses, fit_wind, model_from_fit, synthetic_responses
-from sysid.fit.wind import _prediction_data, sharing_delayed_winds, speed_derivatives, unfitted_wind
+from sysid.fit.wind import (
+    _gains_problem,
+    _Joint,
+    _lagged_wind,
+    _prediction_data,
+    _projected,
+    _with_wind_defaults,
+    sharing_delayed_winds,
+    speed_derivatives,
+    unfitted_wind,
+)
 from sysid.model import ModelStructure, load_structure, structure_model
 
 CONTROLS = ("X_lon", "M_lon", "Y_lat", "L_lat", "N_yaw", "Z_thr")
@@ -123,6 +133,33 @@ def test_fits_of_the_same_records_share_their_delayed_winds_and_give_what_each_g
     np.testing.assert_array_equal(delayed[: t.size], expected - expected.mean())
     assert not delayed.flags.writeable
     assert data(records).delayed is not shared  # freed on leaving
+
+
+def test_the_scans_solutions_from_whole_lag_products_are_those_of_the_delayed_winds(records: list[Record]) -> None:
+    """The delay scans solve the gains (and the speed derivatives beside them) from products at whole lags
+    (:class:`~sysid.fit.wind._LagProducts`): at any delays, the solutions of the delayed winds themselves."""
+    structure = load_structure("hover-wind")
+    values = _with_wind_defaults(structure, structure.values(dict(CALM_HOVER) | {"N_r": 0.0, "Z_w": 0.0}))
+    constants = structure.default_constants()
+    data = _prediction_data(structure, values, constants, records, ["ax", "az"])
+    problem, normal, delay_index, _ = _gains_problem(structure, values, constants, data)
+    u = np.concatenate([r["u"] - r["u"].mean() for r in records])
+    speeds = [np.column_stack([u, 0.3 * u])]
+    joint = _Joint(normal, data, speeds, [_projected(c, _lagged_wind(problem)) for c in speeds])
+    assert len(delay_index) == 2
+    for taus in ((0.0, 0.0), (0.013, 0.2371), (0.5, 0.0049), (0.999, 0.61)):
+        theta = problem.start.copy()
+        theta[delay_index] = taus
+        delays = problem.assembler.matrices(theta).delays[problem.columns]
+        winds = np.column_stack([problem.stacked(k, tau) for k, tau in enumerate(delays)])
+        gains, cost = normal.solve(theta)
+        expected_gains, expected_cost = normal.solve_for(theta, winds, normal.residual)
+        np.testing.assert_allclose(gains, expected_gains, rtol=1e-10, atol=0)
+        assert abs(cost - expected_cost) <= 1e-10 * expected_cost
+        joint_cost, solution = joint.solve_at(problem, delays)
+        expected_joint_cost, expected_solution = joint.solve(winds)
+        np.testing.assert_allclose(solution, expected_solution, rtol=1e-9, atol=0)
+        assert abs(joint_cost - expected_joint_cost) <= 1e-10 * expected_joint_cost
 
 
 def test_records_without_wind_are_refused(records: list[Record]) -> None:
