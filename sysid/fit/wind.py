@@ -169,8 +169,8 @@ class _LagProducts:
     the record, and its mean is the same blend of theirs; so are its products with the columns. Those of
     every whole lag up to `longest_s` are computed at once (:func:`_whole_lag_products`), the records read
     once, and a delay scan's point costs no pass over the columns. They equal the delayed winds' products to
-    rounding (np.interp's weights come from the sample times). Records not uniformly sampled, and negative
-    delays, take the delayed winds' products.
+    rounding (np.interp's weights come from the sample times). Records not uniformly sampled, negative
+    delays and those of :data:`_MOST_WHOLE_LAGS` samples or more take the delayed winds' products.
 
     Parameters
     ----------
@@ -192,7 +192,7 @@ class _LagProducts:
     def __call__(self, k: int, tau: float) -> np.ndarray:
         """``stacked(signal of channel k, tau) @ fixed``, shape (n_columns,)."""
         signal, steps = self.signals[k], self.delayed.steps
-        if steps is None or tau < 0:
+        if steps is None or tau < 0 or tau >= _MOST_WHOLE_LAGS * np.min(steps):
             direct: np.ndarray = self.delayed.stacked(signal, tau) @ self.fixed
             return direct
         position = tau / steps  # (n_records,): whole lag and fraction in each record
@@ -201,8 +201,8 @@ class _LagProducts:
         table = self.tables.get(signal)
         if table is None or table.shape[1] < lag.max() + 2:
             lags = int(np.max(np.ceil(self.longest_s / steps))) if table is None else 2 * table.shape[1]
-            pieces = zip(self.delayed.winds[signal], self.pieces)
-            table = np.array([_whole_lag_products(w, f, max(lags, int(lag.max()) + 1)) for w, f in pieces])
+            lags = min(max(lags, int(lag.max()) + 1), _MOST_WHOLE_LAGS)
+            table = np.array([_whole_lag_products(w, f, lags) for w, f in zip(self.delayed.winds[signal], self.pieces)])
             self.tables[signal] = table
         records = np.arange(lag.size)
         blend: np.ndarray = np.sum((1.0 - fraction) * table[records, lag] + fraction * table[records, lag + 1], axis=0)
@@ -215,12 +215,20 @@ def _whole_lag_products(wind: np.ndarray, fixed: np.ndarray, lags: int) -> np.nd
     n = wind.size
     centred = wind - wind.mean()  # a constant changes no delayed wind less its mean
     held = np.concatenate([np.full(lags, centred[0]), centred])
-    rows = np.ascontiguousarray(np.lib.stride_tricks.sliding_window_view(held, n)[::-1])  # row m: m samples late
+    table = np.zeros((lags + 1, fixed.shape[1]))
+    for start in range(0, n, _WHOLE_LAG_BLOCK):  # (lags + 1, block) delayed winds at a time
+        stop = min(start + _WHOLE_LAG_BLOCK, n)
+        rows = np.lib.stride_tricks.sliding_window_view(held[start : stop + lags], stop - start)[::-1]
+        table += np.ascontiguousarray(rows) @ fixed[start:stop]  # row m: the samples m late
     sums = np.concatenate([[0.0], np.cumsum(centred)])  # sums[j]: of the first j samples
     m = np.arange(lags + 1)
     means = (sums[np.maximum(n - m, 0)] + np.minimum(m, n) * centred[0]) / n
-    table: np.ndarray = rows @ fixed - np.outer(means, fixed.sum(axis=0))
+    table -= np.outer(means, fixed.sum(axis=0))
     return table
+
+
+_MOST_WHOLE_LAGS = 256  # whole lags tabulated at most: a scan of longer delays (a fast log) has fewer points
+_WHOLE_LAG_BLOCK = 16_384  # samples of a record's delayed winds built at once (13 MiB at 100 lags)
 
 
 _SHARED: ContextVar[dict[tuple[int, ...], tuple[Sequence[Record], _DelayedWinds]] | None] = ContextVar(

@@ -1,8 +1,9 @@
 """The delay scans' products of the delayed winds, from their products at whole-sample lags (:class:`_LagProducts`).
 
 They must be the products of the winds np.interp delays (:meth:`_DelayedWinds.stacked`) at every delay a
-scan reaches: between samples, on a sample, past a record's length and past the lags computed first; records
-not uniformly sampled take the delayed winds themselves.
+scan reaches: between samples, on a sample, past a record's length and past the lags computed first, in
+records longer than a block; records not uniformly sampled, and delays past the lags ever tabulated, take the
+delayed winds themselves.
 """
 
 from __future__ import annotations
@@ -37,29 +38,20 @@ def _fixed(n: int, seed: int) -> np.ndarray:
     return fixed
 
 
-@pytest.mark.parametrize("lengths", [(250, 517, 1000), (3387,) * 4])
+@pytest.mark.parametrize("lengths", [(250, 517, 1000), (3387,) * 4, (17_000, 300)])  # the last: past a block
 def test_the_products_are_those_of_the_delayed_winds(lengths: tuple[int, ...]) -> None:
     delayed = _DelayedWinds(_records(lengths, 1), ("wind_lon", "wind_lat"))
     fixed = _fixed(sum(lengths), 2)
     products = _LagProducts(delayed, ("wind_lon", "wind_lat", "wind_lon"), fixed, longest_s=0.5)
-    taus = [
-        0.0,
-        0.01,
-        0.0137,
-        0.25,
-        0.4999,
-        0.5,
-        0.73,
-        1.9,
-        2.5,
-        6.0,
-    ]  # on and between samples, past 0.5 s and a record
+    taus = [0.0, 0.01, 0.0137, 0.25, 0.4999, 0.5, 0.73, 1.9, 2.5]  # on and between samples, past 0.5 s, a record
     for k in range(3):
         for tau in taus:
             direct = delayed.stacked(products.signals[k], tau) @ fixed
             scale = np.linalg.norm(delayed.stacked(products.signals[k], tau)) * np.linalg.norm(fixed, axis=0)
             np.testing.assert_allclose(products(k, tau), direct, rtol=0, atol=1e-12 * scale.max())
-    assert products.tables["wind_lon"].shape[1] > 250  # 6 s reached: the lags were computed again, further
+        assert products.tables[products.signals[k]].shape[1] == 257  # 2.5 s reached: computed again, to the most
+        beyond = delayed.stacked(products.signals[k], 6.0) @ fixed  # 600 lags: not tabulated
+        np.testing.assert_array_equal(products(k, 6.0), beyond)
 
 
 def test_records_not_uniformly_sampled_take_the_delayed_winds() -> None:
