@@ -240,8 +240,7 @@ def _one_pass(
             f"{log.path}: no stretch of at least {options.min_record_s:g} s where every core signal has data"
         )
     values = resample_signals(cut_by | others, time_base, max_gap_samples=options.max_gap_samples)
-    rates = {name: signal.rate_hz for name, signal in others.items()}  # each once: the median of its intervals
-    holds = {name: 1.5 / rate for name, rate in rates.items() if rate > 0}
+    holds = {name: 1.5 / rate for name, signal in others.items() if (rate := signal.rate_hz) > 0}  # rate read once
     for name in others:
         _hold_edges(values[name], time_base, holds.get(name, 0.0))
     if "excitation" in values:  # logged only while a System ID run injects it: zero elsewhere

@@ -5,6 +5,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from itertools import accumulate
 from pathlib import Path
 
 from flightlogs._memory import give_back_freed_memory
@@ -198,6 +199,7 @@ def conditioned_campaign(
         As :func:`ingest_campaign`.
     """
     sizes = [_size(path) for path in log_paths]
+    done, total = list(accumulate(sizes)), sum(sizes)  # bytes after each log, of all
     winds = [read_anemometer_csv(path, columns=columns) for path in expand_wind_paths(wind_paths)]
 
     def condition(k: int) -> _Conditioned:
@@ -207,11 +209,11 @@ def conditioned_campaign(
 
     def reported(k: int, result: _Conditioned) -> _Conditioned:
         if progress is not None:
-            progress(Path(log_paths[k]).name, sum(sizes[: k + 1]), sum(sizes))
+            progress(Path(log_paths[k]).name, done[k], total)
         return result
 
     if progress is not None and log_paths:
-        progress(Path(log_paths[0]).name, 0, sum(sizes))
+        progress(Path(log_paths[0]).name, 0, total)
     return _required(*_collected(reported(k, result) for k, result in enumerate(_each(condition, sizes))))
 
 

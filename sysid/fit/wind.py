@@ -425,6 +425,15 @@ class _Problem:
         """Wind channel `k` delayed by `tau`, each record's mean taken out, the records end to end, shape (n,)."""
         return self.data.delayed.stacked(self.data.signals[k], tau)
 
+    def wind_delays(self, theta: np.ndarray) -> np.ndarray:
+        """Each wind channel's delay at the free values `theta`, s, shape (n_wind,)."""
+        delays: np.ndarray = self.assembler.matrices(theta).delays[self.columns]
+        return delays
+
+    def winds(self, theta: np.ndarray) -> np.ndarray:
+        """The wind channels delayed as `theta` says, records end to end, shape (n_samples, n_wind)."""
+        return np.column_stack([self.stacked(k, tau) for k, tau in enumerate(self.wind_delays(theta))])
+
     def products(self, fixed: np.ndarray, longest_s: float) -> _LagProducts:
         """The products of each wind channel, delayed up to about `longest_s`, with `fixed` (n_samples, n_columns):
         ``(k, tau) -> (n_columns,)``."""
@@ -485,7 +494,7 @@ class _Normal:
         The winds' products come from their products at whole-sample lags (:class:`_LagProducts`): a scan's
         points cost no pass over the residual.
         """
-        delays = self.problem.assembler.matrices(theta).delays[self.problem.columns]
+        delays = self.problem.wind_delays(theta)
         cross = np.array([self._on_residual(k, tau) for k, tau in enumerate(delays)])
         return self._solved(theta, self.problem.gram(delays), cross, self._residual_squares)
 
@@ -861,9 +870,10 @@ class _Joint:
         """Cost (weighted residual sum of squares) and solution ``[speed changes, gains]`` for the winds (n, n_wind)."""
         return self._solved(wind.T @ wind, wind.T @ self.fixed)
 
-    def solve_at(self, problem: _Problem, delays: np.ndarray) -> tuple[float, np.ndarray]:
-        """As :meth:`solve`, for `problem`'s winds delayed by `delays` (n_wind,), s: from their products at whole
-        lags (:class:`_LagProducts`), which a scan's points share."""
+    def solve_at(self, delays: np.ndarray) -> tuple[float, np.ndarray]:
+        """As :meth:`solve`, for the winds of the normal equations' problem delayed by `delays` (n_wind,), s:
+        from their products at whole lags (:class:`_LagProducts`), which a scan's points share."""
+        problem = self.normal.problem
         if self._on_fixed is None:
             self._on_fixed = problem.products(self.fixed, _LONGEST_JOINT_SCAN_S)
         cross = np.array([self._on_fixed(k, tau) for k, tau in enumerate(delays)])
@@ -1015,17 +1025,12 @@ def speed_derivatives(
     lagged = _lagged_wind(problem) if speeds else np.zeros((0, 0))
     joint = _Joint(normal, data, speeds, [_projected(c, lagged) for c in speeds])
 
-    def winds(at: np.ndarray) -> np.ndarray:
-        """The winds delayed as `at` says, shape (n_samples, n_wind)."""
-        taus = problem.assembler.matrices(at).delays[problem.columns]
-        return np.column_stack([problem.stacked(k, tau) for k, tau in enumerate(taus)])
-
     def solved(at: np.ndarray) -> tuple[float, np.ndarray]:
         """Cost and solution at the wind delays of `at`: a scan's point (:meth:`_Joint.solve_at`), or the one
         solution at given delays."""
         if delays is not None:
-            return joint.solve(winds(at))
-        return joint.solve_at(problem, problem.assembler.matrices(at).delays[problem.columns])
+            return joint.solve(problem.winds(at))
+        return joint.solve_at(problem.wind_delays(at))
 
     # u carries the wind undelayed: the split between X_u and X_w_lon follows the wind delay, so it is scanned,
     # every 10 ms then every 2 ms about the best
@@ -1049,7 +1054,7 @@ def speed_derivatives(
     labels = tuple(free[k] for k in chosen) + tuple(problem.free[g] for g in gains)
     estimates = np.concatenate([theta[chosen] + solution[: len(chosen)], solution[len(chosen) :]])
     if with_accuracy:
-        after, design = joint.explicit(winds(at), solution)
+        after, design = joint.explicit(problem.winds(at), solution)
         acc = accuracy(design / math.sqrt(residual_inflation(after)), estimates, labels)
     else:  # the values alone: no information, every bound infinite
         acc = accuracy(np.zeros((1, len(labels))), estimates, labels)

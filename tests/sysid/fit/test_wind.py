@@ -150,13 +150,12 @@ def test_the_scans_solutions_from_whole_lag_products_are_those_of_the_delayed_wi
     for taus in ((0.0, 0.0), (0.013, 0.2371), (0.5, 0.0049), (0.999, 0.61)):
         theta = problem.start.copy()
         theta[delay_index] = taus
-        delays = problem.assembler.matrices(theta).delays[problem.columns]
-        winds = np.column_stack([problem.stacked(k, tau) for k, tau in enumerate(delays)])
+        delays, winds = problem.wind_delays(theta), problem.winds(theta)
         gains, cost = normal.solve(theta)
         expected_gains, expected_cost = normal.solve_for(theta, winds, normal.residual)
         np.testing.assert_allclose(gains, expected_gains, rtol=1e-10, atol=0)
         assert abs(cost - expected_cost) <= 1e-10 * expected_cost
-        joint_cost, solution = joint.solve_at(problem, delays)
+        joint_cost, solution = joint.solve_at(delays)
         expected_joint_cost, expected_solution = joint.solve(winds)
         np.testing.assert_allclose(solution, expected_solution, rtol=1e-9, atol=0)
         assert abs(joint_cost - expected_joint_cost) <= 1e-10 * expected_joint_cost
