@@ -6,7 +6,14 @@ import numpy as np
 
 _CHUNK = 1 << 16  # samples rotated at a time
 
-__all__ = ["quaternion_to_euler", "earth_to_body", "euler_rates_to_body", "air_velocity_body", "wind_to_body_axes"]
+__all__ = [
+    "quaternion_to_euler",
+    "earth_to_body",
+    "euler_rates_to_body",
+    "air_velocity_body",
+    "air_velocity_per_wind",
+    "wind_to_body_axes",
+]
 
 
 def quaternion_to_euler(quaternion: np.ndarray) -> np.ndarray:
@@ -151,6 +158,39 @@ def air_velocity_body(
     relative = np.asarray(velocity_ned, dtype=np.float64).copy()
     relative[:, :2] -= wind_ne
     return earth_to_body(relative, phi, theta, psi)
+
+
+def air_velocity_per_wind(phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> np.ndarray:
+    """How the body-axis air velocity of eq. 3.1 answers the wind: ``d(u, v, w) / d(wind_n, wind_e)``.
+
+    Minus the first two columns of ``R_i^b``: :func:`air_velocity_body` is linear in the wind, so a change
+    ``dW`` of it (n_samples, 2) changes ``u v w`` by ``einsum("nij,nj->ni", air_velocity_per_wind(...), dW)``,
+    without rotating anything again.
+
+    Parameters
+    ----------
+    phi, theta, psi : ndarray, shape (n_samples,)
+        Euler angles, rad.
+
+    Returns
+    -------
+    ndarray, shape (n_samples, 3, 2)
+        Per sample, the change of ``u v w`` (m/s) per m/s of north wind (column 0) and of east wind (column 1).
+
+    Examples
+    --------
+    Nose east, a north wind blows from the left: the air comes at the vehicle from its right, v = +1 per m/s.
+
+    >>> air_velocity_per_wind(np.zeros(1), np.zeros(1), np.array([np.pi / 2]))[0].round(12)
+    array([[-0., -1.],
+           [ 1., -0.],
+           [-0., -0.]])
+    """
+    out = np.empty((np.size(psi), 3, 2))
+    for lo in range(0, out.shape[0], _CHUNK):  # a block of (n, 3, 3) matrices at a time
+        part = slice(lo, lo + _CHUNK)
+        out[part] = -_earth_to_body_matrices(*(np.asarray(a)[part] for a in (phi, theta, psi)))[:, :, :2]
+    return out
 
 
 def wind_to_body_axes(wind_ne: np.ndarray, psi: np.ndarray) -> np.ndarray:

@@ -127,7 +127,7 @@ class Interpolant:
     """One interpolant on knots `t` (n,) evaluated at points `at` (m,) inside [t[0], t[-1]], for any columns.
 
     The columns of one log message share their times: the spline's system is factored and the points
-    located once, and each column is then solved and evaluated alone (no (n, k) working arrays).
+    located once, and the columns are then solved and evaluated a block at a time.
 
     Parameters
     ----------
@@ -148,16 +148,19 @@ class Interpolant:
         self._where = None if self._linear else Located(t, at)
 
     def __call__(self, v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """Column `v` (n,) at the points: shape (m,), written into `out` when given."""
+        """Column `v` (n,), or columns (n, k), at the points: shape (m,) or (m, k), written into `out` when given.
+
+        Each column's values are those it has alone: the arithmetic is column by column, in the same order.
+        """
+        if v.ndim == 1:
+            return self(v[:, None], None if out is None else out[:, None])[:, 0]
         if self._where is None:
-            result = np.interp(self.at, self.t, v)
-            if out is None:
-                return cast(np.ndarray, result)
-            out[...] = result
+            out = np.empty((self.at.size, v.shape[1])) if out is None else out
+            for k in range(v.shape[1]):
+                out[:, k] = np.interp(self.at, self.t, v[:, k])
             return out
-        column = v[:, None]
-        slopes = self._system.slopes(column) if self._system is not None else pchip_slopes(self.t, column)
-        return hermite(self.t, column, slopes, self._where, None if out is None else out[:, None])[:, 0]
+        slopes = self._system.slopes(v) if self._system is not None else pchip_slopes(self.t, v)
+        return hermite(self.t, v, slopes, self._where, out)
 
 
 def complement(pieces: list[tuple[float, float]], lo: float, hi: float) -> list[tuple[float, float]]:

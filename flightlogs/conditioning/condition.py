@@ -86,6 +86,11 @@ class ConditioningOptions:
         own clock without GPS time), s; None to rely on GPS time alone.
     estimate_wind_offset : bool
         Also apply the residual clock offset found by cross-correlation.
+    residual_offset : bool
+        Measure that residual offset (the wind cross-correlated with the autopilot's wind estimate or the
+        attitude, :attr:`WindAlignment.residual`) even when it is not applied: an ingest reports it. A fit,
+        which times the wind on the identification itself, turns it off (a sixth of conditioning a sweep).
+        Estimating the offset or the transport delay measures it whatever this says.
     estimate_transport_delay : bool
         Find the transport delay by cross-correlation instead (the clock
         offset is then trusted); a delay and a clock offset shift the wind the
@@ -115,6 +120,7 @@ class ConditioningOptions:
     rate_hz: float | None = None
     wind_offset_s: float | None = None
     estimate_wind_offset: bool = False
+    residual_offset: bool = True
     estimate_transport_delay: bool = False
     wind_distance_m: float | None = None
     wind_bearing_rad: float | None = None
@@ -240,13 +246,13 @@ def _one_pass(
             f"{log.path}: no stretch of at least {options.min_record_s:g} s where every core signal has data"
         )
     values = resample_signals(cut_by | others, time_base, max_gap_samples=options.max_gap_samples)
-    holds = {name: 1.5 / rate for name, signal in others.items() if (rate := signal.rate_hz) > 0}  # rate read once
+    holds = {name: 1.5 / rate for name, rate in _rates(others).items() if rate > 0}
     for name in others:
         _hold_edges(values[name], time_base, holds.get(name, 0.0))
     if "excitation" in values:  # logged only while a System ID run injects it: zero elsewhere
         np.nan_to_num(values["excitation"], nan=0.0, copy=False)
     units = {name: sig.unit for name, sig in (cut_by | others).items()}
-    if alignment is not None:
+    if alignment is not None and (options.residual_offset or options.estimate_wind_offset):
         alignment = _residual(alignment, time_base, values, rate_hz)
         if options.estimate_wind_offset and alignment.residual is not None:
             return alignment
@@ -268,6 +274,15 @@ def _one_pass(
     return ConditionedFlight(
         source=log.path, records=records, segments=segments, rate_hz=rate_hz, wind=alignment, derived=derived
     )
+
+
+def _rates(signals: Mapping[str, Signal]) -> dict[str, float]:
+    """Each signal's logged rate, Hz, worked out once per time base: the fields of a log message share theirs."""
+    by_times: dict[int, float] = {}
+    for signal in signals.values():
+        if id(signal.time_s) not in by_times:
+            by_times[id(signal.time_s)] = signal.rate_hz
+    return {name: by_times[id(signal.time_s)] for name, signal in signals.items()}
 
 
 _CUT_WARN = 0.2  # the anemometer's overlap cutting more than this fraction off the log is said
@@ -473,7 +488,8 @@ def _with_estimated_offset(
     with collected_warnings() as caught:
         for _ in range(_MAX_OFFSET_ITERATIONS):
             caught.discard()  # an earlier pass's: superseded by this one
-            again = condition_flight(log, wind, replace(options, wind_offset_s=corrected, estimate_wind_offset=False))
+            moved = replace(options, wind_offset_s=corrected, estimate_wind_offset=False, residual_offset=True)
+            again = condition_flight(log, wind, moved)
             assert again.wind is not None
             left = again.wind.residual
             if left is None or abs(left.lag_s) < 0.1 / again.rate_hz:
@@ -486,7 +502,8 @@ def _with_estimated_offset(
 def _with_estimated_delay(log: FlightLog, wind: WindMeasurement, options: ConditioningOptions) -> ConditionedFlight:
     """Condition without a delay, take the vehicle's lag behind the wind as the delay, condition again."""
     with collected_warnings() as caught:
-        first = condition_flight(log, wind, replace(options, transport_delay_s=0.0, estimate_transport_delay=False))
+        undelayed = replace(options, transport_delay_s=0.0, estimate_transport_delay=False, residual_offset=True)
+        first = condition_flight(log, wind, undelayed)
         caught.discard()  # the pass without a delay only measures it: the pass with it says what holds
     assert first.wind is not None
     if first.wind.residual is None:
@@ -575,7 +592,7 @@ def _segments(
         if fitted_on is not None and np.array_equal(unexcited, fitted_on):
             break  # nothing flown to leave out: the refit would repeat the first pass exactly
         fitted_on = unexcited
-        excitation = recovery.estimate(unexcited)
+        excitation = recovery.estimate(unexcited, read=quiet)  # detection reads the stretches between the logged runs
         detected = [
             segment
             for start, stop, detector in detectors

@@ -219,7 +219,8 @@ def uniform_time_base(
     if not series:
         raise DataError("no signal to build a time base from")
     if rate_hz is None:
-        rates = [logged_rate_hz(t) for _, t, _ in series if len(t) > 1 and t[-1] > t[0]]
+        times = {id(t): t for _, t, _ in series if len(t) > 1 and t[-1] > t[0]}  # a message's fields share theirs
+        rates = [logged_rate_hz(t) for t in times.values()]
         if not rates:
             raise DataError("cannot infer a sample rate: every signal has fewer than 2 samples")
         fastest = max(rates)
@@ -333,8 +334,10 @@ def _resample_columns(
 ) -> np.ndarray:
     """Columns sampled at the same times `t` (s, shape (n,)), each (n,), onto `time_base`: shape (n_base, k).
 
-    One spline system (or filter) per piece for all columns, each column then solved on its own:
-    signals of one message share their times.
+    One spline system (or filter) per piece for all columns, solved for as many columns at once as
+    :data:`_BLOCK_VALUES` allows: signals of one message share their times (one column at a time, the
+    halvings of the spline's system took a tenth of conditioning a sweep; 24 columns of 4 000 knots are one
+    block).
     """
     tb, dt_target = check_time_base(time_base)
     if method not in ("spline", "pchip", "linear"):
@@ -354,10 +357,17 @@ def _resample_columns(
         low = AntiAlias(pt, dt_src, 1.0 / dt_target) if filter_needed else None
         knots = pt if low is None else low.grid
         at = Interpolant(knots, np.clip(tb[first:stop], knots[0], knots[-1]), method)
-        for k, column in enumerate(columns):
-            piece = column[i0:i1].astype(np.float64, copy=False)
-            at(piece if low is None else low(piece), out[first:stop, k])
+        width = max(1, _BLOCK_VALUES // max(knots.size, stop - first))
+        for lo in range(0, len(columns), width):
+            block = np.empty((knots.size, min(width, len(columns) - lo)))
+            for k, column in enumerate(columns[lo : lo + width]):
+                piece = column[i0:i1].astype(np.float64, copy=False)
+                block[:, k] = piece if low is None else low(piece)
+            at(block, out[first:stop, lo : lo + block.shape[1]])
     return out
+
+
+_BLOCK_VALUES = 1 << 18  # values of a block of columns interpolated at once (2 MB; several such working arrays)
 
 
 def resample_signals(

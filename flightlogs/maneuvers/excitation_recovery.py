@@ -144,18 +144,26 @@ class ExcitationRecovery:
         self._inputs, self._states, self._time_s = inputs, states, time_s
         self._raw: dict[str, tuple[float, list[tuple[int, int]]]] = {}  # by axis: the input's median and bursts
 
-    def estimate(self, quiet: np.ndarray) -> dict[str, np.ndarray]:
+    def estimate(self, quiet: np.ndarray, read: np.ndarray | None = None) -> dict[str, np.ndarray]:
         """The inputs with the feedback fitted on `quiet` removed.
 
         Parameters
         ----------
         quiet : ndarray of bool, shape (n_samples,)
             Samples with no excitation, where the feedback law is fitted.
+        read : ndarray of bool, shape (n_samples,), optional
+            The samples the caller reads of the result: a burst's joint fit, which changes the excitation
+            within 10 s of it, is only made where it reaches one of them. Segmentation reads the stretches
+            between the logged runs: a burst whose window (up to 10 s either side of it) lies within a
+            logged run is not fitted (67 of the 408 bursts fitted on the chapter 3 campaign's 120 logs, none
+            of which found a doublet).
+            None: every sample.
 
         Returns
         -------
         dict of ndarray
-            As :func:`estimate_excitation`.
+            As :func:`estimate_excitation`; outside `read`, where a burst is not fitted, the quiet-sample
+            fit's excitation.
 
         Raises
         ------
@@ -181,7 +189,7 @@ class ExcitationRecovery:
                     self._raw[axis] = _raw_bursts(u, finite, dt)
                 trusted = bool(np.count_nonzero(quiet & finite) * dt >= _TRUSTED_QUIET_S)
                 angles = [name in _ANGLES for name in names]
-                out = _with_doublets(u, x, out, trusted, finite, dt, angles, self._raw[axis])
+                out = _with_doublets(u, x, out, trusted, finite, dt, angles, self._raw[axis], read)
             estimated[axis] = out
         return estimated
 
@@ -233,13 +241,15 @@ def _with_doublets(
     dt: float,
     angles: list[bool],
     raw: tuple[float, list[tuple[int, int]]],
+    read: np.ndarray | None = None,
 ) -> np.ndarray:
     """`base` with the joint fit of feedback and doublet (or 3-2-1-1) put in around the bursts one explains.
 
     Where `base` is `trusted` (its feedback fitted on enough hover) and a
     doublet or 3-2-1-1 already explains the burst in it, `base` is kept: a
     long quiet fit averages the feedback better than a few seconds around
-    one burst.
+    one burst. A burst whose window holds none of the samples `read` is not
+    fitted (None: all are read).
     """
     bursts = _candidates(base, u, finite, dt, raw)
     pad = int(round((_PAD_S if trusted else _WIDE_PAD_S) / dt))
@@ -252,6 +262,8 @@ def _with_doublets(
         lo = max(a - pad, piece[0], bursts[k - 1][1] + gap if k else 0)
         hi = min(b + pad, piece[1], bursts[k + 1][0] - gap if k + 1 < len(bursts) else u.size - 1)
         burst = (a - lo, b - lo)
+        if read is not None and not read[lo : hi + 1].any():
+            continue  # whatever the fit, nothing of it is read
         if trusted and fit_doublet(base[lo : hi + 1], np.zeros((hi - lo + 1, 0)), dt, burst) is not None:
             continue  # the quiet-sample fit shows the doublet on its own
         window = np.column_stack([column[lo : hi + 1] for column in x])

@@ -45,7 +45,7 @@ import numpy as np
 
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import FitWarning
-from flightlogs.frames import air_velocity_body, wind_to_body_axes
+from flightlogs.frames import air_velocity_per_wind, wind_to_body_axes
 from flightlogs.parallel import map_forked, worker_count
 from flightlogs.record import Record
 from sysid._filters import butterworth_zero_phase
@@ -102,19 +102,26 @@ class _Moved:
     @classmethod
     def of(cls, record: Record, piece_time_s: np.ndarray, piece_wind_ne: np.ndarray) -> _Moved:
         """`record` with its piece's time (n_piece,) and wind (n_piece, 2); u v w per unit of wind, (n, 3) each,
-        and wind_lon, wind_lat per unit of wind, (n, 2) each (the heading's rotation, worked out once per record)."""
+        and wind_lon, wind_lat per unit of wind, (n, 2) each (the attitude's rotation, worked out once per record)."""
         angles = [record.absolute(n) for n in _ANGLES]
-        unit = np.zeros((record.time_s.size, 3))
-        to_north = np.column_stack([np.ones(unit.shape[0]), unit[:, 0]])
-        to_east = np.column_stack([unit[:, 0], np.ones(unit.shape[0])])
+        per_wind = air_velocity_per_wind(*angles)
+        unit = np.ones(record.time_s.size)
         return cls(
             record=record,
             piece_time_s=piece_time_s,
             piece_wind_ne=piece_wind_ne,
-            north=air_velocity_body(unit, to_north, *angles),
-            east=air_velocity_body(unit, to_east, *angles),
-            north_body=wind_to_body_axes(to_north, angles[2]),
-            east_body=wind_to_body_axes(to_east, angles[2]),
+            north=np.ascontiguousarray(per_wind[:, :, 0]),
+            east=np.ascontiguousarray(per_wind[:, :, 1]),
+            north_body=wind_to_body_axes(np.column_stack([unit, 0.0 * unit]), angles[2]),
+            east_body=wind_to_body_axes(np.column_stack([0.0 * unit, unit]), angles[2]),
+        )
+
+    def _rows(self, rows: slice, record: Record) -> _Moved:
+        """The same for `record`, which is this one's `rows`: the rotations taken, not worked out again."""
+        return replace(
+            self,
+            record=record,
+            **{n: np.ascontiguousarray(getattr(self, n)[rows]) for n in ("north", "east", "north_body", "east_body")},
         )
 
     def every(self, rate_hz: float) -> _Moved:
@@ -123,13 +130,17 @@ class _Moved:
         k = max(int(record.rate_hz // rate_hz), 1)
         if k == 1:
             return self
-        thinned = replace(record, time_s=record.time_s[::k], columns={n: v[::k] for n, v in record.columns.items()})
-        return _Moved.of(thinned, self.piece_time_s, self.piece_wind_ne)
+        rows = slice(None, None, k)
+        return self._rows(
+            rows, replace(record, time_s=record.time_s[rows], columns={n: v[rows] for n, v in record.columns.items()})
+        )
 
-    def cut(self, start_s: float, end_s: float) -> _Moved:
-        """The same, the record cut to `start_s`-`end_s`."""
-        record = self.record.between(start_s, end_s, label=self.record.label)
-        return _Moved.of(record, self.piece_time_s, self.piece_wind_ne)
+    def cut(self, first: int, last: int) -> _Moved:
+        """The same, the record cut to its rows `first` to `last` (included)."""
+        record = self.record
+        cut = record.between(float(record.time_s[first]), float(record.time_s[last]), label=record.label)
+        assert cut.time_s.size == last - first + 1  # a record's times increase: those rows
+        return self._rows(slice(first, last + 1), cut)
 
     def reaches(self, shift_s: float) -> np.ndarray:
         """Rows of the record whose wind, moved by `shift_s`, lies inside the piece, shape (n_samples,) bool."""
@@ -361,8 +372,7 @@ def scan_wind_offset(
     for moved in _movable(records, flights, smooth=True):  # one set of rows for every trial: those every move reaches
         rows = np.flatnonzero(moved.reaches(-edge) & moved.reaches(edge))
         if rows.size >= 16:
-            start, end = (float(moved.record.time_s[k]) for k in rows[[0, -1]])
-            movable.append(moved.cut(start, end))
+            movable.append(moved.cut(int(rows[0]), int(rows[-1])))
     if not movable:
         return None
     used = [f.wind.clock_offset_s for f in flights if f.wind is not None]

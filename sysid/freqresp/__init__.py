@@ -2,7 +2,8 @@
 
 The public names live in small modules and are re-exported here:
 :mod:`~sysid.freqresp.options` (:class:`ResponseOptions`),
-:mod:`~sysid.freqresp.estimate` (:func:`frequency_responses`),
+:mod:`~sysid.freqresp.estimate` (:func:`frequency_responses`, :func:`frequency_response_sets`,
+:class:`ChannelWindows`),
 :mod:`~sysid.freqresp.gating` (:func:`gate_responses`),
 :mod:`~sysid.freqresp.records` (:func:`maneuver_records`, :func:`maneuver_band`,
 :func:`quiet_records`, :func:`within_band`, :data:`DEFAULT_PAIRS`, :func:`flight_responses`),
@@ -19,7 +20,12 @@ from typing import TYPE_CHECKING
 
 from flightlogs._lazy import lazy_names
 from sysid.freqresp.coupling import coupled_inputs
-from sysid.freqresp.estimate import automatic_window_lengths, frequency_responses
+from sysid.freqresp.estimate import (
+    ChannelWindows,
+    automatic_window_lengths,
+    frequency_response_sets,
+    frequency_responses,
+)
 from sysid.freqresp.gating import DroppedResponse, Gating, GatingResult, fit_range, gate_responses
 from sysid.freqresp.options import ResponseOptions
 from sysid.freqresp.records import (
@@ -41,9 +47,11 @@ if TYPE_CHECKING:
     from sysid.freqresp.io import RESPONSES_SCHEMA_VERSION, read_responses, write_responses
 
 __all__ = [
+    "ChannelWindows",
     "FrequencyResponse",
     "ResponseOptions",
     "frequency_responses",
+    "frequency_response_sets",
     "automatic_window_lengths",
     "coupled_inputs",
     "DroppedResponse",

@@ -73,6 +73,67 @@ def window_spectra(
     `data` holds one array per record, shape (n_channels, n_samples), C order.
     Returns None when no record holds a whole window.
     """
+    found = window_transforms(
+        data, dt, n_window, omega, overlap=overlap, taper=taper, min_cycles=min_cycles, spacing=spacing
+    )
+    return None if found is None else found.spectra(omega)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class WindowTransforms:
+    """Every window's Fourier transform of the channels of every record, for windows of one length.
+
+    Parameters
+    ----------
+    x : ndarray of complex, shape (n_used, n_channels, n_windows)
+        Transforms of the mean-removed, tapered windows at the grid frequencies the window reaches.
+    window_s : float
+        Window length, s.
+    n_windows : int
+        Windows of each channel.
+    n_effective : float
+        Equivalent number of independent averages (overlap-corrected).
+    omega_low : float
+        Lowest frequency the window resolves, rad/s.
+    scale : float
+        ``dt / (pi sum(w^2) n_windows)``: what the windows' summed products are multiplied by.
+    """
+
+    x: np.ndarray
+    window_s: float
+    n_windows: int
+    n_effective: float
+    omega_low: float
+    scale: float
+
+    def spectra(self, omega: np.ndarray) -> WindowSpectra:
+        """The spectral matrix on the grid `omega` (n_freq,), rad/s, whose frequencies from `omega_low` up are
+        those transformed; zero below."""
+        used = omega >= self.omega_low * (1.0 - 1e-12)
+        spectra = np.zeros((omega.size, self.x.shape[1], self.x.shape[1]), dtype=complex)
+        spectra[used] = np.conj(self.x) @ self.x.transpose(0, 2, 1)
+        spectra *= self.scale
+        return WindowSpectra(
+            window_s=self.window_s,
+            spectra=spectra,
+            n_windows=self.n_windows,
+            n_effective=self.n_effective,
+            omega_low=self.omega_low,
+        )
+
+
+def window_transforms(
+    data: Sequence[np.ndarray],
+    dt: float,
+    n_window: int,
+    omega: np.ndarray,
+    *,
+    overlap: float,
+    taper: str,
+    min_cycles: float,
+    spacing: str = "log",
+) -> WindowTransforms | None:
+    """The windows' transforms behind :func:`window_spectra` (same arguments), None when no record holds a window."""
     hop = max(1, int(round(n_window * (1.0 - overlap))))
     taper_values = taper_window(taper, n_window)  # periodic: the spectral-analysis form
     pieces = []
@@ -96,11 +157,13 @@ def window_spectra(
     else:
         transform = _matrix_dft(flat, dt, taper_values, omega[used])
     x = np.ascontiguousarray(transform.reshape(n_channels, n_windows, -1).transpose(2, 0, 1))  # (n_used, ch, win)
-    spectra = np.zeros((omega.size, n_channels, n_channels), dtype=complex)
-    spectra[used] = np.conj(x) @ x.transpose(0, 2, 1)
-    spectra *= dt / (np.pi * float(np.sum(taper_values**2)) * n_windows)
-    return WindowSpectra(
-        window_s=window_s, spectra=spectra, n_windows=n_windows, n_effective=n_effective, omega_low=omega_low
+    return WindowTransforms(
+        x=x,
+        window_s=window_s,
+        n_windows=n_windows,
+        n_effective=n_effective,
+        omega_low=omega_low,
+        scale=dt / (np.pi * float(np.sum(taper_values**2)) * n_windows),
     )
 
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from flightlogs.record import Record
 from sysid.freqresp._conditioning import coherence
-from sysid.freqresp.estimate import _channels, _common_step, _grid, _window_samples, _windowed
+from sysid.freqresp.estimate import ChannelWindows, _channels, _common_step, _grid, _window_samples
 from sysid.freqresp.options import ResponseOptions
 
 __all__ = ["coupled_inputs"]
@@ -35,6 +35,7 @@ def coupled_inputs(
     min_coherence: float = 0.5,
     min_share: float = 0.1,
     significance: float = 0.01,
+    windows: ChannelWindows | None = None,
 ) -> tuple[str, ...]:
     """The `candidates` that move with `control` over the maneuvers: coherent with it over part of the grid.
 
@@ -55,6 +56,9 @@ def coupled_inputs(
     significance : float, optional
         Chance that unrelated signals pass at a frequency: the coherence must also exceed
         ``1 - significance^(1 / (n_d - 1))`` for the window's ``n_d`` averages.
+    windows : ChannelWindows, optional
+        The records' windowed transforms (with the same `options`), shared with the axis's responses:
+        `control` is then transformed once for both.
 
     Returns
     -------
@@ -91,12 +95,12 @@ def coupled_inputs(
     lengths = _window_samples(blocks, dt, options)
     omega = _grid(options, dt, max(lengths))
     left = [k for k in range(len(names)) if not all(np.ptp(block[k + 1]) == 0 for block in blocks)]
+    windows = ChannelWindows(records, options) if windows is None else windows
     found: set[str] = set()
     for n_window in lengths:  # every candidate still unfound at once: the control's transform made once
         if not left:
             break
-        rows = [0, *(k + 1 for k in left)]
-        spectra = _windowed([np.ascontiguousarray(b[rows]) for b in blocks], dt, n_window, omega, options)
+        spectra = windows.spectra((control, *(names[k] for k in left)), n_window, omega, keep=(control,))
         if spectra is None or spectra.n_effective <= 1.0:
             continue
         reached = omega >= spectra.omega_low * (1.0 - 1e-12)

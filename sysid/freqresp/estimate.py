@@ -2,19 +2,21 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
+from dataclasses import replace
+from typing import cast
 
 import numpy as np
 
 from flightlogs.errors import DataError, MissingSignalError
 from flightlogs.record import Record
 from sysid.freqresp._composite import composite_pair
-from sysid.freqresp._spectra import WindowSpectra, window_spectra
+from sysid.freqresp._spectra import WindowSpectra, WindowTransforms, window_spectra, window_transforms
 from sysid.freqresp._whole import member_possible, whole_record_floor, whole_record_spectra
 from sysid.freqresp.options import ResponseOptions
 from sysid.freqresp.response import FrequencyResponse
 
-__all__ = ["frequency_responses", "automatic_window_lengths"]
+__all__ = ["ChannelWindows", "frequency_responses", "frequency_response_sets", "automatic_window_lengths"]
 
 _N_AUTOMATIC_WINDOWS = 5
 _MIN_WINDOW_SAMPLES = 16
@@ -111,9 +113,51 @@ def frequency_responses(
     >>> h.pair, bool(np.allclose(h.response, 2.0)), bool(np.all(h.coherence > 0.999))
     ('q/delta_lon', True, True)
     """
-    inputs, outputs = tuple(inputs), tuple(outputs)
+    return frequency_response_sets(records, [(inputs, outputs, quiet)], options)[0]
+
+
+def frequency_response_sets(
+    records: Sequence[Record],
+    sets: Sequence[tuple[Sequence[str], Sequence[str], Sequence[Record]]],
+    options: ResponseOptions = ResponseOptions(),
+    *,
+    windows: ChannelWindows | None = None,
+) -> tuple[tuple[FrequencyResponse, ...], ...]:
+    """:func:`frequency_responses` of several sets of inputs and outputs of the same records, at once.
+
+    Each set is ``(inputs, outputs, quiet)`` as :func:`frequency_responses` takes them; its responses are
+    that function's for them (to rounding: the windows' spectra of a channel pair do not depend on the
+    other channels). A channel in several sets is transformed once per window: the longitudinal axis's
+    outputs are two sets (w conditioned on the thrust too), of 6 and 5 channels with the excitation as
+    reference, 8 in all.
+
+    Parameters
+    ----------
+    records : sequence of Record
+        As :func:`frequency_responses`'s.
+    sets : sequence of (sequence of str, sequence of str, sequence of Record)
+        Inputs, outputs and quiet records of each set.
+    options : ResponseOptions, optional
+        As :func:`frequency_responses`'s, for every set.
+    windows : ChannelWindows, optional
+        The records' windowed transforms made so far (with the same `options`), to take those of channels
+        already transformed from; by default made here.
+
+    Returns
+    -------
+    tuple of tuple of FrequencyResponse
+        Each set's responses, as :func:`frequency_responses` returns them.
+
+    Raises
+    ------
+    MissingSignalError, DataError
+        As :func:`frequency_responses`, for any set.
+    """
     reference = options.reference
-    _check_names(inputs, outputs, reference)
+    extra = () if reference is None else (reference,)
+    named = [(tuple(inputs), tuple(outputs), quiet) for inputs, outputs, quiet in sets]
+    for inputs, outputs, _ in named:
+        _check_names(inputs, outputs, reference)
     if not records:
         raise DataError("no records to compute frequency responses from")
     dt = _common_step(records)
@@ -122,21 +166,115 @@ def frequency_responses(
             f"omega_max={options.omega_max:g} rad/s is above the Nyquist frequency "
             f"{np.pi / dt:.1f} rad/s of the {1 / dt:g} Hz records"
         )
+    channels = tuple(dict.fromkeys(c for inputs, outputs, _ in named for c in (*inputs, *extra, *outputs)))
+    data = [_channels(record, channels) for record in records]
+    for name in dict.fromkeys(c for inputs, _, _ in named for c in (*inputs, *extra)):
+        if all(np.ptp(block[channels.index(name)]) == 0 for block in data):
+            what = f"reference {name}" if name in extra else f"input {name}"
+            raise DataError(f"{what} does not vary in any record: nothing excites the responses")
+    lengths = _window_samples(data, dt, options)
+    windows = ChannelWindows(records, options) if windows is None else windows
+    found = []
+    for k, (inputs, outputs, quiet) in enumerate(named):
+        mine_channels = (*inputs, *extra, *outputs)
+        rows = [channels.index(c) for c in mine_channels]
+        mine = data if rows == list(range(len(channels))) else [block[rows] for block in data]
+        instrument = len(inputs) if reference is not None else None
+        whole = options.whole_record and member_possible(len(data), len(inputs), instrument)
+        longest = max(block.shape[1] for block in data) if whole else max(lengths)
+        omega = _grid(options, dt, longest)
+        later = {c for ins, outs, _ in named[k + 1 :] for c in (*ins, *extra, *outs)}  # asked for again: kept
+        spectra = [windows.spectra(mine_channels, n, omega, keep=later) for n in lengths]
+        assert all(s is not None for s in spectra)  # every length fits the longest record (_window_samples)
+        members = cast(list[WindowSpectra], spectra)
+        found.append(_set_responses(records, mine, dt, omega, members, inputs, outputs, whole, quiet, options))
+    return tuple(found)
+
+
+class ChannelWindows:
+    """The windows' Fourier transforms of the channels of a set of records, each channel transformed once per
+    window length and grid.
+
+    The search for the mixer inputs that move with an axis's own (:func:`~sysid.freqresp.coupling.coupled_inputs`)
+    transforms the axis's input, and the axis's responses, in sets conditioned on different inputs, share their
+    inputs and reference: a channel that is asked for again is transformed once, its spectra with any other the
+    products of the two transforms. What each request says to keep is kept, within :data:`_KEEP_BYTES` (a long
+    record's windows would not fit): beyond, a channel is transformed each time it is asked for.
+
+    Parameters
+    ----------
+    records : sequence of Record
+        Records on one time base, as :func:`frequency_responses` takes them.
+    options : ResponseOptions
+        Overlap, taper, cycles and spacing of the windows.
+    """
+
+    def __init__(self, records: Sequence[Record], options: ResponseOptions) -> None:
+        self._records, self._options = records, options
+        self._dt = _common_step(records)
+        self._kept: dict[tuple[int, bytes], tuple[WindowTransforms, dict[str, np.ndarray]]] = {}
+        self._bytes = 0
+
+    def spectra(
+        self, channels: Sequence[str], n_window: int, omega: np.ndarray, *, keep: Collection[str] | None = None
+    ) -> WindowSpectra | None:
+        """The spectral matrix of `channels`, in that order, for windows of `n_window` samples on the grid `omega`
+        (rad/s), as :func:`~sysid.freqresp._spectra.window_spectra` makes it; None when no record holds a window.
+        Of the channels transformed for it, those in `keep` (None: all) are kept for the next requests.
+        """
+        options = self._options
+        low = 2.0 * np.pi * options.min_cycles / (n_window * self._dt)
+        key = (n_window, omega[omega >= low * (1.0 - 1e-12)].tobytes())  # the frequencies the window transforms
+        made, kept = self._kept.get(key, (None, {}))
+        missing = tuple(dict.fromkeys(c for c in channels if c not in kept))
+        if missing:
+            made = window_transforms(
+                [_channels(record, missing) for record in self._records],
+                self._dt,
+                n_window,
+                omega,
+                overlap=options.overlap,
+                taper=options.taper,
+                min_cycles=options.min_cycles,
+                spacing=options.spacing,
+            )
+            if made is None:
+                return None
+            fresh = {c: made.x[:, k, :] for k, c in enumerate(missing)}
+            stored = {c: np.copy(x) for c, x in fresh.items() if keep is None or c in keep}  # not the whole batch
+            size = sum(x.nbytes for x in stored.values())
+            if stored and self._bytes + size <= _KEEP_BYTES:
+                self._bytes += size
+                self._kept[key] = (made, kept | stored)
+            kept = kept | fresh
+        assert made is not None
+        return replace(made, x=np.stack([kept[c] for c in channels], axis=1)).spectra(omega)
+
+
+#: Bytes of windowed transforms a :class:`ChannelWindows` keeps (on the 60-sweep campaign the longitudinal axis
+#: keeps its input, the wind and the excitation, 11 MiB; a 400 Hz log's hour-long record would take gigabytes).
+_KEEP_BYTES = 64 * 2**20
+
+
+def _set_responses(
+    records: Sequence[Record],
+    data: Sequence[np.ndarray],
+    dt: float,
+    omega: np.ndarray,
+    windows: list[WindowSpectra],
+    inputs: tuple[str, ...],
+    outputs: tuple[str, ...],
+    whole: bool,
+    quiet: Sequence[Record],
+    options: ResponseOptions,
+) -> tuple[FrequencyResponse, ...]:
+    """One set's responses from its channels' `data` (inputs, reference, outputs) and windows' spectra."""
+    reference = options.reference
     extra = () if reference is None else (reference,)
     channels = inputs + extra + outputs
-    data = [_channels(record, channels) for record in records]
-    for k, name in enumerate(inputs + extra):
-        if all(np.ptp(block[k]) == 0 for block in data):
-            what = f"input {name}" if k < len(inputs) else f"reference {name}"
-            raise DataError(f"{what} does not vary in any record: nothing excites the responses")
     input_rows = list(range(len(inputs)))
     instrument = len(inputs) if reference is not None else None
     output_rows = [len(inputs) + len(extra) + o for o in range(len(outputs))]
-    lengths = _window_samples(data, dt, options)
-    whole = options.whole_record and member_possible(len(data), len(inputs), instrument)
-    longest = max(block.shape[1] for block in data) if whole else max(lengths)
-    omega = _grid(options, dt, longest)
-    windows = [_spectra(data, dt, n, omega, options) for n in lengths]
     if whole:
         member = whole_record_spectra(
             data,
@@ -280,14 +418,6 @@ def _windowed(
         min_cycles=options.min_cycles,
         spacing=options.spacing,
     )
-
-
-def _spectra(
-    data: Sequence[np.ndarray], dt: float, n_window: int, omega: np.ndarray, options: ResponseOptions
-) -> WindowSpectra:
-    found = _windowed(data, dt, n_window, omega, options)
-    assert found is not None  # every length fits the longest record (checked in _window_samples)
-    return found
 
 
 def _floors(

@@ -109,6 +109,7 @@ def verify_logs(
         on an axis of the model.
     """
     measured = identified.measured_clock_offset_s if wind_paths and conditioning.wind_offset_s is None else None
+    conditioning = replace(conditioning, residual_offset=False)  # no flight's alignment is returned
     if measured is not None:
         conditioning = replace(conditioning, wind_offset_s=measured)
     flights = conditioned_sources(sources, wind_paths, options=conditioning, progress=progress, reading=reading)

@@ -8,7 +8,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from flightlogs.frames import air_velocity_body, earth_to_body, quaternion_to_euler, wind_to_body_axes
+from flightlogs.frames import (
+    air_velocity_body,
+    air_velocity_per_wind,
+    earth_to_body,
+    quaternion_to_euler,
+    wind_to_body_axes,
+)
 
 angles = st.tuples(st.floats(-3.1, 3.1), st.floats(-1.5, 1.5), st.floats(-3.1, 3.1))
 
@@ -56,3 +62,19 @@ def test_wind_in_body_axes_keeps_the_speed() -> None:
     body = wind_to_body_axes(wind, psi)
     np.testing.assert_allclose(np.hypot(*body.T), np.hypot(*wind.T))
     np.testing.assert_allclose(wind_to_body_axes(wind, np.zeros(50)), wind)
+
+
+def test_the_air_velocity_per_wind_is_what_a_wind_of_one_metre_a_second_makes() -> None:
+    """Eq. 3.1 is linear in the wind: its slope is the rotation's first two columns, negated, to the last bit."""
+    rng = np.random.default_rng(11)
+    n = 2000
+    angles = [rng.uniform(-0.5, 0.5, n), rng.uniform(-0.5, 0.5, n), rng.uniform(-np.pi, np.pi, n)]
+    per_wind = air_velocity_per_wind(*angles)
+    assert per_wind.shape == (n, 3, 2)
+    for k in range(2):
+        unit = np.zeros((n, 2))
+        unit[:, k] = 1.0
+        np.testing.assert_array_equal(per_wind[:, :, k], air_velocity_body(np.zeros((n, 3)), unit, *angles))
+    wind = rng.normal(size=(n, 2))
+    change = np.einsum("nij,nj->ni", per_wind, wind)
+    np.testing.assert_allclose(change, air_velocity_body(np.zeros((n, 3)), wind, *angles), rtol=0, atol=1e-14)

@@ -88,6 +88,31 @@ def test_transport_delay_can_be_found_by_correlation(demo: dict) -> None:
     assert abs(flight.wind.residual.lag_s - demo["truth"]["anemometer"]["transport_delay_s"]) < ONE_SAMPLE_S
 
 
+def test_a_flight_conditioned_without_the_residual_offset_is_the_same_flight_without_it(demo: dict) -> None:
+    """A fit times the wind itself and turns the residual off: nothing else of the flight moves; estimating the
+    clock offset or the transport delay, which need it, measures it still."""
+    given = ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5)
+    full = condition_flight(demo["log"], demo["wind"], given)
+    bare = condition_flight(demo["log"], demo["wind"], replace(given, residual_offset=False))
+    assert full.wind is not None and full.wind.residual is not None and full.wind.residual_against is not None
+    assert bare.wind == replace(full.wind, residual=None, residual_against=None)
+    assert bare.segments == full.segments and len(bare.records) == len(full.records)
+    for a, b in zip(full.records, bare.records):
+        assert a.signals == b.signals and a.trim == b.trim
+        assert all(np.array_equal(a[name], b[name], equal_nan=True) for name in a.signals)
+    unasked = ConditioningOptions(wind_distance_m=4.6, residual_offset=False)
+    offset = condition_flight(demo["log"], demo["wind"], replace(unasked, estimate_wind_offset=True))
+    assert offset.wind is not None and offset.wind.clock_offset_source == "estimated"
+    assert abs(offset.wind.clock_offset_s - demo["truth"]["anemometer"]["clock_offset_s"]) < ONE_SAMPLE_S
+    delay = condition_flight(
+        demo["log"],
+        demo["wind"],
+        ConditioningOptions(wind_offset_s=1.5, estimate_transport_delay=True, residual_offset=False),
+    )
+    assert delay.wind is not None and delay.wind.transport.source == "correlation"
+    assert abs(delay.wind.transport.delay_s - demo["truth"]["anemometer"]["transport_delay_s"]) < ONE_SAMPLE_S
+
+
 def test_every_logged_sweep_is_found_exactly(demo: dict) -> None:
     flight = condition_flight(demo["log"], demo["wind"], ConditioningOptions(wind_distance_m=4.6, wind_offset_s=1.5))
     sweeps = [s for s in flight.segments if s.kind == "sweep"]

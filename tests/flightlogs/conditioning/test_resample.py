@@ -12,6 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from flightlogs.conditioning import resample
 from flightlogs.conditioning.resample import (
     ContiguousSpans,
     Gap,
@@ -257,8 +258,14 @@ def test_a_cubic_is_reproduced_by_the_spline() -> None:
 
 @pytest.mark.parametrize("method", ["spline", "pchip", "linear"])
 @pytest.mark.parametrize("rate_hz", [50.0, 400.0])  # downsampled through the anti-alias filter, and not
-def test_signals_on_shared_times_resample_as_each_alone(method: str, rate_hz: float) -> None:
-    """One spline (and one filter) for the columns of a message equals one per signal, gaps included."""
+@pytest.mark.parametrize("block_values", [None, 2 * 2000, 1])  # all columns at once; two at a time; one
+def test_signals_on_shared_times_resample_as_each_alone(
+    method: str, rate_hz: float, block_values: int | None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """One spline (and one filter) for the columns of a message equals one per signal, gaps included, to the
+    last bit, whether its columns are solved all at once or in blocks."""
+    if block_values is not None:
+        monkeypatch.setattr(resample, "_BLOCK_VALUES", block_values)
     rng = np.random.default_rng(5)
     t = np.cumsum(rng.uniform(0.0024, 0.0026, 4000))  # a jittery 400 Hz message
     t[2000:] += 0.5  # a gap
@@ -273,7 +280,7 @@ def test_signals_on_shared_times_resample_as_each_alone(method: str, rate_hz: fl
     assert list(together) == list(signals)
     for name, signal in signals.items():
         alone = resample_signal(signal, base, method=method)  # type: ignore[arg-type]
-        np.testing.assert_allclose(together[name], alone, rtol=0.0, atol=1e-12, equal_nan=True)
+        np.testing.assert_array_equal(together[name], alone)  # NaN where NaN
         assert np.isnan(alone).any()  # the gap is left out in both
 
 

@@ -113,6 +113,33 @@ def test_one_recovery_for_both_passes_gives_what_two_fresh_estimates_give(seed: 
     assert searched[0] == searched[1] and searched[2] == searched[3] - 1  # the raw input's, once
 
 
+def test_bursts_whose_windows_are_not_read_are_not_fitted_and_what_is_read_is_unchanged(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Segmentation reads the stretches between logged runs: a burst whose joint-fit window lies wholly inside a
+    logged run is not fitted; every sample read is bitwise what the full estimate gives, its doublet recovered."""
+    import flightlogs.maneuvers.excitation_recovery as recovery_module
+
+    t = np.arange(6000) * DT  # a doublet at 5 s read; one at 30 s, inside a 'logged run' from 12 s to 48 s, not
+    injected = doublet_input(t, 5.0, 1.0) + doublet_input(t, 30.0, 1.0)
+    log = closed_loop_roll_hold(injected, 3, GUST["strong"])
+    states = {name: log[name] for name in ("p", "phi", "ve")}
+    read = (t < 12.0) | (t > 48.0)
+    fitted: list[int] = []
+    original = recovery_module.fit_doublet
+    monkeypatch.setattr(recovery_module, "fit_doublet", lambda u, *a: fitted.append(u.size) or original(u, *a))
+    quiet = read & ~((t > 4.0) & (t < 8.0))
+    whole = ExcitationRecovery({"lat": log["u"]}, states, time_s=t).estimate(quiet)["lat"]
+    every = len(fitted)
+    fitted.clear()
+    part = ExcitationRecovery({"lat": log["u"]}, states, time_s=t).estimate(quiet, read=read)["lat"]
+    assert 0 < len(fitted) < every  # the doublet at 5 s fitted, the one at 30 s not
+    np.testing.assert_array_equal(part[read], whole[read])
+    inside = (t >= 30.0) & (t < 32.0)
+    assert np.max(np.abs(whole[inside] - injected[inside])) < 0.01 * AMPLITUDE  # fitted: recovered
+    assert not np.array_equal(part[inside], whole[inside])  # not fitted: the quiet fit's, never read
+    read_doublet = (t >= 5.0) & (t < 7.0)
+    assert np.max(np.abs(part[read_doublet] - injected[read_doublet])) < 0.01 * AMPLITUDE
+
+
 def test_units_do_not_matter() -> None:
     """A mixer input logged in % instead of 0-1 gives the same excitation, ×100: every rule is a ratio."""
     t = np.arange(800) * DT

@@ -61,6 +61,23 @@ def test_the_wind_is_low_passed_and_u_v_w_follow_it(flight: ConditionedFlight) -
             np.testing.assert_allclose(after[name] - before[name], body[:, k], atol=1e-12)
 
 
+def test_a_record_cut_or_thinned_moves_its_wind_as_one_made_for_it(flight: ConditionedFlight) -> None:
+    """The scan cuts its records to the rows every move reaches and thins them for the coarse pass: the
+    rotations of the record are taken for those rows, the same to the last bit as worked out for them anew."""
+    from sysid.fit.wind_offset import _movable, _Moved
+
+    (moved, *_) = _movable(flight.records, [flight], smooth=True)
+    n = moved.record.time_s.size
+    for made in (moved.cut(n // 5, n - n // 4), moved.every(20.0), moved.cut(n // 5, n - n // 4).every(20.0)):
+        anew = _Moved.of(made.record, made.piece_time_s, made.piece_wind_ne)
+        assert made.record.time_s.size < n
+        for shift in (-1.3, 0.0, 0.47):
+            ours, theirs = made.columns(shift), anew.columns(shift)
+            assert ours.keys() == theirs.keys()
+            for name in ours:
+                np.testing.assert_array_equal(ours[name], theirs[name])
+
+
 def test_a_flight_without_wind_is_kept_as_it_is(flight: ConditionedFlight) -> None:
     calm = replace(flight, wind=None)
     assert smoothed_flights([calm])[0] is calm

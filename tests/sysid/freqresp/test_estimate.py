@@ -43,7 +43,7 @@ from flightlogs.record import Record
 from simulator.autopilot.excitation import Maneuver, excitation_signal, sweep
 from simulator.flights.linear import simulate_hover
 from simulator.vehicle.identified import CALM_HOVER
-from sysid.freqresp import ResponseOptions, frequency_responses
+from sysid.freqresp import ResponseOptions, frequency_response_sets, frequency_responses
 from sysid.freqresp._spectra import effective_averages
 from sysid.model.statespace import DelayedStateSpace
 
@@ -427,6 +427,93 @@ def test_chirp_z_on_an_even_grid_equals_the_matrix_transform() -> None:
         by_matrix = _spectra.window_spectra(data, 0.01, n, czt.omega, overlap=0.8, taper="hann", min_cycles=2)
         assert by_czt is not None and by_matrix is not None
         np.testing.assert_allclose(by_czt.spectra, by_matrix.spectra, rtol=1e-8, atol=1e-12)
+
+
+def _two_input_records(seed: int, n_records: int) -> tuple[list[Record], Record]:
+    """Records of a reference r, inputs x1 (r plus noise) and x2, outputs driven by both or one; and a quiet one."""
+    rng = np.random.default_rng(seed)
+    time_s = np.arange(2500) / RATE_HZ
+
+    def flown(excited: float) -> Record:
+        r = excited * rng.normal(size=time_s.size)
+        x1, x2 = r + 0.3 * rng.normal(size=r.size), rng.normal(size=r.size)
+        noise = 0.1 * rng.normal(size=(3, r.size))
+        columns = {"r": r, "x1": x1, "x2": x2, "y1": np.roll(x1, 3) - 0.5 * x2 + noise[0]}
+        return _record(columns | {"y2": 2.0 * x1 + noise[1], "y3": np.roll(x1, 7) + noise[2]}, time_s)
+
+    return [flown(1.0) for _ in range(n_records)], flown(0.0)
+
+
+@pytest.mark.parametrize(("reference", "n_records"), [(None, 3), ("r", 2)])  # one grid; two (a member for B alone)
+def test_sets_of_responses_of_the_same_records_are_each_set_computed_alone(
+    reference: str | None, n_records: int
+) -> None:
+    """Channels shared by several sets are transformed once: each set's responses are still its own, to rounding."""
+    records, quiet = _two_input_records(3, n_records)
+    options = ResponseOptions(omega_min=1.0, omega_max=40.0, n_freq=60, reference=reference)
+    sets = [(["x1", "x2"], ["y1", "y3"], []), (["x1"], ["y2", "y3"], [] if reference else [quiet])]
+    together = frequency_response_sets(records, sets, options)
+    assert len(together) == len(sets)
+    for (inputs, outputs, quiet_records), found in zip(sets, together):
+        alone = frequency_responses(records, inputs, outputs, options, quiet=quiet_records)
+        assert [(r.input, r.output, r.conditioned_on) for r in found] == [
+            (r.input, r.output, r.conditioned_on) for r in alone
+        ]
+        for a, b in zip(found, alone):
+            np.testing.assert_array_equal(a.omega, b.omega)
+            assert a.windows_s == b.windows_s and a.whole_record == b.whole_record
+            for name in ("response", "coherence", "random_error", "input_autospectrum", "cross_spectrum"):
+                np.testing.assert_allclose(getattr(a, name), getattr(b, name), rtol=1e-10, atol=1e-14)
+    if reference:  # the member needs more records than inputs with a reference: the sets' grids differ
+        assert together[0][0].omega[0] > together[1][0].omega[0]
+
+
+@pytest.mark.parametrize("keep_bytes", [None, 0])  # within the budget; nothing kept
+def test_channel_windows_give_each_request_the_spectra_of_its_channels_alone(keep_bytes, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """Transforms kept from one request serve the next, on another grid reaching the same frequencies too: each
+    request's spectra are those of its channels transformed on their own; the coupling search sharing them
+    finds what it finds alone."""
+    from sysid.freqresp import ChannelWindows, _spectra, coupled_inputs
+    from sysid.freqresp import estimate as estimate_module
+
+    if keep_bytes is not None:
+        monkeypatch.setattr(estimate_module, "_KEEP_BYTES", keep_bytes)
+    records, _ = _two_input_records(4, 3)
+    options = ResponseOptions(omega_min=1.0, omega_max=40.0, n_freq=60)
+    windows = ChannelWindows(records, options)
+    long_grid, short_grid = options.grid(), options.grid()[10:]  # the same frequencies from 1.5 rad/s up
+    assert coupled_inputs(records, "x1", ["x2", "r"], options, windows=windows) == coupled_inputs(
+        records, "x1", ["x2", "r"], options
+    )
+    transformed: list[int] = []  # channels transformed by each request
+    made = estimate_module.window_transforms
+    monkeypatch.setattr(
+        estimate_module,
+        "window_transforms",
+        lambda data, *a, **k: transformed.append(data[0].shape[0]) or made(data, *a, **k),
+    )
+    for channels, grid, keep, new in [
+        (("x1", "y1"), long_grid, ("x1",), 2),
+        (("y2", "x1", "x2"), short_grid, ("x2",), 2),  # x1 kept, on the other grid: the same frequencies
+        (("x2", "y3", "x1"), long_grid, (), 1),
+    ]:
+        for n_window in (300, 600):
+            transformed.clear()
+            found = windows.spectra(channels, n_window, grid, keep=keep)
+            assert transformed == [len(channels) if keep_bytes == 0 else new]
+            data = [np.vstack([r[c] for c in channels]) for r in records]
+            alone = _spectra.window_spectra(
+                data, 0.01, n_window, grid, overlap=0.8, taper="hann", min_cycles=options.min_cycles
+            )
+            assert found is not None and alone is not None
+            assert (found.n_windows, found.n_effective, found.omega_low) == (
+                alone.n_windows,
+                alone.n_effective,
+                alone.omega_low,
+            )
+            np.testing.assert_allclose(found.spectra, alone.spectra, rtol=1e-12, atol=1e-15)
+    kept = {c for _, by_channel in windows._kept.values() for c in by_channel}
+    assert kept == (set() if keep_bytes == 0 else {"x1", "x2"})
 
 
 def test_the_kernels_kept_are_those_computed_and_stay_within_their_budget(monkeypatch) -> None:  # type: ignore[no-untyped-def]
