@@ -146,14 +146,6 @@ class IdentifyOptions:
     partial: bool = False
 
 
-def _response_work(axis: str, records: Sequence[Record]) -> int:
-    """A measure of the work of an axis's responses, to hand the longest to the cores first: its samples times
-    the channels transformed (its outputs and two inputs). On the 60-sweep campaign's second pass the axes take
-    0.67 (lon), 0.47 (lat), 0.34 (thr) and 0.28 s (yaw) on one core: in this order the two cores end at 0.95
-    and 0.81 s, in the axes' order (lat, lon, yaw, thr) at 0.75 and 1.01 s."""
-    return sum(r.time_s.size for r in records) * (len(FIT_PAIRS[axis]) + 2)
-
-
 def _report(progress: Progress | None, stage: str, done: int, total: int) -> None:
     if progress is not None:
         progress(stage, done, total)
@@ -308,7 +300,6 @@ def _identified(
 
     def compute(wanted: Sequence[str]) -> None:
         todo = [k for k, axis in enumerate(flown) if axis in wanted and axis not in computed]
-        todo.sort(key=lambda k: -_response_work(flown[k], used[flown[k]]))  # the longest first: the cores end together
         for k, found in zip(todo, map_forked(lambda j: axis_responses(todo[j]), len(todo))):  # the axes on the cores
             _report(progress, f"responses {flown[k]}", len(computed) + 1, len(_AXES) + 2)
             computed[flown[k]] = found

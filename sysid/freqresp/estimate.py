@@ -11,7 +11,7 @@ import numpy as np
 from flightlogs.errors import DataError, MissingSignalError
 from flightlogs.record import Record
 from sysid.freqresp._composite import composite_pair
-from sysid.freqresp._spectra import WindowSpectra, WindowTransforms, window_spectra, window_transforms
+from sysid.freqresp._spectra import WindowSpectra, WindowTransforms, window_transforms
 from sysid.freqresp._whole import member_possible, whole_record_floor, whole_record_spectra
 from sysid.freqresp.options import ResponseOptions
 from sysid.freqresp.response import FrequencyResponse
@@ -228,15 +228,8 @@ class ChannelWindows:
         made, kept = self._kept.get(key, (None, {}))
         missing = tuple(dict.fromkeys(c for c in channels if c not in kept))
         if missing:
-            made = window_transforms(
-                [_channels(record, missing) for record in self._records],
-                self._dt,
-                n_window,
-                omega,
-                overlap=options.overlap,
-                taper=options.taper,
-                min_cycles=options.min_cycles,
-                spacing=options.spacing,
+            made = _transforms(
+                [_channels(record, missing) for record in self._records], self._dt, n_window, omega, options
             )
             if made is None:
                 return None
@@ -408,7 +401,15 @@ def _windowed(
     data: Sequence[np.ndarray], dt: float, n_window: int, omega: np.ndarray, options: ResponseOptions
 ) -> WindowSpectra | None:
     """:func:`~sysid.freqresp._spectra.window_spectra` with the overlap, taper, cycles and spacing of `options`."""
-    return window_spectra(
+    found = _transforms(data, dt, n_window, omega, options)
+    return None if found is None else found.spectra(omega)
+
+
+def _transforms(
+    data: Sequence[np.ndarray], dt: float, n_window: int, omega: np.ndarray, options: ResponseOptions
+) -> WindowTransforms | None:
+    """:func:`~sysid.freqresp._spectra.window_transforms` with the overlap, taper, cycles and spacing of `options`."""
+    return window_transforms(
         data,
         dt,
         n_window,
