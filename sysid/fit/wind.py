@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field, replace
@@ -58,6 +58,7 @@ from sysid.model.axes import axis_parts
 from sysid.model.structure import ModelStructure
 
 __all__ = [
+    "WindCost",
     "WindStepResult",
     "fit_wind",
     "identified_outputs",
@@ -496,14 +497,14 @@ class _Normal:
         """
         delays = self.problem.wind_delays(theta)
         cross = np.array([self._on_residual(k, tau) for k, tau in enumerate(delays)])
-        return self._solved(theta, self.problem.gram(delays), cross, self._residual_squares)
+        return self.solve_products(theta, self.problem.gram(delays), cross, self._residual_squares)
 
     def solve_for(self, theta: np.ndarray, winds: np.ndarray, residual: np.ndarray) -> tuple[np.ndarray, float]:
         """As :meth:`solve`, with the delayed winds (n, n_wind) and the residual (n, n_out) given."""
         rr = self._residual_squares if residual is self.residual else np.einsum("nr,nr->r", residual, residual)
-        return self._solved(theta, winds.T @ winds, winds.T @ residual, rr)
+        return self.solve_products(theta, winds.T @ winds, winds.T @ residual, rr)
 
-    def _solved(
+    def solve_products(
         self, theta: np.ndarray, gram: np.ndarray, cross: np.ndarray, rr: np.ndarray
     ) -> tuple[np.ndarray, float]:
         """The gains and cost from the winds' inner products (n_wind, n_wind), their products with the residual
@@ -768,7 +769,7 @@ def wind_cost(
     constants: Mapping[str, float],
     records: Sequence[Record],
     outputs: Sequence[str] = ("ax", "az"),
-) -> Callable[[Sequence[Mapping[str, np.ndarray]]], tuple[float, float, np.ndarray]] | None:
+) -> WindCost | None:
     """The eq. 3.14 residual's cost after the best G_w gains, as a function of the records' wind and u v w.
 
     The residual of `records` is computed once; a call gives new values of
@@ -795,11 +796,8 @@ def wind_cost(
 
     Returns
     -------
-    callable or None
-        None when every output belongs to an unidentified axis; else
-        ``cost(changed) -> (cost with the gains, cost without wind, weighted residual after)`` with
-        ``changed`` one mapping of signal name to new values per record: the costs are weighted sums of
-        squares per sample (dimensionless), the residual has shape (n_samples, n_outputs).
+    WindCost or None
+        None when every output belongs to an unidentified axis.
     """
     values, outputs, _ = identified_outputs(structure, values, outputs)
     if not outputs:
@@ -807,32 +805,89 @@ def wind_cost(
     current = _with_wind_defaults(structure, values)
     data = _prediction_data(structure, current, constants, records, outputs)
     problem, normal, _, _ = _gains_problem(structure, current, constants, data)
-    m = problem.assembler.matrices(problem.start)
-    delays = m.delays[problem.columns]
-    signals = [c.signal for c in structure.wind_inputs]
-    moving = [k for k, s in enumerate(structure.states) if s in _AIR_STATES]
-    c_moving = m.c[data.rows][:, moving]  # (n_out, n_moving): the outputs' rows read the velocities so
-    base = [record.time_s for record in records]
+    return WindCost(structure, records, data, problem, normal)
 
-    def cost(changed: Sequence[Mapping[str, np.ndarray]]) -> tuple[float, float, np.ndarray]:
+
+class WindCost:
+    """The cost of :func:`wind_cost`: ``cost(changed)`` for one set of moved signals, ``cost.costs(...)`` for many.
+
+    The costs are weighted sums of squares per sample (dimensionless).
+    """
+
+    def __init__(
+        self, structure: ModelStructure, records: Sequence[Record], data: _Data, problem: _Problem, normal: _Normal
+    ) -> None:
+        self.records, self.data, self.problem, self.normal = list(records), data, problem, normal
+        m = problem.assembler.matrices(problem.start)
+        self.delays = m.delays[problem.columns]
+        self.signals = [c.signal for c in structure.wind_inputs]
+        moving = [k for k, s in enumerate(structure.states) if s in _AIR_STATES]
+        self.states = [structure.states[k] for k in moving]
+        self.c_moving = m.c[data.rows][:, moving]  # (n_out, n_moving): the outputs' rows read the velocities so
+
+    def __call__(self, changed: Sequence[Mapping[str, np.ndarray]]) -> tuple[float, float, np.ndarray]:
+        """The cost with the best gains, the cost without wind, and the weighted residual after, shape
+        (n_samples, n_outputs); `changed` is one mapping of signal name to new values (n_samples,) per record."""
         residual, winds = [], []
-        for record, t, r0, new in zip(records, base, data.residual, changed):
-            states = [structure.states[k] for k in moving]
-            if any(s in new for s in states):
-                dx = np.column_stack([new[s] - record[s] if s in new else np.zeros(t.size) for s in states])
-                r = r0 - dx @ c_moving.T
+        for record, r0, new in zip(self.records, self.data.residual, changed):
+            t = record.time_s
+            if any(s in new for s in self.states):
+                dx = np.column_stack([new[s] - record[s] if s in new else np.zeros(t.size) for s in self.states])
+                r = r0 - dx @ self.c_moving.T
                 r0 = r - r.mean(axis=0)
             residual.append(r0)
-            w = np.column_stack([np.interp(t - tau, t, new.get(s, record[s])) for s, tau in zip(signals, delays)])
+            w = np.column_stack(
+                [np.interp(t - tau, t, new.get(s, record[s])) for s, tau in zip(self.signals, self.delays)]
+            )
             winds.append(w - w.mean(axis=0))
         stacked, wind = np.vstack(residual), np.vstack(winds)
-        theta, left = normal.solve_for(problem.start, wind, stacked)
-        d_w = problem.assembler.matrices(theta).d[data.rows][:, problem.columns]
-        after = (stacked - wind @ d_w.T) * data.scale
+        theta, left = self.normal.solve_for(self.problem.start, wind, stacked)
+        d_w = self.problem.assembler.matrices(theta).d[self.data.rows][:, self.problem.columns]
+        after = (stacked - wind @ d_w.T) * self.data.scale
         n = stacked.shape[0]
-        return left / n, float(np.sum((stacked * data.scale) ** 2)) / n, after
+        return left / n, float(np.sum((stacked * self.data.scale) ** 2)) / n, after
 
-    return cost
+    def costs(self, changed: Iterable[Mapping[str, np.ndarray]]) -> np.ndarray:
+        """The cost with the best gains of each of several sets of moved signals, shape (n_moves,).
+
+        `changed` gives, record by record (it may be a generator: a record's moves are dropped once read),
+        a mapping of signal name to new values of shape (n_moves, n_samples). Each cost equals that of
+        ``cost([...])`` for the one set, to rounding: the winds' and residual's products are summed record by
+        record for all the moves at once.
+        """
+        gram = cross = squares = None
+        n = 0
+        for record, r0, new in zip(self.records, self.data.residual, changed):
+            t = record.time_s
+            n_moves = next(iter(new.values())).shape[0]
+            if any(s in new for s in self.states):
+                dx = np.stack([new[s] - record[s] if s in new else np.zeros(t.size) for s in self.states], axis=-1)
+                r = r0 - dx @ self.c_moving.T  # (n_moves, n_samples, n_out)
+                r -= r.mean(axis=1, keepdims=True)
+            else:
+                r = np.broadcast_to(r0, (n_moves, *r0.shape))
+            w = np.stack(
+                [_interpolated_rows(t - tau, t, new.get(s, record[s])) for s, tau in zip(self.signals, self.delays)],
+                axis=-1,
+            )
+            w = np.broadcast_to(w, (n_moves, *w.shape[-2:])) - w.mean(axis=-2, keepdims=True)
+            w_t = w.transpose(0, 2, 1)
+            parts = (w_t @ w, w_t @ r, np.einsum("mno,mno->mo", r, r))
+            gram, cross, squares = parts if gram is None else (gram + parts[0], cross + parts[1], squares + parts[2])
+            n += t.size
+        if gram is None:
+            return np.zeros(0)
+        start = self.problem.start
+        return np.array([self.normal.solve_products(start, g, c, s)[1] for g, c, s in zip(gram, cross, squares)]) / n
+
+
+def _interpolated_rows(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
+    """``np.interp(x, xp, row)`` for each row of `fp` (..., n_xp), shape (..., n_x): the end values held."""
+    j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, xp.size - 2)
+    fraction = np.clip((x - xp[j]) / (xp[j + 1] - xp[j]), 0.0, 1.0)
+    low = fp[..., j]
+    out: np.ndarray = low + (fp[..., j + 1] - low) * fraction
+    return out
 
 
 class _Joint:

@@ -38,15 +38,15 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import FitWarning
 from flightlogs.frames import air_velocity_per_wind, wind_to_body_axes
-from flightlogs.parallel import map_forked, worker_count
 from flightlogs.record import Record
 from sysid._filters import butterworth_zero_phase
 from sysid.fit.result import WindClockOffset
@@ -81,10 +81,18 @@ MAX_SIGMA_S = 0.1
 #: Least contrast of the residual's minimum (:attr:`WindClockOffset.contrast`) for the offset to be claimed.
 MIN_CONTRAST = 0.03
 _ANGLES = ("phi", "theta", "psi")
+_NE = ("wind_n", "wind_e")
 
-#: ``cost(changed) -> (cost with the best G_w gains, cost without wind, weighted residual after)``, one
-#: mapping of moved signals per record.
-CostOf = Callable[[Sequence[Mapping[str, np.ndarray]]], tuple[float, float, np.ndarray]]
+class CostOf(Protocol):
+    """The residual's cost as a function of the records' moved signals (:class:`sysid.fit.wind.WindCost`)."""
+
+    def __call__(self, changed: Sequence[Mapping[str, np.ndarray]]) -> tuple[float, float, np.ndarray]:
+        """(cost with the best G_w gains, cost without wind, weighted residual after) of one mapping of moved
+        signals (n_samples,) per record."""
+
+    def costs(self, changed: Iterable[Mapping[str, np.ndarray]]) -> np.ndarray:
+        """The cost with the best gains of several moves, shape (n_moves,), from one mapping of moved signals
+        (n_moves, n_samples) per record."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -148,18 +156,19 @@ class _Moved:
         inside: np.ndarray = (t >= self.piece_time_s[0]) & (t <= self.piece_time_s[-1])
         return inside
 
-    def columns(self, shift_s: float) -> dict[str, np.ndarray]:
-        """The record's wind signals and u v w with its piece's wind moved by `shift_s`."""
-        record, t = self.record, self.record.time_s - shift_s
-        moved = np.column_stack([np.interp(t, self.piece_time_s, c) for c in self.piece_wind_ne.T])
-        change = moved - np.column_stack([record["wind_n"], record["wind_e"]])
-        out = {"wind_n": record["wind_n"] + change[:, 0], "wind_e": record["wind_e"] + change[:, 1]}
-        uvw = change[:, :1] * self.north + change[:, 1:] * self.east
-        out |= {n: record[n] + uvw[:, k] for k, n in enumerate("uvw") if n in record.signals}
-        body = change[:, :1] * self.north_body + change[:, 1:] * self.east_body  # wind_to_body_axes(change, psi)
-        for k, name in enumerate(("wind_lon", "wind_lat")):
+    def columns(self, shift_s: float | np.ndarray) -> dict[str, np.ndarray]:
+        """The record's wind signals and u v w with its piece's wind moved by `shift_s`, s: each (n_samples,), or
+        (n_moves, n_samples) for moves of shape (n_moves,)."""
+        record = self.record
+        t = record.time_s - np.asarray(shift_s, dtype=np.float64)[..., None]
+        change_n, change_e = (np.interp(t, self.piece_time_s, c) - record[s] for c, s in zip(self.piece_wind_ne.T, _NE))
+        out = {"wind_n": record["wind_n"] + change_n, "wind_e": record["wind_e"] + change_e}
+        for k, name in enumerate("uvw"):
             if name in record.signals:
-                out[name] = record[name] + body[:, k]
+                out[name] = record[name] + (change_n * self.north[:, k] + change_e * self.east[:, k])
+        for k, name in enumerate(("wind_lon", "wind_lat")):  # wind_to_body_axes(change, psi)
+            if name in record.signals:
+                out[name] = record[name] + (change_n * self.north_body[:, k] + change_e * self.east_body[:, k])
         return out
 
 
@@ -415,14 +424,9 @@ def scan_wind_offset(
 
 
 def _costs(shifts: np.ndarray, cost_of: CostOf, movable: Sequence[_Moved]) -> dict[float, float]:
-    """The cost at each move of the wind, s, by shift: the moves split over the cores, each computed as in a loop."""
-    chunks = np.array_split(shifts, worker_count(shifts.size))
-
-    def chunk(k: int) -> list[float]:
-        return [cost_of([m.columns(float(s)) for m in movable])[0] for s in chunks[k]]
-
-    found = [c for part in map_forked(chunk, len(chunks)) for c in part]
-    return dict(zip((float(s) for s in shifts), found))
+    """The cost at each move of the wind, s, by shift: all the moves of a record at once (:meth:`CostOf.costs`)."""
+    found = cost_of.costs(m.columns(shifts) for m in movable)
+    return dict(zip((float(s) for s in shifts), (float(c) for c in found)))
 
 
 def _fine_costs(centre: float, cost_of: CostOf, movable: Sequence[_Moved]) -> dict[float, float]:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -14,7 +14,9 @@ from flightlogs.readers.anemometer import read_anemometer_csv
 from flightlogs.readers.dispatch import read_log
 from simulator.campaign.demo_flight import write_demo_flight
 from sysid.fit.result import WindClockOffset
+from sysid.fit.wind import wind_cost
 from sysid.fit.wind_offset import SMOOTHING_HZ, CostOf, _fine_costs, smoothed, smoothed_flights
+from sysid.model import load_structure
 
 
 @pytest.fixture(scope="module")
@@ -78,6 +80,57 @@ def test_a_record_cut_or_thinned_moves_its_wind_as_one_made_for_it(flight: Condi
                 np.testing.assert_array_equal(ours[name], theirs[name])
 
 
+def test_a_record_moved_by_many_shifts_at_once_moves_as_by_each(flight: ConditionedFlight) -> None:
+    """The scan moves a record's wind by all its trial shifts at once: each row is that shift's move, bitwise."""
+    from sysid.fit.wind_offset import _movable
+
+    (moved, *_) = _movable(flight.records, [flight], smooth=True)
+    shifts = np.array([-4.9, -1.37, -0.01, 0.0, 0.013, 2.5])
+    at_once = moved.columns(shifts)
+    for k, shift in enumerate(shifts):
+        alone = moved.columns(float(shift))
+        assert at_once.keys() == alone.keys()
+        for name in alone:
+            assert at_once[name].shape == (shifts.size, moved.record.time_s.size)
+            np.testing.assert_array_equal(at_once[name][k], alone[name])
+
+
+@pytest.mark.parametrize("thinned", [False, True])
+def test_the_costs_of_many_moves_are_those_of_each_move(flight: ConditionedFlight, thinned: bool) -> None:
+    """The scan's costs of all its trials at once (:meth:`WindCost.costs`) are the cost of each trial alone, on
+    the scan's cut (and, for the coarse pass, thinned) records: whole-sample and fractional moves, the wind
+    read from its own record where a move does not give it, and records that move no velocity."""
+    from sysid.fit.wind_offset import _movable
+
+    structure = load_structure("hover-wind")
+    movable = [m.cut(600, m.record.time_s.size - 600) for m in _movable(flight.records, [flight], smooth=True)]
+    movable = [m.every(20.0) for m in movable] if thinned else movable
+    records = [m.record for m in movable]
+    trim = {n: float(np.mean([r.trim[n] for r in records if n in r.trim])) for r in records for n in r.trim}
+    cost = wind_cost(structure, structure.values(), structure.constants_from_trim(trim), records)
+    assert cost is not None
+    shifts = np.array([-5.0, -1.5, -1.49, -0.255, 0.0, 0.03, 3.7])
+    each = np.array([cost([m.columns(float(s)) for m in movable])[0] for s in shifts])
+    np.testing.assert_allclose(cost.costs(m.columns(shifts) for m in movable), each, rtol=1e-10)
+    assert np.ptp(each) > 0.01 * np.max(each)  # the moves change the cost: the rows are told apart
+    for dropped in (("wind_lon",), ("u", "v", "w")):  # read from the record as it is
+        partial = [{n: v for n, v in m.columns(shifts).items() if n not in dropped} for m in movable]
+        alone = [cost([{n: v[k] for n, v in p.items()} for p in partial])[0] for k in range(shifts.size)]
+        np.testing.assert_allclose(cost.costs(partial), alone, rtol=1e-10)
+
+
+def test_rows_are_interpolated_as_numpy_interpolates_each() -> None:
+    from sysid.fit.wind import _interpolated_rows
+
+    rng = np.random.default_rng(5)
+    xp = np.cumsum(rng.uniform(0.005, 0.015, 300))
+    fp = rng.standard_normal((4, xp.size))
+    x = np.concatenate([xp - 0.0123, xp[::7], [xp[0] - 1.0, xp[-1] + 1.0, xp[0], xp[-1]]])
+    expected = np.array([np.interp(x, xp, row) for row in fp])
+    np.testing.assert_allclose(_interpolated_rows(x, xp, fp), expected, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(_interpolated_rows(x, xp, fp[0]), expected[0], rtol=0, atol=1e-14)
+
+
 def test_a_flight_without_wind_is_kept_as_it_is(flight: ConditionedFlight) -> None:
     calm = replace(flight, wind=None)
     assert smoothed_flights([calm])[0] is calm
@@ -86,18 +139,27 @@ def test_a_flight_without_wind_is_kept_as_it_is(flight: ConditionedFlight) -> No
 class _Trial:
     """Stands for a record moved by the scan: the move it was asked for is what the cost reads."""
 
-    def columns(self, shift_s: float) -> dict[str, float]:
+    def columns(self, shift_s: float | np.ndarray) -> dict[str, float | np.ndarray]:
         return {"shift_s": shift_s}
 
 
-def _cost_of(true_shift_s: float) -> CostOf:
+class _CostOf:
     """A residual least at `true_shift_s`, with a ripple of 0.3 s (the wind low-passed at 2 Hz) on a parabola."""
 
-    def cost(moved: Sequence[Mapping[str, float]]) -> tuple[float, float, np.ndarray]:
-        s = moved[0]["shift_s"] - true_shift_s
+    def __init__(self, true_shift_s: float) -> None:
+        self.true_shift_s = true_shift_s
+
+    def __call__(self, moved: Sequence[Mapping[str, float]]) -> tuple[float, float, np.ndarray]:
+        s = moved[0]["shift_s"] - self.true_shift_s
         return 1.0 + 4.0 * s**2 + 0.05 * (1.0 - np.cos(2 * np.pi * s / 0.3)), 2.0, np.zeros(1)
 
-    return cost
+    def costs(self, moved: Iterable[Mapping[str, np.ndarray]]) -> np.ndarray:
+        shifts = next(iter(moved))["shift_s"]
+        return np.array([self([{"shift_s": float(s)}])[0] for s in shifts])
+
+
+def _cost_of(true_shift_s: float) -> CostOf:
+    return _CostOf(true_shift_s)
 
 
 @pytest.mark.parametrize("true_shift_s", [0.0, 0.013, -0.047, 0.08, -0.099, 0.14, -0.2])
