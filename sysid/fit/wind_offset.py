@@ -47,6 +47,7 @@ import numpy as np
 from flightlogs.conditioning.condition import ConditionedFlight
 from flightlogs.errors import FitWarning
 from flightlogs.frames import air_velocity_per_wind, wind_to_body_axes
+from flightlogs.parallel import map_forked, worker_count
 from flightlogs.record import Record
 from sysid._filters import butterworth_zero_phase
 from sysid.fit.result import WindClockOffset
@@ -424,9 +425,18 @@ def scan_wind_offset(
 
 
 def _costs(shifts: np.ndarray, cost_of: CostOf, movable: Sequence[_Moved]) -> dict[float, float]:
-    """The cost at each move of the wind, s, by shift: all the moves of a record at once (:meth:`CostOf.costs`)."""
-    found = cost_of.costs(m.columns(shifts) for m in movable)
+    """The cost at each move of the wind, s, by shift: the moves split over the cores, all the moves of a
+    record at once (:meth:`CostOf.costs`)."""
+    chunks = np.array_split(shifts, worker_count(shifts.size // _LEAST_MOVES_A_CORE))
+
+    def chunk(k: int) -> np.ndarray:
+        return cost_of.costs(m.columns(chunks[k]) for m in movable)
+
+    found = np.concatenate(list(map_forked(chunk, len(chunks))))
     return dict(zip((float(s) for s in shifts), (float(c) for c in found)))
+
+
+_LEAST_MOVES_A_CORE = 20  # fewer (the fine pass's) cost less in one process than a worker's start
 
 
 def _fine_costs(centre: float, cost_of: CostOf, movable: Sequence[_Moved]) -> dict[float, float]:
