@@ -855,7 +855,7 @@ class WindCost:
         ``cost([...])`` for the one set, to rounding: the winds' and residual's products are summed record by
         record for all the moves at once.
         """
-        gram = cross = squares = None
+        sums: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # the winds' gram, with r, r's squares
         n = 0
         for record, r0, new in zip(self.records, self.data.residual, changed):
             t = record.time_s
@@ -873,12 +873,12 @@ class WindCost:
             w = np.broadcast_to(w, (n_moves, *w.shape[-2:])) - w.mean(axis=-2, keepdims=True)
             w_t = w.transpose(0, 2, 1)
             parts = (w_t @ w, w_t @ r, np.einsum("mno,mno->mo", r, r))
-            gram, cross, squares = parts if gram is None else (gram + parts[0], cross + parts[1], squares + parts[2])
+            sums = parts if sums is None else (sums[0] + parts[0], sums[1] + parts[1], sums[2] + parts[2])
             n += t.size
-        if gram is None:
+        if sums is None:
             return np.zeros(0)
         start = self.problem.start
-        return np.array([self.normal.solve_products(start, g, c, s)[1] for g, c, s in zip(gram, cross, squares)]) / n
+        return np.array([self.normal.solve_products(start, g, c, s)[1] for g, c, s in zip(*sums)]) / n
 
 
 def _interpolated_rows(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:

@@ -84,6 +84,7 @@ MIN_CONTRAST = 0.03
 _ANGLES = ("phi", "theta", "psi")
 _NE = ("wind_n", "wind_e")
 
+
 class CostOf(Protocol):
     """The residual's cost as a function of the records' moved signals (:class:`sysid.fit.wind.WindCost`)."""
 
