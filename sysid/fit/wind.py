@@ -428,7 +428,7 @@ class _Problem:
 
     def wind_delays(self, theta: np.ndarray) -> np.ndarray:
         """Each wind channel's delay at the free values `theta`, s, shape (n_wind,)."""
-        delays: np.ndarray = self.assembler.matrices(theta).delays[self.columns]
+        delays: np.ndarray = self.assembler.delays(theta)[self.columns]
         return delays
 
     def winds(self, theta: np.ndarray) -> np.ndarray:

@@ -175,10 +175,20 @@ class Assembler:
             If M is singular or an entry cannot be evaluated.
         """
         raw = self.raw(theta)
-        env = self.environment(theta)
-        delays = np.array([float(np.real(c.delay(env))) for c in self.channels])
         a, b = self._solve_m(raw["M"], raw["F"]), self._solve_m(raw["M"], raw["G"])
-        return SystemMatrices(a=a, b=b, c=raw["H0"] + raw["H1"] @ a, d=raw["H1"] @ b, delays=delays)
+        return SystemMatrices(a=a, b=b, c=raw["H0"] + raw["H1"] @ a, d=raw["H1"] @ b, delays=self.delays(theta))
+
+    def delays(self, theta: np.ndarray) -> np.ndarray:
+        """Each input channel's delay at `theta`, s, shape (n_channels,): those of :meth:`matrices`, without the
+        matrices (a delay scan's points).
+
+        Parameters
+        ----------
+        theta : ndarray, shape (n_free,)
+            Free-parameter values.
+        """
+        env = self.environment(theta)
+        return np.array([float(np.real(c.delay(env))) for c in self.channels])
 
     def derivatives(self, theta: np.ndarray, base: SystemMatrices | None = None) -> SystemMatrices:
         """Derivatives of ``A, B, C, D`` and delays with respect to each free parameter.
