@@ -150,11 +150,27 @@ class _DelayedWinds:
         if key not in self._cache:
             if sum(x.nbytes for x in self._cache.values()) > _CACHE_BYTES:
                 self._cache.clear()
-            shifted = [np.interp(t - tau, t, w) for t, w in zip(self.times, self.winds[signal])]
+            if self.steps is not None and tau >= 0:  # np.interp's blend of two whole lags, without its search
+                shifted = [_delayed_uniform(w, tau / dt) for w, dt in zip(self.winds[signal], self.steps)]
+            else:
+                shifted = [np.interp(t - tau, t, w) for t, w in zip(self.times, self.winds[signal])]
             stacked = np.concatenate([x - x.mean() for x in shifted])  # as the residual: a bias per record
             stacked.flags.writeable = False
             self._cache[key] = stacked
         return self._cache[key]
+
+
+def _delayed_uniform(wind: np.ndarray, position: float) -> np.ndarray:
+    """`wind` (n_samples,), evenly sampled, delayed by `position` >= 0 samples: ``np.interp(t - tau, t, wind)``
+    with ``tau = position dt``, the first sample held before it, as the blend of the two whole lags around it
+    (:class:`_LagProducts`), to rounding."""
+    lag = int(position)
+    fraction = position - lag
+    n = wind.size
+    held = np.concatenate([np.full(min(lag + 1, n + 1), wind[0]), wind[: max(n - lag, 0)]])  # held[m]: m - lag - 1
+    late, later = held[1:], held[:-1]  # delayed by lag and by lag + 1 samples
+    delayed: np.ndarray = late + (later - late) * fraction if fraction else late
+    return delayed
 
 
 #: Bytes of delayed winds kept: a scan's grids of two channels (about 140 delays) at 100 000 samples.
@@ -170,7 +186,7 @@ class _LagProducts:
     the record, and its mean is the same blend of theirs; so are its products with the columns. Those of
     every whole lag up to `longest_s` are computed at once (:func:`_whole_lag_products`), the records read
     once, and a delay scan's point costs no pass over the columns. They equal the delayed winds' products to
-    rounding (np.interp's weights come from the sample times). Records not uniformly sampled, negative
+    rounding (summed in another order). Records not uniformly sampled, negative
     delays and those of :data:`_MOST_WHOLE_LAGS` samples or more take the delayed winds' products.
 
     Parameters

@@ -1,4 +1,5 @@
-"""The delay scans' products of the delayed winds, from their products at whole-sample lags (:class:`_LagProducts`).
+"""The delay scans' products of the delayed winds, from their products at whole-sample lags (:class:`_LagProducts`),
+and the delayed winds themselves (:meth:`_DelayedWinds.stacked`) against np.interp's.
 
 They must be the products of the winds np.interp delays (:meth:`_DelayedWinds.stacked`) at every delay a
 scan reaches: between samples, on a sample, past a record's length and past the lags computed first, in
@@ -52,6 +53,19 @@ def test_the_products_are_those_of_the_delayed_winds(lengths: tuple[int, ...]) -
         assert products.tables[products.signals[k]].shape[1] == 257  # 2.5 s reached: computed again, to the most
         beyond = delayed.stacked(products.signals[k], 6.0) @ fixed  # 600 lags: not tabulated
         np.testing.assert_array_equal(products(k, 6.0), beyond)
+
+
+@pytest.mark.parametrize("lengths", [(250, 517, 1000), (17_000, 300)])
+def test_the_delayed_winds_are_those_np_interp_delays(lengths: tuple[int, ...]) -> None:
+    """Evenly sampled records are delayed by the blend of two whole lags, not np.interp's search: the same winds,
+    to rounding, on and between samples, past a record's length and before its start (a negative delay)."""
+    records = _records(lengths, 5)
+    delayed = _DelayedWinds(records, ("wind_lon",))
+    assert delayed.steps is not None
+    for tau in [0.0, 0.01, 0.0137, 0.4999, 2.5, 3.0, 6.0, 200.0, -0.013]:
+        shifted = [np.interp(r.time_s - tau, r.time_s, r["wind_lon"]) for r in records]
+        expected = np.concatenate([x - x.mean() for x in shifted])
+        np.testing.assert_allclose(delayed.stacked("wind_lon", tau), expected, rtol=0, atol=1e-12)
 
 
 def test_records_not_uniformly_sampled_take_the_delayed_winds() -> None:
