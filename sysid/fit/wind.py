@@ -847,11 +847,7 @@ class WindCost:
         residual, winds = [], []
         for record, r0, new in zip(self.records, self.data.residual, changed):
             t = record.time_s
-            if any(s in new for s in self.states):
-                dx = np.column_stack([new[s] - record[s] if s in new else np.zeros(t.size) for s in self.states])
-                r = r0 - dx @ self.c_moving.T
-                r0 = r - r.mean(axis=0)
-            residual.append(r0)
+            residual.append(self._moved_residual(record, r0, new))
             w = np.column_stack(
                 [np.interp(t - tau, t, new.get(s, record[s])) for s, tau in zip(self.signals, self.delays)]
             )
@@ -876,12 +872,7 @@ class WindCost:
         for record, r0, new in zip(self.records, self.data.residual, changed):
             t = record.time_s
             n_moves = next(iter(new.values())).shape[0]
-            if any(s in new for s in self.states):
-                dx = np.stack([new[s] - record[s] if s in new else np.zeros(t.size) for s in self.states], axis=-1)
-                r = r0 - dx @ self.c_moving.T  # (n_moves, n_samples, n_out)
-                r -= r.mean(axis=1, keepdims=True)
-            else:
-                r = np.broadcast_to(r0, (n_moves, *r0.shape))
+            r = np.broadcast_to(self._moved_residual(record, r0, new), (n_moves, *r0.shape))
             w = np.stack(
                 [_interpolated_rows(t - tau, t, new.get(s, record[s])) for s, tau in zip(self.signals, self.delays)],
                 axis=-1,
@@ -895,6 +886,19 @@ class WindCost:
             return np.zeros(0)
         start = self.problem.start
         return np.array([self.normal.solve_products(start, g, c, s)[1] for g, c, s in zip(*sums)]) / n
+
+    def _moved_residual(self, record: Record, r0: np.ndarray, new: Mapping[str, np.ndarray]) -> np.ndarray:
+        """The record's residual `r0` (n_samples, n_out), bias removed, with u v w moved to `new`'s: shape
+        (n_samples, n_out), or (n_moves, n_samples, n_out) for moved signals (n_moves, n_samples); `r0` itself
+        where `new` moves no velocity."""
+        given = [new[s] for s in self.states if s in new]
+        if not given:
+            return r0
+        zero = np.zeros(np.broadcast_shapes(*(g.shape for g in given)))  # a velocity the move leaves as it was
+        dx = np.stack([new[s] - record[s] if s in new else zero for s in self.states], axis=-1)
+        r = r0 - dx @ self.c_moving.T
+        moved: np.ndarray = r - r.mean(axis=-2, keepdims=True)
+        return moved
 
 
 def _interpolated_rows(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
